@@ -1,0 +1,227 @@
+"""Build one infant as a ``mujoco.MjSpec`` from the measurement tables.
+
+Names in the returned spec are UNPREFIXED (``hip``, ``right_elbow`` ...); the world attaches each
+infant with a prefix per agent (``infant_0/``). Angles are radians everywhere
+(``spec.compiler.degree = False``).
+
+Joints a task wants held still are *frozen*: when a frozen joint comes before every free joint
+of its segment, its rotation is folded into the segment's orientation and the joint disappears
+from the model (no degree of freedom, no cost); otherwise it is held by an equality constraint.
+Motors of frozen joints are not built.
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+from importlib import resources
+from typing import Mapping
+
+import mujoco
+import numpy as np
+
+from .tables import BodyTables, load_body
+
+__all__ = ["InfantBuild", "build_infant", "axis_angle_quat", "quat_mul"]
+
+# Contact and joint-limit solver settings of the published model's defaults.
+GEOM_SOLIMP = (0.95, 0.99, 0.001, 0.5, 1.0)
+GEOM_SOLREF = (0.005, 1.0)
+GEOM_FRICTION = (1.0, 0.005, 0.0002)
+LIMIT_SOLIMP = (0.98, 0.99, 0.001, 0.5, 1.0)
+LIMIT_SOLREF = (0.02, 1.0)
+
+SKIN_RGBA = (0.94, 0.78, 0.67, 1.0)
+EYE_RGBA = (0.12, 0.08, 0.05, 1.0)
+DEFAULT_CLOTHES_RGBA = (0.35, 0.55, 0.85, 1.0)
+# Segments shown in skin colour; the rest wear the agent's clothes colour.
+SKIN_SEGMENTS = {"head", "right_hand", "left_hand", "right_fingers", "left_fingers",
+                 "right_lower_arm", "left_lower_arm"}
+EYE_FOVY_DEG = 60.0
+HIDDEN_GROUP = 3  # geom group not drawn by default renderers
+
+
+def axis_angle_quat(axis, angle: float) -> np.ndarray:
+    axis = np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    return np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * axis])
+
+
+def quat_mul(a, b) -> np.ndarray:
+    out = np.empty(4)
+    mujoco.mju_mulQuat(out, np.asarray(a, float), np.asarray(b, float))
+    return out
+
+
+_AXIS_QUATS = {  # rotate a primitive's local z onto the named axis of its segment
+    "z": (1.0, 0.0, 0.0, 0.0),
+    "x": tuple(axis_angle_quat((0, 1, 0), np.pi / 2)),
+    "y": tuple(axis_angle_quat((1, 0, 0), -np.pi / 2)),
+}
+
+
+@dataclass
+class InfantBuild:
+    """The spec of one infant and what the builder decided (unprefixed names)."""
+
+    spec: mujoco.MjSpec
+    tables: BodyTables
+    joints: list[str]            # hinge joints present in the model, in model order
+    actuated: list[str]          # joints with a motor, in actuator order
+    actuators: list[str]         # motor names, same order as `actuated`
+    frozen: dict[str, float]     # joint -> held angle (rad)
+    locked: list[str] = field(default_factory=list)  # frozen joints held by an equality
+
+
+def _excludes(hands: str) -> list[tuple[str, str]]:
+    with resources.files("mimo_social.body").joinpath("data").joinpath(
+            f"{hands}_excludes.csv").open() as f:
+        rows = [(r["body_a"], r["body_b"]) for r in csv.DictReader(f)]
+    mirror = [(a.replace("right_", "left_"), b.replace("right_", "left_")) for a, b in rows]
+    return sorted(set(rows + mirror))
+
+
+def build_infant(
+    hands: str = "mitten",
+    frozen: Mapping[str, float] | None = None,
+    base: str = "free",
+    clothes_rgba=DEFAULT_CLOTHES_RGBA,
+) -> InfantBuild:
+    """Build one infant.
+
+    Args:
+        hands: hand version (``"mitten"``).
+        frozen: joint name -> angle (rad) to hold the joint at. Frozen trunk joints drag their
+            coupled partner along (at the coupling ratio) unless it is named too.
+        base: ``"free"`` (a free joint at the hip: the infant can walk, fall, be pushed) or
+            ``"fixed"`` (the hip is fixed to the world at its placement).
+        clothes_rgba: colour of the clothed segments, so infants can be told apart.
+    """
+    tables = load_body(hands)
+    if base not in ("free", "fixed"):
+        raise ValueError(f"base={base!r}; allowed: 'free', 'fixed'")
+    by_name = {j.name: j for j in tables.joints}
+    frozen = dict(frozen or {})
+    unknown = sorted(set(frozen) - set(by_name))
+    if unknown:
+        raise ValueError(f"cannot freeze unknown joints {unknown}; known joints: {sorted(by_name)}")
+    for j in tables.joints:  # a frozen driver joint freezes its coupled follower
+        if j.coupled_to in frozen and j.name not in frozen:
+            frozen[j.name] = frozen[j.coupled_to] * j.coupling
+    for name, angle in frozen.items():
+        lo, hi = np.deg2rad(by_name[name].range_deg)
+        if not lo - 1e-9 <= angle <= hi + 1e-9:
+            raise ValueError(
+                f"frozen angle {angle:.3f} rad for {name} is outside its range [{lo:.3f}, {hi:.3f}] rad")
+
+    spec = mujoco.MjSpec()
+    spec.modelname = "mimo"
+    spec.compiler.degree = False
+    spec.compiler.autolimits = True
+
+    joints_of: dict[str, list] = {}
+    for j in tables.joints:
+        joints_of.setdefault(j.body, []).append(j)
+
+    bodies = {}
+    present, locked = [], []
+    for seg in tables.segments:
+        parent = spec.worldbody if seg.parent is None else bodies[seg.parent]
+        quat = np.array(seg.quat, float)
+        seg_joints = joints_of.get(seg.name, [])
+        folding = True
+        to_build = []
+        for j in seg_joints:  # fold a leading run of frozen joints into the segment orientation
+            if folding and j.name in frozen:
+                quat = quat_mul(quat, axis_angle_quat(j.axis, frozen[j.name]))
+            else:
+                folding = False
+                to_build.append(j)
+        body = parent.add_body(name=seg.name, pos=seg.pos, quat=quat)
+        bodies[seg.name] = body
+        if seg.parent is None and base == "free":
+            body.add_freejoint(name="root")
+        for j in to_build:
+            lo, hi = np.deg2rad(j.range_deg)
+            body.add_joint(
+                name=j.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=j.axis, range=[lo, hi],
+                limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+                springref=np.deg2rad(j.springref_deg), stiffness=[j.stiffness, 0.0, 0.0],
+                damping=[j.damping, 0.0, 0.0], frictionloss=j.frictionloss,
+                armature=j.armature, solimp_limit=LIMIT_SOLIMP, solref_limit=LIMIT_SOLREF,
+            )
+            present.append(j.name)
+            if j.name in frozen:
+                locked.append(j.name)
+        _add_geoms(body, seg.name, tables, clothes_rgba)
+
+    _add_sites_cameras_sensors(spec, bodies, tables)
+
+    for a, b in _excludes(hands):
+        spec.add_exclude(bodyname1=a, bodyname2=b)
+
+    for j in tables.joints:  # trunk coupling, when both joints are free to move
+        if j.coupled_to and j.name in present and j.coupled_to in present \
+                and j.name not in frozen:
+            spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=j.name, name2=j.coupled_to,
+                              data=np.r_[0.0, j.coupling, np.zeros(10)])
+    for name in locked:  # frozen joints that could not be folded away
+        spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=name,
+                          data=np.r_[frozen[name], np.zeros(11)])
+
+    actuated, actuators = [], []
+    for j in tables.joints:
+        if j.actuator and j.name in present and j.name not in frozen:
+            spec.add_actuator(
+                name=j.actuator, target=j.name, trntype=mujoco.mjtTrn.mjTRN_JOINT,
+                gear=[1, 0, 0, 0, 0, 0], ctrlrange=[-j.torque_neg, j.torque_pos],
+                forcerange=[-j.torque_neg, j.torque_pos],
+                ctrllimited=mujoco.mjtLimited.mjLIMITED_TRUE,
+                forcelimited=mujoco.mjtLimited.mjLIMITED_TRUE,
+            )
+            actuated.append(j.name)
+            actuators.append(j.actuator)
+    return InfantBuild(spec, tables, present, actuated, actuators, frozen, locked)
+
+
+def _add_geoms(body, segment: str, tables: BodyTables, clothes_rgba) -> None:
+    rgba = SKIN_RGBA if segment in SKIN_SEGMENTS else clothes_rgba
+    group = 0
+    if segment.endswith("_eye"):  # the face texture draws the visible eyes (with their lids)
+        rgba, group = EYE_RGBA, HIDDEN_GROUP
+    for g in tables.geoms:
+        if g.body != segment:
+            continue
+        gtype = {"sphere": mujoco.mjtGeom.mjGEOM_SPHERE, "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
+                 "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER, "box": mujoco.mjtGeom.mjGEOM_BOX,
+                 "ellipsoid": mujoco.mjtGeom.mjGEOM_ELLIPSOID}[g.type]
+        size = np.zeros(3)
+        size[: len(g.size)] = g.size
+        body.add_geom(
+            name=g.name, type=gtype, size=size, pos=g.pos, quat=_AXIS_QUATS[g.axis],
+            mass=g.mass, friction=g.friction or GEOM_FRICTION, condim=3,
+            solimp=GEOM_SOLIMP, solref=GEOM_SOLREF, rgba=rgba, group=group,
+        )
+
+
+def _add_sites_cameras_sensors(spec, bodies, tables: BodyTables) -> None:
+    head_geom = next(g for g in tables.geoms if g.name == "head")
+    bodies["head"].add_site(name="head_centre", pos=head_geom.pos, size=[0.005, 0, 0])
+    for side in ("right", "left"):
+        palm = next(g for g in tables.geoms if g.name == f"{side}_palm")
+        bodies[f"{side}_hand"].add_site(name=f"{side}_palm_centre", pos=palm.pos,
+                                        size=[0.005, 0, 0])
+        tips = next(g for g in tables.geoms if g.name == f"{side}_fingertips")
+        bodies[f"{side}_fingers"].add_site(name=f"{side}_fingertips", pos=tips.pos,
+                                           size=[0.005, 0, 0])
+        # Eye camera: MuJoCo cameras look along their local -z with +y up; the eye looks
+        # along its local +x with +z up.
+        bodies[f"{side}_eye"].add_camera(
+            name=f"{side}_eye", pos=[0, 0, 0], fovy=EYE_FOVY_DEG,
+            quat=quat_mul(axis_angle_quat((0, 0, 1), -np.pi / 2),
+                          axis_angle_quat((1, 0, 0), np.pi / 2)),
+        )
+    spec.add_sensor(name="vestibular_gyro", type=mujoco.mjtSensor.mjSENS_GYRO,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE, objname="head_centre")
+    spec.add_sensor(name="vestibular_accel", type=mujoco.mjtSensor.mjSENS_ACCELEROMETER,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE, objname="head_centre")

@@ -1,0 +1,1 @@
+"""Environments: the world, the PettingZoo ParallelEnv, the Gymnasium adapter and the tasks."""

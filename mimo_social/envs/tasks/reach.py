@@ -1,0 +1,98 @@
+"""Reach (paper Sec. VI-A): a standing infant reaches for a ball with its right hand.
+
+| | |
+|---|---|
+| agents | 1 (`infant_0`) |
+| body | hip fixed; everything but the right arm held; head and eyes fixate the ball (set each step) |
+| scene | gravity off (as in the published task); a ball (r = 2.5 cm) placed at random within reach |
+| reset | the right arm starts in one of 10 postures (fixed set, drawn once from a seeded generator); the ball position is sampled |
+| action | the 8 right-arm motors in [-1, 1] |
+| observation | `proprioception` only (the head and eye angles tell where the ball is) |
+| reward | `-distance(right fingertips, ball)`, or `+100` when the right hand or fingers touch the ball |
+| termination | on touching the ball; truncation at 1000 steps |
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...body.tables import load_body
+from ..world import AgentSetup, Prop
+from .base import GAZE_JOINTS, RIGHT_ARM_JOINTS, Task, geoms_in_contact, held_posture, point_gaze
+
+BALL_RADIUS = 0.025
+N_START_POSTURES = 10
+
+
+class Reach(Task):
+    name = "reach"
+    n_agents_range = (1, 1)
+    default_n_agents = 1
+    default_max_steps = 1000
+    physics_overrides = {"gravity": (0.0, 0.0, 0.0)}
+
+    def option_defaults(self) -> dict:
+        return {"success_reward": 100.0}
+
+    def agent_defaults(self, i):
+        return {"posture": "standing", "vestibular": False, "expressions": False}
+
+    def setup(self, i, config):
+        tables = load_body(config.hands)
+        frozen = held_posture(tables, keep=RIGHT_ARM_JOINTS + GAZE_JOINTS)
+        return AgentSetup(config, position=(0.0, 0.0), facing=(1.0, 0.0), frozen=frozen,
+                          base="fixed", actuated=RIGHT_ARM_JOINTS, gaze_joints=GAZE_JOINTS)
+
+    def props(self):
+        return [Prop("ball", "sphere", (BALL_RADIUS,), (0.3, -0.05, 0.7), 0.05, (0.9, 0.2, 0.2, 1))]
+
+    def _arm(self, env):
+        a = env.world.agents[0]
+        k = [a.joint_names.index(n) for n in RIGHT_ARM_JOINTS]
+        return a, np.array(k)
+
+    def reset(self, env, rng):
+        w = env.world
+        m, d = w.model, w.data
+        a, k = self._arm(env)
+        if not hasattr(self, "_postures"):
+            lo, hi = a.joint_range[k, 0], a.joint_range[k, 1]
+            span = hi - lo
+            fixed = np.random.default_rng(12345)  # the same 10 postures in every run
+            self._postures = lo + span * (0.3 + 0.4 * fixed.random((N_START_POSTURES, len(k))))
+            m_ = env.world.model
+            a_ = env.world.agents[0]
+            self._hand = a_.geom_ids[np.isin(m_.geom_bodyid[a_.geom_ids], [
+                m_.site_bodyid[a_.palm_sites[0]], m_.site_bodyid[a_.fingertip_sites[0]]])]
+            self._ball_geom = np.array([m_.geom("ball").id])
+            self._shoulder_body = m_.jnt_bodyid[m_.jnt_qposadr.tolist().index(
+                a_.qpos_adr[a_.joint_names.index("right_shoulder_horizontal")])]
+        d.qpos[a.qpos_adr[k]] = self._postures[rng.integers(N_START_POSTURES)]
+        # the ball: in front of the right shoulder, within the arm's reach
+        sh = d.xpos[self._shoulder_body]
+        direction = np.array([1.0, rng.uniform(-0.6, 0.2), rng.uniform(-0.5, 0.5)])
+        direction /= np.linalg.norm(direction)
+        ball = sh + rng.uniform(0.14, 0.22) * direction
+        q = w.prop_qpos["ball"]
+        d.qpos[q:q + 3] = ball
+        d.qpos[q + 3:q + 7] = (1, 0, 0, 0)
+        self._ball_start = ball.copy()
+        self._touched = False
+        self.before_physics(env)
+
+    def before_physics(self, env):
+        d = env.world.data
+        point_gaze(env, 0, d.xpos[env.world.prop_bodies["ball"]].copy())
+
+    def rewards(self, env):
+        w = env.world
+        d = w.data
+        self._touched = geoms_in_contact(w.model, d, self._hand, self._ball_geom)
+        dist = np.linalg.norm(d.site_xpos[w.agents[0].fingertip_sites[0]]
+                              - d.xpos[w.prop_bodies["ball"]])
+        self._dist = dist
+        return np.array([self.options["success_reward"] if self._touched else -dist])
+
+    def terminations(self, env):
+        return (np.array([self._touched]),
+                [{"is_success": self._touched, "distance": float(self._dist)}])

@@ -1,0 +1,47 @@
+"""Proprioception (paper Sec. V): joint angles, velocities, actuator torques, limit sensors,
+and the actuation model's state, each component switchable.
+
+Limit sensors rise linearly from 0 to 1 over the last ``limit_margin_deg`` before a joint limit:
+positive near the upper limit, negative near the lower one, 0 elsewhere.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from gymnasium import spaces
+
+
+class Proprioception:
+    def __init__(self, config, agent, actuation):
+        self.config = config
+        self.agent = agent
+        self.actuation = actuation
+        self.margin = np.deg2rad(config.limit_margin_deg)
+        n = len(agent.joint_names)
+        sizes = {"qpos": n, "qvel": n, "torque": n, "limits": n,
+                 "actuation": actuation.observation_size}
+        self.slices, start = {}, 0
+        for c in config.components:
+            self.slices[c] = slice(start, start + sizes[c])
+            start += sizes[c]
+        self.size = start
+        self.space = spaces.Box(-np.inf, np.inf, (self.size,), np.float32)
+
+    def read(self, model, data) -> np.ndarray:
+        a = self.agent
+        out = np.empty(self.size, np.float32)
+        q = data.qpos[a.qpos_adr]
+        for c, sl in self.slices.items():
+            if c == "qpos":
+                out[sl] = q
+            elif c == "qvel":
+                out[sl] = data.qvel[a.dof_adr]
+            elif c == "torque":
+                out[sl] = data.qfrc_actuator[a.dof_adr]
+            elif c == "limits":
+                lo = np.clip(1.0 - (q - a.joint_range[:, 0]) / self.margin, 0.0, 1.0)
+                hi = np.clip(1.0 - (a.joint_range[:, 1] - q) / self.margin, 0.0, 1.0)
+                out[sl] = hi - lo
+            else:
+                out[sl] = self.actuation.observation(data)
+        return out

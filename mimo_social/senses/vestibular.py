@@ -1,0 +1,23 @@
+"""Vestibular sense (paper Sec. V): a gyroscope and an accelerometer at the head centre,
+both in the head's frame (MuJoCo's gyro and accelerometer sensors)."""
+
+from __future__ import annotations
+
+import numpy as np
+from gymnasium import spaces
+
+
+class Vestibular:
+    def __init__(self, config, agent):
+        self.config = config
+        idx = []
+        if "gyro" in config.components:
+            idx += range(agent.gyro_adr, agent.gyro_adr + 3)
+        if "accel" in config.components:
+            idx += range(agent.accel_adr, agent.accel_adr + 3)
+        self.idx = np.array(idx, dtype=np.intp)
+        self.size = len(idx)
+        self.space = spaces.Box(-np.inf, np.inf, (self.size,), np.float32)
+
+    def read(self, model, data) -> np.ndarray:
+        return data.sensordata[self.idx].astype(np.float32)
