@@ -129,20 +129,20 @@ class World:
         self._build()
 
     # -- pickling: rebuild from the recipe (MuJoCo objects are not kept in the pickle) --------
+    _STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # everything mj_step reads, warm start included
+
     def __getstate__(self):
-        return {"recipe": self._recipe, "qpos": self.data.qpos.copy(),
-                "qvel": self.data.qvel.copy(), "time": self.data.time,
-                "act": self.data.act.copy(), "ctrl": self.data.ctrl.copy(),
-                "mat_texid": self.model.mat_texid.copy()}
+        m, d = self.model, self.data
+        full = np.empty(mujoco.mj_stateSize(m, self._STATE))
+        mujoco.mj_getState(m, d, full, self._STATE)
+        return {"recipe": self._recipe, "state": full, "mat_texid": m.mat_texid.copy(),
+                "bad_count": self._bad_count}
 
     def __setstate__(self, state):
         self.__init__(*state["recipe"])
-        self.data.qpos[:] = state["qpos"]
-        self.data.qvel[:] = state["qvel"]
-        self.data.act[:] = state["act"]
-        self.data.ctrl[:] = state["ctrl"]
-        self.data.time = state["time"]
+        mujoco.mj_setState(self.model, self.data, state["state"], self._STATE)
         self.model.mat_texid[:] = state["mat_texid"]
+        self._bad_count = state["bad_count"]
         mujoco.mj_forward(self.model, self.data)
 
     # -- building ------------------------------------------------------------------------------
@@ -347,7 +347,7 @@ class World:
         for a in self.agents:
             self.faces.show(self.model, a.head_material, 0)
         mujoco.mj_forward(self.model, self.data)
-        self._bad_qacc = 0
+        self._bad_count = 0
 
     @property
     def initial_qpos(self) -> np.ndarray:
@@ -360,19 +360,26 @@ class World:
             if before_substep is not None:
                 before_substep()
             mujoco.mj_step(m, d)
+        # mj_step leaves positions of the state before its last integration; bring body, geom
+        # and site poses up to date so tasks and senses read the state they are given.
+        mujoco.mj_kinematics(m, d)
         return self.instability()
 
+    _BAD = (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+            mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADCTRL)
+
     def instability(self) -> str | None:
+        """A reason string when the last steps diverged. MuJoCo resets the data when it meets a
+        NaN/inf or huge value; its warning counters tell that this happened."""
         d = self.data
-        warn = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number
-        if warn > self._bad_qacc:
-            self._bad_qacc = warn
-            return (f"MuJoCo reported bad accelerations (mjWARN_BADQACC) at t={d.time:.3f} s; "
-                    "the simulation diverged")
+        counts = [d.warning[w].number for w in self._BAD]
+        if sum(counts) > self._bad_count:
+            self._bad_count = sum(counts)
+            which = [w.name for w, c in zip(self._BAD, counts) if c]
+            return (f"MuJoCo found NaN, inf or huge values ({', '.join(which)}) and reset the "
+                    f"simulation: it went unstable")
         if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
             return f"non-finite state (NaN/inf in qpos or qvel) at t={d.time:.3f} s"
-        if np.abs(d.qvel).max() > 1e4:
-            return f"joint velocity above 1e4 at t={d.time:.3f} s: the simulation diverged"
         return None
 
     def set_expression(self, agent: int, expression: int) -> None:

@@ -1,0 +1,158 @@
+"""The PettingZoo env through its public API."""
+
+import pickle
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from pettingzoo.test import parallel_api_test, parallel_seed_test
+
+import mimo_social  # noqa: F401
+from mimo_social.envs import free_play_v0, high_five_v0
+
+
+@pytest.mark.parametrize("n_agents", [2, 3])
+def test_free_play_api(n_agents):
+    parallel_api_test(free_play_v0.parallel_env(n_agents=n_agents, max_steps=60), num_cycles=80)
+
+
+@pytest.mark.parametrize("n_agents", [2, 3])
+def test_free_play_seed(n_agents):
+    parallel_seed_test(lambda: free_play_v0.parallel_env(n_agents=n_agents, max_steps=60))
+
+
+def test_high_five_api_and_seed():
+    parallel_api_test(high_five_v0.parallel_env(max_steps=60), num_cycles=80)
+    parallel_seed_test(lambda: high_five_v0.parallel_env(max_steps=60))
+
+
+def _rollout(seed, steps=200):
+    env = free_play_v0.parallel_env(n_agents=2)
+    env.reset(seed=seed)
+    rng = np.random.default_rng(seed)
+    traj = []
+    for _ in range(steps):
+        actions = {a: {"motors": rng.uniform(-1, 1, 44).astype(np.float32),
+                       "expression": int(rng.integers(7))} for a in env.agents}
+        obs, *_ = env.step(actions)
+        traj.append(np.concatenate([obs[a]["proprioception"] for a in env.possible_agents]))
+    return np.array(traj), env.world.data.qpos.copy()
+
+
+def test_same_seed_same_trajectory_over_200_steps():
+    t1, q1 = _rollout(7)
+    t2, q2 = _rollout(7)
+    np.testing.assert_array_equal(t1, t2)
+    np.testing.assert_array_equal(q1, q2)
+    t3, _ = _rollout(8)
+    assert not np.array_equal(t1, t3)
+
+
+def test_reach_check_env():
+    env = gym.make("mimo_social/Reach-v0")
+    check_env(env.unwrapped, skip_render_check=True)
+    obs, info = env.reset(seed=0)
+    assert set(obs) == {"proprioception"}
+    assert env.action_space.shape == (8,)
+
+
+def test_reach_reward_is_minus_distance_and_success_ends():
+    env = gym.make("mimo_social/Reach-v0").unwrapped
+    env.reset(seed=1)
+    _, r, term, trunc, info = env.step(np.zeros(8, np.float32))
+    assert r == pytest.approx(-info["distance"]) and not term
+    # put the hand on the ball: the episode ends with the success reward
+    w = env.parallel.world
+    ball = w.prop_qpos["ball"]
+    w.data.qpos[ball:ball + 3] = w.data.site_xpos[w.agents[0].palm_sites[0]]
+    import mujoco
+    mujoco.mj_forward(w.model, w.data)
+    _, r, term, _, info = env.step(np.zeros(8, np.float32))
+    assert term and r == 100.0 and info["is_success"]
+
+
+def test_motor_torques_at_plus_and_minus_one():
+    """A motor at +1 and -1 (joint held by the other motors' irrelevance) gives Table I torques."""
+    env = free_play_v0.parallel_env(n_agents=1, expressions=False)
+    env.reset(seed=0)
+    a = env.world.agents[0]
+    knee = a.actuated_names.index("right_knee")
+    dof = a.dof_adr[a.joint_names.index("right_knee")]
+    for u, torque in ((1.0, 10.0), (-1.0, -6.5), (0.5, 5.0), (-0.5, -3.25)):
+        action = np.zeros(44, np.float32)
+        action[knee] = u
+        env.step({"infant_0": action})
+        assert env.world.data.qfrc_actuator[dof] == pytest.approx(torque, rel=1e-6)
+        obs = env._observe(0)["proprioception"]
+        assert torque in obs  # the actuation state reports the torque
+
+
+def test_actions_move_the_joint():
+    env = high_five_v0.parallel_env(expressions=False)
+    env.reset(seed=0)
+    a = env.world.agents[0]
+    k = a.joint_names.index("right_elbow")
+    before = env.world.data.qpos[a.qpos_adr[k]]
+    act = {n: np.zeros(8, np.float32) for n in env.agents}
+    act["infant_0"][a.actuated_names.index("right_elbow")] = -1.0  # flex
+    for _ in range(30):
+        env.step(act)
+    assert env.world.data.qpos[a.qpos_adr[k]] < before - 0.3
+
+
+def test_gravity_makes_an_unactuated_infant_settle():
+    env = free_play_v0.parallel_env(n_agents=1, expressions=False, max_steps=2000)
+    env.reset(seed=0)
+    d = env.world.data
+    root = env.world.agents[0].root_body
+    z0 = d.xpos[root, 2]
+    zero = {"infant_0": np.zeros(44, np.float32)}
+    for _ in range(400):
+        env.step(zero)
+    assert d.xpos[root, 2] < z0 - 0.05                 # it sagged or fell
+    for _ in range(200):
+        env.step(zero)
+    assert np.abs(d.qvel).max() < 0.5                  # and came to rest
+
+
+def test_pickle_round_trip():
+    env = high_five_v0.parallel_env()
+    env.reset(seed=3)
+    for _ in range(5):
+        env.step({a: env.action_space(a).sample() for a in env.agents})
+    clone = pickle.loads(pickle.dumps(env))
+    np.testing.assert_array_equal(clone.world.data.qpos, env.world.data.qpos)
+    actions = {a: {"motors": np.full(8, 0.3, np.float32), "expression": 2} for a in env.agents}
+    o1, *_ = env.step(actions)
+    o2, *_ = clone.step(actions)
+    for a in o1:
+        np.testing.assert_allclose(o1[a]["proprioception"], o2[a]["proprioception"], atol=1e-9)
+
+
+def test_spaces_follow_configuration():
+    env = free_play_v0.parallel_env(n_agents=2, vestibular=False,
+                                    per_agent=[{}, {"proprioception": {"components": ["qpos"]}}])
+    s0 = env.observation_space("infant_0")
+    s1 = env.observation_space("infant_1")
+    assert "vestibular" not in s0.spaces
+    assert s1["proprioception"].shape == (47,)
+    assert env.observation_space("infant_0") is s0
+    obs, _ = env.reset(seed=0)
+    assert s0.contains(obs["infant_0"]) and s1.contains(obs["infant_1"])
+
+
+def test_state_for_centralised_critics():
+    env = free_play_v0.parallel_env(n_agents=2)
+    env.reset(seed=0)
+    assert env.state().shape == env.state_space().shape
+
+
+def test_instability_ends_the_episode_with_a_reason():
+    env = free_play_v0.parallel_env(n_agents=2, expressions=False)
+    env.reset(seed=0)
+    env.world.data.qvel[7] = np.nan
+    _, _, term, _, infos = env.step({a: np.zeros(44, np.float32) for a in env.agents})
+    assert all(term.values())
+    assert all("instability" in i for i in infos.values())
+    assert env.agents == []
