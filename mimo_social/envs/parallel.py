@@ -194,7 +194,7 @@ class MimoParallelEnv(ParallelEnv):
                                      f"'expression' (expressions are on), got {action!r:.200}")
                 motors, expression = action["motors"], action["expression"]
                 e = np.asarray(expression)
-                if e.shape not in ((), (1,)) or not np.issubdtype(e.dtype, np.integer) \
+                if e.shape not in ((), (1,)) or e.dtype.kind not in "iu" \
                         or not 0 <= int(e.reshape(())) < len(EXPRESSIONS):
                     raise ValueError(
                         f"{a}: expression={expression!r} not allowed; an integer 0..{len(EXPRESSIONS) - 1}: "
@@ -211,7 +211,7 @@ class MimoParallelEnv(ParallelEnv):
                 bad = [self.world.agents[i].actuated_names[k] for k in np.flatnonzero(~np.isfinite(u))]
                 raise ValueError(f"{a}: motor action has NaN/inf for {bad}; values must be finite, "
                                  "in [-1, 1]")
-            np.clip(u, -1.0, 1.0, out=u)
+            u.clip(-1.0, 1.0, out=u)
             self._controls[i] = u
             act.apply(w.model, w.data, u)
 

@@ -365,21 +365,20 @@ class World:
         mujoco.mj_kinematics(m, d)
         return self.instability()
 
-    _BAD = (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
-            mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADCTRL)
+    _BAD = np.array([mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                     mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADCTRL], int)
 
     def instability(self) -> str | None:
         """A reason string when the last steps diverged. MuJoCo resets the data when it meets a
         NaN/inf or huge value; its warning counters tell that this happened."""
         d = self.data
-        counts = [d.warning[w].number for w in self._BAD]
-        if sum(counts) > self._bad_count:
-            self._bad_count = sum(counts)
-            which = [w.name for w, c in zip(self._BAD, counts) if c]
+        counts = d.warning.number[self._BAD]
+        total = int(counts.sum())
+        if total > self._bad_count:
+            self._bad_count = total
+            which = [mujoco.mjtWarning(w).name for w, c in zip(self._BAD, counts) if c]
             return (f"MuJoCo found NaN, inf or huge values ({', '.join(which)}) and reset the "
                     f"simulation: it went unstable")
-        if not (np.isfinite(d.qpos).all() and np.isfinite(d.qvel).all()):
-            return f"non-finite state (NaN/inf in qpos or qvel) at t={d.time:.3f} s"
         return None
 
     def set_expression(self, agent: int, expression: int) -> None:

@@ -17,6 +17,9 @@ class Proprioception:
         self.agent = agent
         self.actuation = actuation
         self.margin = np.deg2rad(config.limit_margin_deg)
+        self._inv_margin = 1.0 / self.margin
+        self._lo = agent.joint_range[:, 0].copy()
+        self._hi = agent.joint_range[:, 1].copy()
         n = len(agent.joint_names)
         sizes = {"qpos": n, "qvel": n, "torque": n, "limits": n,
                  "actuation": actuation.observation_size}
@@ -38,9 +41,9 @@ class Proprioception:
                 out[sl] = data.qvel[a.dof_adr]
             elif c == "torque":
                 out[sl] = data.qfrc_actuator[a.dof_adr]
-            elif c == "limits":
-                lo = np.clip(1.0 - (q - a.joint_range[:, 0]) / self.margin, 0.0, 1.0)
-                hi = np.clip(1.0 - (a.joint_range[:, 1] - q) / self.margin, 0.0, 1.0)
+            elif c == "limits":  # 1 - distance/margin, floored at 0, on each side
+                lo = np.maximum(1.0 - (q - self._lo) * self._inv_margin, 0.0)
+                hi = np.maximum(1.0 - (self._hi - q) * self._inv_margin, 0.0)
                 out[sl] = hi - lo
             else:
                 out[sl] = self.actuation.observation(data)

@@ -34,7 +34,7 @@ class SpringDamper(Actuation):
         return self._high
 
     def torque(self, u: np.ndarray) -> np.ndarray:
-        return np.where(u >= 0.0, u * self.torque_pos, u * self.torque_neg)
+        return u * self.strength(u)
 
     def apply(self, model, data, controls):
         self._u = np.asarray(controls, dtype=float)
@@ -59,11 +59,11 @@ class SpringDamper(Actuation):
 
     def cost(self, controls):
         u = np.asarray(controls, dtype=float)
-        return float(np.mean(u * u)) if u.size else 0.0
+        return float(u @ u) / u.size if u.size else 0.0
 
     def weighted_cost(self, controls):
         u = np.asarray(controls, dtype=float)
         if not u.size:
             return 0.0
         t = self.strength(u)
-        return float(np.sum(u * u * t) / (u.size * np.sum(t)))
+        return float((u * u) @ t) / (u.size * float(t.sum()))
