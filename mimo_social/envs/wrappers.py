@@ -1,0 +1,312 @@
+"""Flat (Box) views of the environments, for learners that want one array in and one array out.
+
+``FlattenParallel(env)``
+    A PettingZoo ``ParallelEnv`` around any ParallelEnv of this package. Each agent's observation
+    becomes one float32 ``Box``: the entries of its ``Dict`` observation flattened and concatenated
+    in the order of the ``Dict`` space (``proprioception`` then ``vestibular`` ...). Each agent's
+    action becomes one float32 ``Box``:
+
+    * motors only (``expressions=False``): the motor ``Box`` itself, ``[-1, 1]^n``;
+    * with expressions: ``n`` motor values followed by 7 expression *logits* in ``[-1, 1]``; the
+      expression played is ``argmax(logits)`` (ties go to the lowest id, so "neutral" wins when
+      all logits are equal, e.g. all clipped to the same bound).
+
+    Spaces are built once: ``observation_space(agent)`` / ``action_space(agent)`` return the same
+    object every call. ``reset(seed=...)`` passes the seed to the wrapped env; ``render``,
+    ``close``, ``state`` and ``state_space`` are the wrapped env's, other public attributes are
+    looked up on it. The wrapper pickles (the wrapped env drops its renderer when pickled).
+
+``make_sb3_single(env_id_or_env)``
+    A Gymnasium env with a ``Box`` observation (``gymnasium.wrappers.FlattenObservation``) and a
+    ``Box`` action (expression logits as above, when the env has a ``Dict`` action), for SB3.
+"""
+
+from __future__ import annotations
+
+import traceback
+from typing import Any, Callable, Mapping
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+
+__all__ = ["FlattenParallel", "FlatActionWrapper", "make_sb3_single", "flat_action_space",
+           "flat_observation_space"]
+
+LOGIT_LOW, LOGIT_HIGH = -1.0, 1.0
+
+
+# -- observations -------------------------------------------------------------------------------
+class _ObsFlattener:
+    """Turns one agent's observation (a ``Dict``, a ``Box`` or another space) into a float32 vector."""
+
+    def __init__(self, space: spaces.Space):
+        self.source = space
+        if isinstance(space, spaces.Dict):
+            self.parts = list(space.spaces.items())
+        else:
+            self.parts = [(None, space)]
+        lows, highs = [], []
+        for _, sub in self.parts:
+            flat = spaces.flatten_space(sub)
+            if not isinstance(flat, spaces.Box):
+                raise TypeError(f"cannot flatten observation space {sub} to a Box")
+            lows.append(np.asarray(flat.low, dtype=np.float32).ravel())
+            highs.append(np.asarray(flat.high, dtype=np.float32).ravel())
+        self.space = spaces.Box(np.concatenate(lows), np.concatenate(highs), dtype=np.float32)
+        self._box = [isinstance(sub, spaces.Box) for _, sub in self.parts]
+
+    def __call__(self, obs) -> np.ndarray:
+        chunks = []
+        for (key, sub), is_box in zip(self.parts, self._box):
+            value = obs if key is None else obs[key]
+            if is_box:
+                chunks.append(np.asarray(value, dtype=np.float32).ravel())
+            else:
+                chunks.append(np.asarray(spaces.flatten(sub, value), dtype=np.float32).ravel())
+        return np.concatenate(chunks)
+
+
+def flat_observation_space(space: spaces.Space) -> spaces.Box:
+    """The float32 ``Box`` that :class:`FlattenParallel` gives for an observation space."""
+    return _ObsFlattener(space).space
+
+
+# -- actions ------------------------------------------------------------------------------------
+class _ActionDecoder:
+    """Maps a flat float32 action onto an agent's action space of this package.
+
+    Supported: a ``Box`` (returned reshaped), or ``Dict({"motors": Box, "expression": Discrete})``
+    (the Box holds the motors then one logit per expression).
+    """
+
+    def __init__(self, space: spaces.Space):
+        self.source = space
+        if isinstance(space, spaces.Box):
+            self.n_motors = int(np.prod(space.shape))
+            self.n_expressions = 0
+            self.motor_shape = space.shape
+            low, high = space.low.ravel(), space.high.ravel()
+        elif (isinstance(space, spaces.Dict) and set(space.spaces) == {"motors", "expression"}
+              and isinstance(space["motors"], spaces.Box)
+              and isinstance(space["expression"], spaces.Discrete)):
+            motors, expression = space["motors"], space["expression"]
+            self.n_motors = int(np.prod(motors.shape))
+            self.n_expressions = int(expression.n)
+            self.expression_start = int(expression.start)
+            self.motor_shape = motors.shape
+            low = np.concatenate([motors.low.ravel(),
+                                  np.full(self.n_expressions, LOGIT_LOW)])
+            high = np.concatenate([motors.high.ravel(),
+                                   np.full(self.n_expressions, LOGIT_HIGH)])
+        else:
+            raise TypeError(f"cannot flatten action space {space}; supported: a Box of motors, or "
+                            "Dict(motors=Box, expression=Discrete)")
+        self.space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32),
+                                dtype=np.float32)
+
+    def __call__(self, action, who: str = "agent"):
+        a = np.asarray(action, dtype=np.float32)
+        if a.shape != self.space.shape:
+            layout = (f"{self.n_motors} motors + {self.n_expressions} expression logits"
+                      if self.n_expressions else f"{self.n_motors} motors")
+            raise ValueError(f"{who}: flat action has shape {a.shape}; expected "
+                             f"{self.space.shape} ({layout})")
+        motors = a[:self.n_motors].reshape(self.motor_shape)
+        if not self.n_expressions:
+            return motors
+        logits = a[self.n_motors:]
+        if not np.isfinite(logits).all():
+            raise ValueError(f"{who}: expression logits must be finite, got {logits}")
+        return {"motors": motors,
+                "expression": np.int64(self.expression_start + int(np.argmax(logits)))}
+
+
+def flat_action_space(space: spaces.Space) -> spaces.Box:
+    """The float32 ``Box`` that :class:`FlattenParallel` accepts for an action space."""
+    return _ActionDecoder(space).space
+
+
+# -- the PettingZoo wrapper ---------------------------------------------------------------------
+class FlattenParallel(ParallelEnv):
+    """Box observations and Box actions for every agent of a ParallelEnv (see module docstring)."""
+
+    def __init__(self, env: ParallelEnv):
+        if not isinstance(env, ParallelEnv):
+            raise TypeError(f"FlattenParallel wraps a pettingzoo ParallelEnv, got {type(env).__name__}")
+        self.env = env
+        self.metadata = dict(getattr(env, "metadata", {}))
+        self.render_mode = getattr(env, "render_mode", None)
+        self.possible_agents = list(env.possible_agents)
+        self._obs = {a: _ObsFlattener(env.observation_space(a)) for a in self.possible_agents}
+        self._act = {a: _ActionDecoder(env.action_space(a)) for a in self.possible_agents}
+        self._obs_spaces = {a: f.space for a, f in self._obs.items()}
+        self._act_spaces = {a: d.space for a, d in self._act.items()}
+
+    # the live agents are always the wrapped env's
+    @property
+    def agents(self):
+        return self.env.agents
+
+    @property
+    def unwrapped(self):
+        return self.env.unwrapped
+
+    def observation_space(self, agent):
+        try:
+            return self._obs_spaces[agent]
+        except KeyError:
+            raise KeyError(f"unknown agent {agent!r}; agents of this env: "
+                           f"{self.possible_agents}") from None
+
+    def action_space(self, agent):
+        try:
+            return self._act_spaces[agent]
+        except KeyError:
+            raise KeyError(f"unknown agent {agent!r}; agents of this env: "
+                           f"{self.possible_agents}") from None
+
+    def _flat_obs(self, obs: Mapping[str, Any]) -> dict:
+        return {a: (self._obs[a](o) if a in self._obs else o) for a, o in obs.items()}
+
+    def reset(self, seed: int | None = None, options: dict | None = None):
+        obs, infos = self.env.reset(seed=seed, options=options)
+        return self._flat_obs(obs), infos
+
+    def step(self, actions: Mapping[str, Any]):
+        if not isinstance(actions, Mapping):
+            raise ValueError(f"actions must be a dict agent -> action, got {type(actions).__name__}")
+        # unknown agents are passed on untouched: the wrapped env names them in its error
+        decoded = {a: (self._act[a](act, a) if a in self._act else act)
+                   for a, act in actions.items()}
+        obs, rewards, terminations, truncations, infos = self.env.step(decoded)
+        return self._flat_obs(obs), rewards, terminations, truncations, infos
+
+    def render(self):
+        return self.env.render()
+
+    def close(self):
+        return self.env.close()
+
+    def state(self):
+        return self.env.state()
+
+    def state_space(self, *args, **kwargs):
+        space = self.env.state_space
+        return space(*args, **kwargs) if callable(space) else space
+
+    def __getattr__(self, name: str):
+        # only public names, and never before __init__/__setstate__ has set ``env`` (pickling)
+        env = self.__dict__.get("env")
+        if env is None or name.startswith("_"):
+            raise AttributeError(f"{type(self).__name__} has no attribute {name!r}")
+        return getattr(env, name)
+
+    def __str__(self):
+        return f"FlattenParallel<{self.env}>"
+
+
+# -- the Gymnasium side -------------------------------------------------------------------------
+class FlatActionWrapper(gym.ActionWrapper):
+    """A Gymnasium env with a ``Dict(motors, expression)`` action takes the flat Box instead."""
+
+    def __init__(self, env: gym.Env):
+        super().__init__(env)
+        self._decoder = _ActionDecoder(env.action_space)
+        self.action_space = self._decoder.space
+
+    def action(self, action):
+        return self._decoder(action, "action")
+
+
+def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
+    """A one-agent Gymnasium env with a ``Box`` observation and a ``Box`` action, for SB3.
+
+    ``env_id_or_env``: a registered id (``"mimo_social/Reach-v0"``; ``make_kwargs`` go to
+    ``gymnasium.make``) or a ``gymnasium.Env``. A non-Box observation is flattened with
+    ``gymnasium.wrappers.FlattenObservation``; a ``Dict(motors, expression)`` action becomes the
+    flat Box of :class:`FlatActionWrapper`.
+    """
+    if isinstance(env_id_or_env, str):
+        import mimo_social  # noqa: F401  (registers the ids)
+        env = gym.make(env_id_or_env, **make_kwargs)
+    elif isinstance(env_id_or_env, gym.Env):
+        if make_kwargs:
+            raise TypeError("keyword arguments are only used with an env id, not with an env")
+        env = env_id_or_env
+    else:
+        raise TypeError(f"make_sb3_single takes an env id or a gymnasium.Env, got "
+                        f"{type(env_id_or_env).__name__}")
+    if not isinstance(env.observation_space, spaces.Box):
+        env = gym.wrappers.FlattenObservation(env)
+    if not isinstance(env.action_space, spaces.Box):
+        env = FlatActionWrapper(env)
+    return env
+
+
+# -- worker side of ``vector.SpawnConcatVecEnv`` ------------------------------------------------
+# (here rather than in ``vector`` because this module imports neither SB3 nor torch: a spawned
+# worker imports the module of its target function)
+def _markov_env(env_fn: Callable[[], ParallelEnv]):
+    """One world as SuperSuit's gymnasium vector env (one slot per agent)."""
+    import supersuit as ss
+    return ss.pettingzoo_env_to_vec_env_v1(FlattenParallel(env_fn()))
+
+
+def _world_call(par_env: FlattenParallel, kind: str, name: str, args: tuple = (),
+                kwargs: dict | None = None):
+    """Get or set an attribute of, or call a method of, one world (a FlattenParallel)."""
+    if kind == "get":
+        return getattr(par_env, name)
+    if kind == "set":
+        setattr(par_env.unwrapped, name, args[0])
+        return None
+    if kind == "call":
+        return getattr(par_env, name)(*args, **(kwargs or {}))
+    raise ValueError(f"unknown world call {kind!r}")
+
+
+def _vec_worker(conn, payload: bytes, n_worlds: int) -> None:
+    """Process entry point: SuperSuit's in-process vector env of ``n_worlds`` worlds built from
+    the cloudpickled ``env_fn`` in ``payload``; every answer on ``conn`` is ``(status, value)``."""
+    try:
+        import cloudpickle
+        import supersuit as ss
+        env_fn = cloudpickle.loads(payload)
+        venv = ss.concat_vec_envs_v1(_markov_env(env_fn), n_worlds, num_cpus=0,
+                                     base_class="gymnasium")
+        par_envs = [m.par_env for m in venv.vec_envs]
+        conn.send(("ok", (venv.num_envs, venv.observation_space, venv.action_space,
+                          dict(venv.metadata), venv.render_mode)))
+    except BaseException:
+        conn.send(("error", traceback.format_exc()))
+        conn.close()
+        return
+    try:
+        while True:
+            try:
+                cmd, data = conn.recv()
+            except EOFError:  # the parent is gone
+                break
+            if cmd == "close":
+                venv.close()
+                conn.send(("ok", None))
+                break
+            try:
+                if cmd == "step":
+                    out = venv.step(data)
+                elif cmd == "reset":
+                    out = venv.reset(seed=data[0], options=data[1])
+                elif cmd == "world":
+                    out = [_world_call(p, *data) for p in par_envs]
+                else:
+                    raise ValueError(f"unknown command {cmd!r}")
+            except Exception:
+                conn.send(("error", traceback.format_exc()))
+            else:
+                conn.send(("ok", out))
+    except KeyboardInterrupt:
+        pass
+    finally:
+        conn.close()
