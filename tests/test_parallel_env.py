@@ -156,3 +156,31 @@ def test_instability_ends_the_episode_with_a_reason():
     assert all(term.values())
     assert all("instability" in i for i in infos.values())
     assert env.agents == []
+
+
+def test_gaze_fixates_the_target():
+    """In reach, both eye cameras look at the ball; in high five, at the partner's right hand."""
+    env = gym.make("mimo_social/Reach-v0").unwrapped
+    for seed in range(3):
+        env.reset(seed=seed)
+        w = env.parallel.world
+        d = w.data
+        ball = d.xpos[w.prop_bodies["ball"]]
+        for cam in w.agents[0].eye_cameras:
+            look = -d.cam_xmat[cam].reshape(3, 3)[:, 2]
+            to_ball = ball - d.cam_xpos[cam]
+            cos = look @ to_ball / np.linalg.norm(to_ball)
+            assert cos > np.cos(np.deg2rad(2.0))
+    hf = high_five_v0.parallel_env(expressions=False)
+    hf.reset(seed=0)
+    for _ in range(10):
+        hf.step({a: np.full(8, 0.4, np.float32) for a in hf.agents})
+    hf.task.before_physics(hf)
+    import mujoco
+    mujoco.mj_camlight(hf.world.model, hf.world.data)  # camera poses follow the new angles
+    d = hf.world.data
+    hand1 = d.site_xpos[hf.world.agents[1].palm_sites[0]]
+    cam = hf.world.agents[0].eye_cameras[1]
+    look = -d.cam_xmat[cam].reshape(3, 3)[:, 2]
+    to_hand = hand1 - d.cam_xpos[cam]
+    assert look @ to_hand / np.linalg.norm(to_hand) > np.cos(np.deg2rad(2.0))

@@ -360,9 +360,10 @@ class World:
             if before_substep is not None:
                 before_substep()
             mujoco.mj_step(m, d)
-        # mj_step leaves positions of the state before its last integration; bring body, geom
-        # and site poses up to date so tasks and senses read the state they are given.
+        # mj_step leaves positions of the state before its last integration; bring body, geom,
+        # site and camera poses up to date so tasks and senses read the state they are given.
         mujoco.mj_kinematics(m, d)
+        mujoco.mj_camlight(m, d)
         return self.instability()
 
     _BAD = np.array([mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,

@@ -107,57 +107,83 @@ def held_posture(tables, keep: tuple[str, ...], angles: Mapping[str, float] | No
     return out
 
 
-def geoms_in_contact(model, data, geoms_a: np.ndarray, geoms_b: np.ndarray) -> bool:
-    """True when any active contact joins a geom of set a with a geom of set b."""
-    n = data.ncon
-    if n == 0:
-        return False
-    g1 = data.contact.geom1[:n]
-    g2 = data.contact.geom2[:n]
-    real = data.contact.dist[:n] <= 0.0
-    ina1, ina2 = np.isin(g1, geoms_a), np.isin(g2, geoms_a)
-    inb1, inb2 = np.isin(g1, geoms_b), np.isin(g2, geoms_b)
-    return bool(np.any(real & ((ina1 & inb2) | (ina2 & inb1))))
+class ContactProbe:
+    """Tells whether any active contact joins a geom of set a with a geom of set b.
+
+    Boolean masks over all geoms are built once, so a query is two gathers over the contacts.
+    """
+
+    def __init__(self, ngeom: int, geoms_a, geoms_b):
+        self.a = np.zeros(ngeom, bool)
+        self.b = np.zeros(ngeom, bool)
+        self.a[np.asarray(geoms_a, dtype=np.intp)] = True
+        self.b[np.asarray(geoms_b, dtype=np.intp)] = True
+
+    def __call__(self, data) -> bool:
+        n = data.ncon
+        if n == 0:
+            return False
+        c = data.contact
+        g1, g2 = c.geom1[:n], c.geom2[:n]
+        hit = (self.a[g1] & self.b[g2]) | (self.a[g2] & self.b[g1])
+        return bool(np.any(hit & (c.dist[:n] <= 0.0)))
 
 
-def point_gaze(env: "MimoParallelEnv", i: int, target: np.ndarray) -> None:
-    """Turn agent i's head and eyes to fixate ``target`` (world point): sets the joint angles.
+class Gaze:
+    """Turns one agent's head and eyes to fixate a world point by setting their joint angles.
 
     The head turns (swivel, then tilt) to face the target from the neck; each eye then turns
     (horizontal, then vertical) to look at it from its own centre, so the joint angles of head
     and eyes together tell where the target is, as in the paper's reach and catch tasks.
+    Addresses are resolved once; a call costs three ``mj_kinematics``.
     """
-    m, d = env.world.model, env.world.data
-    a = env.world.agents[i]
-    idx = a.gaze_idx
-    if not len(idx):
-        return
-    names = [a.joint_names[k] for k in idx]
-    adr = {n: a.qpos_adr[k] for n, k in zip(names, idx)}
-    d.qpos[[adr[n] for n in names]] = 0.0
-    d.qvel[[a.dof_adr[k] for k in idx]] = 0.0
-    mujoco.mj_kinematics(m, d)
-    head_body = m.site_bodyid[a.head_site]
-    if "head_swivel" in adr:
-        R = d.xmat[head_body].reshape(3, 3)
-        v = R.T @ (target - d.xpos[head_body])
-        _set(d, a, adr, "head_swivel", np.arctan2(v[1], v[0]))
-        _set(d, a, adr, "head_tilt", -np.arctan2(v[2], np.hypot(v[0], v[1])))
-        mujoco.mj_kinematics(m, d)
-    R = d.xmat[head_body].reshape(3, 3)
-    for side, cam in zip(("right", "left"), a.eye_cameras):
-        h = f"{side}_eye_horizontal"
-        if h not in adr:
-            continue
-        v = R.T @ (target - d.xpos[m.cam_bodyid[cam]])
-        az = np.arctan2(v[1], v[0])
-        _set(d, a, adr, h, az if side == "left" else -az)
-        _set(d, a, adr, f"{side}_eye_vertical", np.arctan2(v[2], np.hypot(v[0], v[1])))
-    mujoco.mj_kinematics(m, d)
 
+    def __init__(self, world, i: int):
+        m = world.model
+        a = world.agents[i]
+        self.agent = a
+        names = [a.joint_names[k] for k in a.gaze_idx]
+        self.qpos = a.qpos_adr[a.gaze_idx]
+        self.dof = a.dof_adr[a.gaze_idx]
+        self.head_body = int(m.site_bodyid[a.head_site])
+        self.has_head = "head_swivel" in names
 
-def _set(d, a, adr, name, angle):
-    if name in adr:
-        k = a.joint_names.index(name)
-        lo, hi = a.joint_range[k]
-        d.qpos[adr[name]] = np.clip(angle, lo, hi)
+        def slot(name):
+            if name not in names:
+                return None
+            k = a.gaze_idx[names.index(name)]
+            return int(a.qpos_adr[k]), float(a.joint_range[k, 0]), float(a.joint_range[k, 1])
+
+        self.swivel, self.tilt = slot("head_swivel"), slot("head_tilt")
+        self.eyes = [(int(m.cam_bodyid[cam]), sign, slot(f"{side}_eye_horizontal"),
+                      slot(f"{side}_eye_vertical"))
+                     for side, sign, cam in (("right", -1.0, a.eye_cameras[0]),
+                                             ("left", 1.0, a.eye_cameras[1]))]
+
+    @staticmethod
+    def _set(d, slot, angle):
+        if slot is not None:
+            adr, lo, hi = slot
+            d.qpos[adr] = min(max(float(angle), lo), hi)
+
+    def __call__(self, model, data, kind: str, obj: int) -> None:
+        """Fixate body ``obj`` (``kind="body"``) or site ``obj`` (``kind="site"``)."""
+        d = data
+        if not len(self.qpos):
+            return
+        d.qpos[self.qpos] = 0.0
+        d.qvel[self.dof] = 0.0
+        mujoco.mj_kinematics(model, d)  # also brings the target's position up to date
+        target = (d.xpos if kind == "body" else d.site_xpos)[obj].copy()
+        hb = self.head_body
+        if self.has_head:
+            v = d.xmat[hb].reshape(3, 3).T @ (target - d.xpos[hb])
+            self._set(d, self.swivel, np.arctan2(v[1], v[0]))
+            self._set(d, self.tilt, -np.arctan2(v[2], np.hypot(v[0], v[1])))
+            mujoco.mj_kinematics(model, d)
+        R = d.xmat[hb].reshape(3, 3)
+        for body, sign, horizontal, vertical in self.eyes:
+            v = R.T @ (target - d.xpos[body])
+            self._set(d, horizontal, sign * np.arctan2(v[1], v[0]))
+            self._set(d, vertical, np.arctan2(v[2], np.hypot(v[0], v[1])))
+        mujoco.mj_kinematics(model, d)

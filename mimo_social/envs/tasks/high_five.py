@@ -16,7 +16,7 @@ import numpy as np
 
 from ...body.tables import load_body
 from ..world import AgentSetup
-from .base import GAZE_JOINTS, RIGHT_ARM_JOINTS, Task, geoms_in_contact, held_posture, point_gaze
+from .base import GAZE_JOINTS, RIGHT_ARM_JOINTS, ContactProbe, Gaze, Task, held_posture
 
 DISTANCE = 0.45
 
@@ -51,21 +51,24 @@ class HighFive(Task):
         return a.geom_ids[np.isin(m.geom_bodyid[a.geom_ids], list(bodies))]
 
     def reset(self, env, rng):
-        self._geoms = [self._hand_geoms(env, i) for i in range(2)]
+        if not hasattr(self, "_gaze"):
+            self._gaze = [Gaze(env.world, i) for i in range(2)]
+            self._palms = [env.world.agents[i].palm_sites[0] for i in range(2)]
+            self._hands_meet = ContactProbe(env.world.model.ngeom, self._hand_geoms(env, 0),
+                                            self._hand_geoms(env, 1))
         self._touching = False
         self.before_physics(env)
 
     def before_physics(self, env):
-        d = env.world.data
+        m, d = env.world.model, env.world.data
         for i in range(2):
-            partner = env.world.agents[1 - i]
-            point_gaze(env, i, d.site_xpos[partner.palm_sites[0]].copy())
+            self._gaze[i](m, d, "site", self._palms[1 - i])
 
     def rewards(self, env):
         d = env.world.data
         a0, a1 = env.world.agents
         dist = np.linalg.norm(d.site_xpos[a0.palm_sites[0]] - d.site_xpos[a1.palm_sites[0]])
-        self._touching = geoms_in_contact(env.world.model, d, self._geoms[0], self._geoms[1])
+        self._touching = self._hands_meet(d)
         r = -dist + (self.options["touch_bonus"] if self._touching else 0.0)
         self._distance = dist
         return np.array([r, r])

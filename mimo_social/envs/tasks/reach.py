@@ -18,7 +18,7 @@ import numpy as np
 
 from ...body.tables import load_body
 from ..world import AgentSetup, Prop
-from .base import GAZE_JOINTS, RIGHT_ARM_JOINTS, Task, geoms_in_contact, held_posture, point_gaze
+from .base import GAZE_JOINTS, RIGHT_ARM_JOINTS, ContactProbe, Gaze, Task, held_posture
 
 BALL_RADIUS = 0.025
 N_START_POSTURES = 10
@@ -64,7 +64,9 @@ class Reach(Task):
             a_ = env.world.agents[0]
             self._hand = a_.geom_ids[np.isin(m_.geom_bodyid[a_.geom_ids], [
                 m_.site_bodyid[a_.palm_sites[0]], m_.site_bodyid[a_.fingertip_sites[0]]])]
-            self._ball_geom = np.array([m_.geom("ball").id])
+            self._touch_ball = ContactProbe(m_.ngeom, self._hand, [m_.geom("ball").id])
+            self._gaze = Gaze(env.world, 0)
+            self._ball_body = env.world.prop_bodies["ball"]
             self._shoulder_body = m_.jnt_bodyid[m_.jnt_qposadr.tolist().index(
                 a_.qpos_adr[a_.joint_names.index("right_shoulder_horizontal")])]
         d.qpos[a.qpos_adr[k]] = self._postures[rng.integers(N_START_POSTURES)]
@@ -81,13 +83,13 @@ class Reach(Task):
         self.before_physics(env)
 
     def before_physics(self, env):
-        d = env.world.data
-        point_gaze(env, 0, d.xpos[env.world.prop_bodies["ball"]].copy())
+        w = env.world
+        self._gaze(w.model, w.data, "body", self._ball_body)
 
     def rewards(self, env):
         w = env.world
         d = w.data
-        self._touched = geoms_in_contact(w.model, d, self._hand, self._ball_geom)
+        self._touched = self._touch_ball(d)
         dist = np.linalg.norm(d.site_xpos[w.agents[0].fingertip_sites[0]]
                               - d.xpos[w.prop_bodies["ball"]])
         self._dist = dist
