@@ -28,7 +28,8 @@ from .world import World
 
 __all__ = ["MimoParallelEnv", "TIMING_KEYS"]
 
-TIMING_KEYS = ("actuation", "physics", "proprioception", "vestibular", "task", "other")
+TIMING_KEYS = ("actuation", "physics", "proprioception", "vestibular", "touch", "vision", "task",
+               "other")
 
 
 class MimoParallelEnv(ParallelEnv):
@@ -65,8 +66,15 @@ class MimoParallelEnv(ParallelEnv):
         self._steps = 0
 
     def _bind(self):
+        """Actuation and senses of every agent, and the observation and action spaces.
+
+        A sense is an object with ``name`` (its timing key), ``spaces`` (observation key ->
+        space) and ``observe(model, data, out)``. A shared system (one per world, e.g. the
+        touch skin reading the contacts once for everyone) has ``name``, ``reset(model, data)``
+        and ``update(model, data)``, run once per step before the senses read.
+        """
         w = self.world
-        self.actuation, self.proprioception, self.vestibular = [], [], []
+        self.actuation, self.senses, self.shared = [], [], []
         self._obs_spaces, self._act_spaces = {}, {}
         self._needs_substep = False
         for i, (name, cfg, a) in enumerate(zip(self.possible_agents, self.agent_configs, w.agents)):
@@ -76,24 +84,26 @@ class MimoParallelEnv(ParallelEnv):
                                                   a.actuator_ids)
             self._needs_substep |= act.needs_substep
             self.actuation.append(act)
-            prop = Proprioception(cfg.proprioception, a, act) if cfg.proprioception else None
-            vest = Vestibular(cfg.vestibular, a) if cfg.vestibular else None
-            self.proprioception.append(prop)
-            self.vestibular.append(vest)
+            senses = []
+            if cfg.proprioception:
+                senses.append(Proprioception(cfg.proprioception, a, act))
+            if cfg.vestibular:
+                senses.append(Vestibular(cfg.vestibular, a))
+            self.senses.append(senses)
+        for i, name in enumerate(self.possible_agents):
             obs = {}
-            if prop:
-                obs["proprioception"] = prop.space
-            if vest:
-                obs["vestibular"] = vest.space
+            for sense in self.senses[i]:
+                obs.update(sense.spaces)
             obs.update(self.task.task_spaces(self, i))
             if not obs:
                 raise ConfigError(f"{name}: every sense is off; turn on at least one of "
                                   "proprioception, vestibular")
             self._obs_spaces[name] = spaces.Dict(obs)
+            act = self.actuation[i]
             motors = spaces.Box(act.control_low, act.control_high, dtype=np.float32)
             self._act_spaces[name] = (spaces.Dict({"motors": motors,
                                                    "expression": spaces.Discrete(len(EXPRESSIONS))})
-                                      if cfg.expressions else motors)
+                                      if self.agent_configs[i].expressions else motors)
         self._expression = np.zeros(len(self.possible_agents), dtype=np.int64)
         self._controls = [np.zeros(act.n_controls) for act in self.actuation]
 
@@ -121,6 +131,9 @@ class MimoParallelEnv(ParallelEnv):
             c[:] = 0.0
         self.task.reset(self, self._rng)
         mujoco.mj_forward(w.model, w.data)
+        for system in self.shared:
+            system.reset(w.model, w.data)
+        self._update_shared()
         self.agents = list(self.possible_agents)
         self._steps = 0
         obs = {a: self._observe(i) for i, a in enumerate(self.agents)}
@@ -152,6 +165,7 @@ class MimoParallelEnv(ParallelEnv):
         t3 = time.perf_counter()
         timing["physics"] += t3 - t2
         self._steps += 1
+        self._update_shared()
         obs = {a: self._observe(self._index[a]) for a in self.agents}
         t4 = time.perf_counter()
         rewards = self.task.rewards(self)
@@ -218,18 +232,23 @@ class MimoParallelEnv(ParallelEnv):
     def _observe(self, i: int) -> dict:
         m, d = self.world.model, self.world.data
         out = {}
+        timing = self.timing
         t = time.perf_counter()
-        if self.proprioception[i] is not None:
-            out["proprioception"] = self.proprioception[i].read(m, d)
-        t2 = time.perf_counter()
-        if self.vestibular[i] is not None:
-            out["vestibular"] = self.vestibular[i].read(m, d)
-        t3 = time.perf_counter()
+        for sense in self.senses[i]:
+            sense.observe(m, d, out)
+            t2 = time.perf_counter()
+            timing[sense.name] += t2 - t
+            t = t2
         out.update(self.task.observe(self, i))
-        self.timing["proprioception"] += t2 - t
-        self.timing["vestibular"] += t3 - t2
-        self.timing["task"] += time.perf_counter() - t3
+        timing["task"] += time.perf_counter() - t
         return out
+
+    def _update_shared(self):
+        m, d = self.world.model, self.world.data
+        for system in self.shared:
+            t = time.perf_counter()
+            system.update(m, d)
+            self.timing[system.name] += time.perf_counter() - t
 
     def _info(self, i: int) -> dict:
         act = self.actuation[i]

@@ -12,6 +12,8 @@ from gymnasium import spaces
 
 
 class Proprioception:
+    name = "proprioception"
+
     def __init__(self, config, agent, actuation):
         self.config = config
         self.agent = agent
@@ -29,6 +31,10 @@ class Proprioception:
             start += sizes[c]
         self.size = start
         self.space = spaces.Box(-np.inf, np.inf, (self.size,), np.float32)
+        self.spaces = {self.name: self.space}
+
+    def observe(self, model, data, out: dict) -> None:
+        out[self.name] = self.read(model, data)
 
     def read(self, model, data) -> np.ndarray:
         a = self.agent

@@ -8,6 +8,8 @@ from gymnasium import spaces
 
 
 class Vestibular:
+    name = "vestibular"
+
     def __init__(self, config, agent):
         self.config = config
         idx = []
@@ -18,6 +20,10 @@ class Vestibular:
         self.idx = np.array(idx, dtype=np.intp)
         self.size = len(idx)
         self.space = spaces.Box(-np.inf, np.inf, (self.size,), np.float32)
+        self.spaces = {self.name: self.space}
+
+    def observe(self, model, data, out: dict) -> None:
+        out[self.name] = data.sensordata[self.idx].astype(np.float32)
 
     def read(self, model, data) -> np.ndarray:
         return data.sensordata[self.idx].astype(np.float32)
