@@ -71,11 +71,58 @@ class VestibularConfig:
             "vestibular", self.components, VESTIBULAR_COMPONENTS))
 
 
-_SENSES = {"proprioception": ProprioceptionConfig, "vestibular": VestibularConfig}
-_NOT_YET = {
-    "touch": "the touch skin is not part of this version (it is the next milestone)",
-    "vision": "eye cameras are not part of this version (they arrive with the vision milestone)",
-}
+TOUCH_RESPONSES = ("spread_linear", "nearest")
+TOUCH_FRAMES = ("body", "world")
+
+
+@dataclass(frozen=True)
+class TouchConfig:
+    """The full-body skin: sensor points over every body part, each sensing a force vector.
+
+    ``density`` multiplies the published per-part point density (spacing / sqrt(density));
+    ``exclude`` lists body parts without skin; ``response`` spreads each contact over nearby
+    points; ``frame`` is the frame of the force vectors; ``normal_only`` keeps 1 value a point.
+    """
+
+    density: float = 1.0
+    response: str = "spread_linear"
+    frame: str = "body"
+    normal_only: bool = False
+    exclude: tuple[str, ...] = ()
+    cache: bool = True
+
+    def __post_init__(self):
+        if not 0.05 <= float(self.density) <= 8.0:
+            raise ConfigError(f"touch: density={self.density}; allowed: 0.05 to 8 (a multiplier "
+                              "of the published point density)")
+        if self.response not in TOUCH_RESPONSES:
+            raise ConfigError(f"touch: response={self.response!r}; allowed: {list(TOUCH_RESPONSES)}")
+        if self.frame not in TOUCH_FRAMES:
+            raise ConfigError(f"touch: frame={self.frame!r}; allowed: {list(TOUCH_FRAMES)}")
+        object.__setattr__(self, "exclude", tuple(self.exclude))
+
+
+@dataclass(frozen=True)
+class VisionConfig:
+    """Two eye cameras (60 degree field of view) rendering RGB images, optionally depth."""
+
+    width: int = 256
+    height: int = 256
+    depth: bool = False
+    every: int = 1          # render every k-th control step, holding the last images between
+
+    def __post_init__(self):
+        for key in ("width", "height"):
+            v = getattr(self, key)
+            if not isinstance(v, int) or not 8 <= v <= 2048:
+                raise ConfigError(f"vision: {key}={v!r}; allowed: an integer 8 to 2048 pixels")
+        if not isinstance(self.every, int) or not 1 <= self.every <= 1000:
+            raise ConfigError(f"vision: every={self.every!r}; allowed: an integer 1 to 1000")
+
+
+_SENSES = {"proprioception": ProprioceptionConfig, "vestibular": VestibularConfig,
+           "touch": TouchConfig, "vision": VisionConfig}
+_NOT_YET: dict = {}
 
 
 @dataclass(frozen=True)
@@ -86,8 +133,8 @@ class AgentConfig:
     actuation: str = "spring_damper"
     proprioception: ProprioceptionConfig | None = ProprioceptionConfig()
     vestibular: VestibularConfig | None = VestibularConfig()
-    touch: None = None
-    vision: None = None
+    touch: TouchConfig | None = None
+    vision: VisionConfig | None = None
     expressions: bool = True
     posture: str = "standing"
     position: tuple[float, float] | None = None   # (x, y) on the floor; None: the task decides

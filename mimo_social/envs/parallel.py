@@ -10,6 +10,7 @@ allowed. A simulation that goes unstable ends the episode for every agent with t
 
 from __future__ import annotations
 
+import importlib
 import time
 from typing import Any, Mapping, Sequence
 
@@ -90,6 +91,18 @@ class MimoParallelEnv(ParallelEnv):
             if cfg.vestibular:
                 senses.append(Vestibular(cfg.vestibular, a))
             self.senses.append(senses)
+        # Senses that share one per-world system: the skin reads the contacts once for every
+        # agent; the eyes share one renderer per process.
+        for key, module, builder in (("touch", "touch", "build_touch"),
+                                     ("vision", "vision", "build_vision")):
+            configs = [getattr(c, key) for c in self.agent_configs]
+            if any(configs):
+                mod = importlib.import_module(f"mimo_social.senses.{module}")
+                system, per_agent = getattr(mod, builder)(w, configs)
+                self.shared.append(system)
+                for i, sense in enumerate(per_agent):
+                    if sense is not None:
+                        self.senses[i].append(sense)
         for i, name in enumerate(self.possible_agents):
             obs = {}
             for sense in self.senses[i]:
@@ -97,7 +110,7 @@ class MimoParallelEnv(ParallelEnv):
             obs.update(self.task.task_spaces(self, i))
             if not obs:
                 raise ConfigError(f"{name}: every sense is off; turn on at least one of "
-                                  "proprioception, vestibular")
+                                  "proprioception, vestibular, touch, vision")
             self._obs_spaces[name] = spaces.Dict(obs)
             act = self.actuation[i]
             motors = spaces.Box(act.control_low, act.control_high, dtype=np.float32)
@@ -253,9 +266,13 @@ class MimoParallelEnv(ParallelEnv):
     def _info(self, i: int) -> dict:
         act = self.actuation[i]
         u = self._controls[i]
-        return {"expression": EXPRESSIONS[self._expression[i]], "step": self._steps,
+        info = {"expression": EXPRESSIONS[self._expression[i]], "step": self._steps,
                 "time": float(self.world.data.time),
                 "cost": act.cost(u), "weighted_cost": act.weighted_cost(u)}
+        for sense in self.senses[i]:
+            if hasattr(sense, "info"):
+                info.update(sense.info())
+        return info
 
     def state(self) -> np.ndarray:
         d = self.world.data
