@@ -242,17 +242,18 @@ class World:
     def _rest_pose(build, posture: str, setup: AgentSetup):
         """Joint angles of the posture, the root orientation, and the hip height on the floor."""
         spec = build.spec.copy()
+        hip = spec.body("hip")
+        if hip.first_joint() is None or hip.first_joint().type != mujoco.mjtJoint.mjJNT_FREE:
+            hip.add_freejoint(name="root")  # only to orient this measuring copy
         model = spec.compile()
         data = mujoco.MjData(model)
-        tables = build.tables
-        by_name = {j.name: j for j in tables.joints}
+        by_name = {j.name: j for j in build.tables.joints}
         wanted = POSTURES[posture]["joints"]
         pose = {}
         for name in build.joints:
             j = by_name[name]
             lo, hi = np.deg2rad(j.range_deg)
-            angle = np.deg2rad(wanted.get(name, j.springref_deg))
-            pose[name] = float(np.clip(angle, lo, hi))
+            pose[name] = float(np.clip(np.deg2rad(wanted.get(name, j.springref_deg)), lo, hi))
         for name in build.joints:  # coupled trunk joints follow their driver
             j = by_name[name]
             if j.coupled_to in pose:
@@ -262,27 +263,12 @@ class World:
             pose[name] = build.frozen[name]
         pitch = axis_angle_quat((0, 1, 0), np.deg2rad(POSTURES[posture]["pitch_deg"]))
         root_quat = quat_mul(_yaw_quat(setup.position, setup.facing), pitch)
-        if model.njnt and model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE:
-            data.qpos[3:7] = root_quat
+        data.qpos[model.joint("root").qposadr[0] + 3:][:4] = root_quat
         for name, angle in pose.items():
             data.qpos[model.joint(name).qposadr[0]] = angle
         mujoco.mj_kinematics(model, data)
-        geoms = np.arange(model.ngeom)
-        low = float(_support_below(model, data, geoms).min())
-        if model.njnt and model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE:
-            height = -low + 0.002
-        else:  # fixed base: orientation is the frame's; measure with it applied
-            R = np.empty(9)
-            mujoco.mju_quat2Mat(R, root_quat)
-            R = R.reshape(3, 3)
-            pts_low = np.inf
-            for g in geoms:
-                xm = data.geom_xmat[g].reshape(3, 3)
-                data.geom_xpos[g] = R @ data.geom_xpos[g]
-                data.geom_xmat[g] = (R @ xm).ravel()
-            pts_low = float(_support_below(model, data, geoms).min())
-            height = -pts_low + 0.002
-        return pose, root_quat, height
+        low = float(_support_below(model, data, np.arange(model.ngeom)).min())
+        return pose, root_quat, -low + 0.002
 
     def _index(self, builds):
         m = self.model
