@@ -1,0 +1,632 @@
+"""Touch (paper Sec. V-C): a full-body skin of force sensors on every infant, infant-to-infant too.
+
+Turn it on with ``touch=True`` or a mapping of :class:`~mimo_social.envs.config.TouchConfig`
+settings (``density``, ``response``, ``frame``, ``normal_only``, ``exclude``, ``cache``), for all
+agents or per agent (``per_agent=[...]``).
+
+Observation ``touch`` (flat float32)
+    The skin points of every skinned body part, part after part in model body order (see
+    :meth:`TouchSystem.layout`); per point the force the touching thing exerts on the skin there,
+    3 floats (x, y, z) in the part's body frame (``frame="body"``, default) or the world frame
+    (``frame="world"``), or 1 float, the normal (pressing) force, with ``normal_only=True``.
+    A pressing force points into the body, against the point's outward normal.
+
+How a contact is felt
+    Every MuJoCo contact that has a skinned geom on either side is read once per control step
+    (after the physics, before any agent observes), for all agents at once. Its force (normal and
+    friction, in the contact frame, decoded from ``data.efc_force`` exactly as
+    ``mujoco.mj_contactForce`` does) is felt by each skinned side, with the sign for that side: a
+    contact between two skinned bodies (self-touch, two infants) is felt by both. Each contact
+    point, in the touched part's body frame and moved half a spacing outward along the contact
+    normal (so on a thin part it stays on the touched side), is looked up in the part's
+    precomputed grid, which names a skin point next to it; the force is spread over that point's
+    precomputed surface neighbourhood (:mod:`.skin`), so it never bleeds through a thin part.
+    All of it is array operations over all contacts at once (no Python loop over contacts or
+    points):
+
+    * ``spread_linear`` (default, the published response): weight ``max(0, (2s - d) / (2s))`` of
+      each neighbour at straight-line distance d from the contact (s: the part's spacing),
+      normalised to sum 1: the summed normal force over the points equals the contact's normal
+      force, and the friction is spread with the same weights (a contact farther than 2 s from
+      every point lands on the nearest one);
+    * ``nearest``: all of the force on the nearest point of the neighbourhood.
+
+    Where the reach 2 s exceeds a part's thickness (low densities), force that wraps round the
+    part's rim within that reach over the surface is felt on the far side near the rim, as the
+    published breadth-first search allows; straight through the part it is not.
+
+    ``mj_step`` leaves contacts at the positions before its last integration while the world
+    brings body poses up to date after stepping; each contact point is carried along with its
+    body over that last step (velocities from ``mujoco.mj_comVel``; ``data`` is left as it was)
+    before it is placed on the skin.
+
+Infos
+    ``infos[agent]["touch"]``: per body part touched this step (unprefixed name, parts in contact
+    only), who touches it: ``{"self": bool, "agents": [names], "object": bool}``; a geom of another
+    agent names that agent, a geom of the same agent is ``self``, a world or prop geom (the floor
+    too) is ``object``.
+
+For people
+    :meth:`TouchSystem.view` gives per part the points, normals and forces in world coordinates;
+    :func:`save_skin_png` draws one agent's skin coloured by force (paper Fig. 5b);
+    ``python -m mimo_social.senses.touch out.png`` draws a hand holding a ball.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Sequence
+
+import mujoco
+import numpy as np
+from gymnasium import spaces
+
+from ..envs.config import ConfigError, TouchConfig
+from .skin import GRID_CELL, Skin, build_skin
+
+__all__ = ["build_touch", "TouchSystem", "AgentTouch", "save_skin_png", "hand_ball_scene",
+           "save_hand_ball_png"]
+
+_SHIFT = 0.5   # a contact is looked up this many spacings outward along its normal
+_PYRAMIDAL = int(mujoco.mjtCone.mjCONE_PYRAMIDAL)
+_AR3 = np.arange(3)
+_SIGN = np.array([[-1.0], [1.0]])
+# cross products as matrix products: a x b = [a]x b, with the 3x3 matrix [a]x = (a @ _SKEW)
+_LEVI_CIVITA = np.zeros((3, 3, 3))
+for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+    _LEVI_CIVITA[_i, _j, _k], _LEVI_CIVITA[_i, _k, _j] = 1.0, -1.0
+_SKEW = np.transpose(_LEVI_CIVITA, (1, 0, 2)).reshape(3, 9)
+_AR4 = np.arange(4)
+# pyramid edge forces (f0+, f0-, f1+, f1-) -> (normal, f0+ - f0-, f1+ - f1-)
+_PYRAMID = np.array([[1.0, 1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 0.0, 1.0], [1.0, 0.0, -1.0]])
+
+
+class AgentTouch:
+    """One agent's touch sense: reads its slice of the shared :class:`TouchSystem`."""
+
+    name = "touch"
+
+    def __init__(self, system: "TouchSystem", agent: int):
+        self.system = system
+        self.agent = agent
+        self.config = system.configs[agent]
+        self.skin = system.skins[agent]
+        self.start, self.stop = system.agent_slices[agent]
+        n = self.stop - self.start
+        size = n if self.config.normal_only else 3 * n
+        self.space = spaces.Box(-np.inf, np.inf, (size,), np.float32)
+        self.spaces = {self.name: self.space}
+
+    @property
+    def n_points(self) -> int:
+        return self.stop - self.start
+
+    def observe(self, model, data, out: dict) -> None:
+        out[self.name] = self.read()
+
+    def read(self) -> np.ndarray:
+        """This agent's ``touch`` vector as of the last update (a new float32 array)."""
+        if self.config.normal_only:
+            return self.system._normal[self.start:self.stop].astype(np.float32)
+        return self.system._xyz[3 * self.start:3 * self.stop].astype(np.float32)
+
+    def info(self) -> dict:
+        return {"touch": self.system.touched_by(self.agent)}
+
+
+class TouchSystem:
+    """The skins of all agents with touch, updated once per control step from the contacts."""
+
+    name = "touch"
+
+    def __init__(self, world, configs: Sequence[TouchConfig | None]):
+        m = world.model
+        self.world = world
+        self.names = list(world.names)
+        self.configs = list(configs)
+        self.skins: list[Skin | None] = []
+        t0 = time.perf_counter()
+        for i, cfg in enumerate(configs):
+            if cfg is None:
+                self.skins.append(None)
+                continue
+            agent = world.agents[i]
+            spacing = world.tables[i].touch_spacing
+            prefix = f"{world.names[i]}/"
+            known = sorted({m.body(int(b)).name[len(prefix):] for b in agent.body_ids
+                            if m.body_geomnum[b] > 0})
+            bad = [p for p in cfg.exclude if p not in known]
+            if bad:
+                raise ConfigError(f"agent {world.names[i]}: touch: exclude={list(cfg.exclude)} "
+                                  f"names unknown body part(s) {bad}; known parts: {known}")
+            if set(known) <= set(cfg.exclude):
+                raise ConfigError(f"agent {world.names[i]}: touch: exclude removes every body "
+                                  "part; use touch=False to turn touch off")
+            self.skins.append(build_skin(m, agent.body_ids, prefix, spacing, cfg.density,
+                                         cfg.exclude, cfg.cache))
+        self._concatenate(m)
+        self.build_seconds = time.perf_counter() - t0
+        self.reset(m, world.data)
+
+    # -- building --------------------------------------------------------------------------------
+    def _concatenate(self, m):
+        """All agents' skins as one set of arrays (global point and part numbers)."""
+        pts, nrm, scaled, nbr, parts, grids = [], [], [], [], [], []
+        part_body, part_agent, part_s, part_start, part_world, part_nearest = [], [], [], [], [], []
+        params = []
+        self.part_names: list[str] = []
+        self.agent_slices: list[tuple[int, int]] = []
+        self.agent_parts: list[range] = []
+        geom_part = np.full(m.ngeom, -1, dtype=np.intp)
+        skins = [(i, sk) for i, sk in enumerate(self.skins) if sk is not None]
+        N = sum(sk.n_points for _, sk in skins)      # row N: a sink for padded neighbours
+        n0 = cells0 = 0
+        for i, skin in enumerate(self.skins):
+            if skin is None:
+                self.agent_slices.append((n0, n0))
+                self.agent_parts.append(range(len(part_body), len(part_body)))
+                continue
+            cfg = self.configs[i]
+            p0 = len(part_body)
+            for k, name in enumerate(skin.part_names):
+                part_body.append(int(skin.part_bodies[k]))
+                part_agent.append(i)
+                part_s.append(float(skin.part_spacing[k]))
+                part_start.append(n0 + int(skin.part_start[k]))
+                part_world.append(cfg.frame == "world")
+                part_nearest.append(cfg.response == "nearest")
+                self.part_names.append(name)
+                geom_part[skin.part_geoms[k]] = p0 + k
+                dims = skin.grid_dims[k]
+                strides = np.array([dims[1] * dims[2], dims[2], 1], float)
+                params.append(np.concatenate([[1.0 / skin.part_spacing[k]], skin.grid_lo[k],
+                                              dims - 1.0, strides,
+                                              [cells0 + skin.grid_start[k]]]))
+            s = skin.part_spacing[skin.point_part][:, None]
+            pts.append(skin.points)
+            nrm.append(skin.normals)
+            scaled.append(skin.points / s)
+            nb = skin.nbr.astype(np.intp) + n0
+            nb[~np.isfinite(skin.nbr_dist)] = N
+            nbr.append(nb)
+            parts.append(skin.point_part + p0)
+            grids.append(skin.grid.astype(np.intp) + n0)
+            self.agent_slices.append((n0, n0 + skin.n_points))
+            self.agent_parts.append(range(p0, len(part_body)))
+            n0 += skin.n_points
+            cells0 += len(skin.grid)
+        self.n_points = N
+        part_start.append(N)
+        K = max(a.shape[1] for a in nbr)
+        self.points = np.concatenate(pts)
+        self.normals = np.concatenate(nrm)
+        self.scaled = np.concatenate(scaled + [np.full((1, 3), 1e9)])  # points / spacing
+        self.nbr = np.concatenate([np.pad(a, ((0, 0), (0, K - a.shape[1])), constant_values=N)
+                                   for a in nbr])
+        self.point_part = np.concatenate(parts)
+        self.grid = np.concatenate(grids)
+        self.part_body = np.array(part_body, dtype=np.intp)
+        self.part_root = m.body_rootid[self.part_body].astype(np.intp)
+        self.part_agent = np.array(part_agent, dtype=np.intp)
+        self.part_spacing = np.array(part_s)
+        self.part_start = np.array(part_start, dtype=np.intp)
+        self.part_world = np.array(part_world, bool)
+        self.part_nearest = np.array(part_nearest, bool)
+        self.part_params = np.array(params)
+        # one more entry, -1, so that the geom id -1 of a flex contact reads as "no skin", "world"
+        self.geom_part = np.append(geom_part, -1)
+        self.geom_agent = np.append(np.asarray(self.world.geom_agent, dtype=np.intp), -1)
+        self._any_world = bool(self.part_world.any())
+        self._all_world = bool(self.part_world.all())
+        self._any_nearest = bool(self.part_nearest.any())
+        # the forces of all points, one flat array: [x, y, z of point 0, 1, ..., N | normal force
+        # of point 0, 1, ..., N]; point N is the sink of padded neighbours. Per point, the four
+        # places it owns in that array:
+        self._acc = np.zeros(4 * (N + 1))
+        p = np.arange(N + 1)
+        self._slots = np.stack([3 * p, 3 * p + 1, 3 * p + 2, 3 * (N + 1) + p], axis=1)
+        self._touched = None
+        # every contact has 3 rows (pyramidal: 4) when every geom has condim 3 and no pairs
+        self._all_dim3 = m.npair == 0 and bool(np.all(m.geom_condim == 3))
+
+    # -- the shared-system interface -------------------------------------------------------------
+    def reset(self, model, data) -> None:
+        self._acc[:] = 0.0
+        self._touched = None
+        self._just_reset = True   # the next update reads contacts of mj_forward: no integration
+        self._clear()
+
+    def _clear(self):
+        if self._touched is not None:   # zero only what the last update wrote
+            self._acc[self._touched] = 0.0
+            self._touched = None
+        self._sides = None
+        self._info = {}
+
+    @property
+    def _xyz(self) -> np.ndarray:
+        return self._acc[:3 * (self.n_points + 1)]
+
+    @property
+    def _normal(self) -> np.ndarray:
+        return self._acc[3 * (self.n_points + 1):]
+
+    @property
+    def force_xyz(self) -> np.ndarray:
+        """(3 N,) per point force x, y, z in its agent's output frame (read-only view)."""
+        v = self._xyz[:3 * self.n_points]
+        v.flags.writeable = False
+        return v
+
+    @property
+    def force_normal(self) -> np.ndarray:
+        """(N,) per point normal force (read-only view)."""
+        v = self._normal[:self.n_points]
+        v.flags.writeable = False
+        return v
+
+    @staticmethod
+    def _decode(c, ci, ea, efc, pyramidal: bool, all_dim3: bool) -> np.ndarray:
+        """Normal and two friction forces (contact frame) of the contacts ``ci``: what
+        ``mujoco.mj_contactForce`` returns, for all contacts at once."""
+        if all_dim3:
+            if pyramidal:
+                f = efc[ea[:, None] + _AR4] @ _PYRAMID      # normal, p0 - p1, p2 - p3
+                f[:, 1:] *= c.friction[ci, :2]
+                return f
+            return efc[ea[:, None] + _AR3]
+        dim = c.dim[ci]
+        f = np.zeros((len(ci), 3))
+        fr = dim >= 3
+        if pyramidal:
+            rows = np.where(dim > 1, 2 * (dim - 1), 1)
+            width = int(rows.max())
+            cols = np.arange(width)
+            mask = cols < rows[:, None]
+            P = np.where(mask, efc[np.where(mask, ea[:, None] + cols, 0)], 0.0)
+            f[:, 0] = P.sum(1)
+            if width >= 4:
+                mu = c.friction[ci]
+                f[fr, 1] = (P[fr, 0] - P[fr, 1]) * mu[fr, 0]
+                f[fr, 2] = (P[fr, 2] - P[fr, 3]) * mu[fr, 1]
+        else:
+            f[:, 0] = efc[ea]
+            f[fr, 1] = efc[ea[fr] + 1]
+            f[fr, 2] = efc[ea[fr] + 2]
+        return f
+
+    def update(self, model, data) -> None:
+        """Read the contacts once and compute every agent's point forces."""
+        self._clear()
+        h = 0.0 if self._just_reset else model.opt.timestep
+        self._just_reset = False
+        if data.ncon == 0:
+            return
+        c = data.contact
+        geom = c.geom.ravel()                            # geom1, geom2 of each contact
+        gp = self.geom_part[geom]
+        sides = np.flatnonzero(gp >= 0)                  # one row per skinned side of a contact
+        if not len(sides):
+            return
+        ci = sides >> 1
+        ea = c.efc_address[ci]
+        if ea.min() < 0:                                 # contacts MuJoCo left out (no dofs ...)
+            keep = ea >= 0
+            sides, ci, ea = sides[keep], ci[keep], ea[keep]
+            if not len(sides):
+                return
+        efc = data.efc_force
+        pyramidal = model.opt.cone == _PYRAMIDAL         # (read each step: it may change)
+        if self._all_dim3 and pyramidal:                 # as mj_contactForce does
+            f = efc[ea[:, None] + _AR4] @ _PYRAMID       # normal, p0 - p1, p2 - p3
+            f[:, 1:] *= c.friction[ci, :2]
+        else:                                            # (S, 3) contact frame, on geom2
+            f = self._decode(c, ci, ea, efc, pyramidal, self._all_dim3)
+        part = gp[sides]
+        body = self.part_body[part]
+        sign = _SIGN[sides & 1]                          # geom2 feels +F, geom1 -F
+        # rows: the contact point relative to the body, the outward normal of the touched skin
+        # and the force on it, all in the world frame
+        frame = c.frame[ci].reshape(-1, 3, 3)            # rows: normal (geom1 -> geom2), tangents
+        V = np.empty((len(ci), 3, 3))
+        V[:, 0] = c.pos[ci]
+        V[:, 1] = frame[:, 0]
+        np.matmul((f * sign)[:, None, :], frame, out=V[:, 2:])
+        if h > 0.0:
+            # carry the contact point along with its body over the last physics step: the
+            # bodies moved by h times their velocities of now (semi-implicit Euler), expressed in
+            # the com frames of the contacts' time (``cdof``, ``subtree_com`` are still those)
+            kept = data.cvel.copy(), data.cdof_dot.copy()
+            mujoco.mj_comVel(model, data)
+            cv = data.cvel[body]                         # [angular; linear at the root's com]
+            data.cvel[:], data.cdof_dot[:] = kept        # leave MjData as the step left it
+            arm = V[:, 0] - data.subtree_com[self.part_root[part]]
+            spin = (cv[:, :3] @ _SKEW).reshape(-1, 3, 3)    # [w]x
+            V[:, 0] += h * (cv[:, 3:] + (spin @ arm[:, :, None])[:, :, 0])
+        V[:, 0] -= data.xpos[body]
+        R = data.xmat[body].reshape(-1, 3, 3)
+        B = V @ R                                        # the same rows in the body frame
+        prm = self.part_params[part]
+        qs = B[:, 0] * prm[:, :1]                        # contact point, in spacings
+        cell = np.floor((qs - (_SHIFT * sign) * B[:, 1] - prm[:, 1:4]) * (1.0 / GRID_CELL))
+        np.clip(cell, 0.0, prm[:, 4:7], out=cell)
+        flat = np.einsum("si,si->s", cell, prm[:, 7:10]) + prm[:, 10]
+        nb = np.take(self.nbr, np.take(self.grid, flat.astype(np.intp)), axis=0)  # (S, K)
+        diff = np.take(self.scaled, nb, axis=0) - qs[:, None, :]
+        d = np.sqrt(np.einsum("skj,skj->sk", diff, diff))  # in spacings
+        w = np.maximum(1.0 - 0.5 * d, 0.0)
+        if self._any_nearest:
+            near = np.flatnonzero(self.part_nearest[part])
+            if len(near):
+                w[near] = 0.0
+                w[near, d[near].argmin(1)] = 1.0
+        total = w.sum(1)
+        if total.min() <= 0.0:                           # no point within 2 s: the nearest
+            lone = np.flatnonzero(total <= 0.0)
+            w[lone, d[lone].argmin(1)] = 1.0
+            total[lone] = 1.0
+        # per side: force (output frame) and normal force, divided by the summed weights
+        out = np.empty((len(ci), 4))
+        if self._all_world:
+            out[:, :3] = V[:, 2]
+        else:
+            out[:, :3] = B[:, 2]
+            if self._any_world:
+                world = self.part_world[part]
+                out[world, :3] = V[world, 2]
+        out[:, 3] = f[:, 0]
+        out /= total[:, None]
+        slots = np.take(self._slots, nb, axis=0).ravel()
+        np.add.at(self._acc, slots, (w[:, :, None] * out[:, None, :]).ravel())
+        self._touched = slots
+        self._sides = (part, geom[sides ^ 1], f[:, 0])
+
+    # -- who touches what ------------------------------------------------------------------------
+    def touched_by(self, agent: int) -> dict:
+        """Per touched body part of ``agent``: whether itself, other agents, objects touch it.
+
+        Worked out for every agent at the first call after an update (one pass over the
+        contacts), then read from there."""
+        if self._sides is None:
+            return {}
+        if not self._info:
+            part, other, fn = self._sides
+            info: dict = {i: {} for i, sk in enumerate(self.skins) if sk is not None}
+            names, part_names = self.names, self.part_names
+            for p, owner, src, f in zip(part.tolist(), self.part_agent[part].tolist(),
+                                        self.geom_agent[other].tolist(), fn.tolist()):
+                if f <= 0.0:
+                    continue
+                entry = info[owner].get(part_names[p])
+                if entry is None:
+                    entry = info[owner][part_names[p]] = {"self": False, "agents": [],
+                                                          "object": False}
+                if src < 0:
+                    entry["object"] = True
+                elif src == owner:
+                    entry["self"] = True
+                elif names[src] not in entry["agents"]:
+                    entry["agents"].append(names[src])
+            for parts in info.values():
+                for entry in parts.values():
+                    entry["agents"].sort()
+            self._info = info
+        return self._info.get(agent, {})
+
+    # -- for people ------------------------------------------------------------------------------
+    def _agent_index(self, agent) -> int:
+        if isinstance(agent, str):
+            if agent not in self.names:
+                raise KeyError(f"unknown agent {agent!r}; agents: {self.names}")
+            agent = self.names.index(agent)
+        if self.skins[agent] is None:
+            raise ValueError(f"{self.names[agent]} has no touch skin (touch is off for it)")
+        return int(agent)
+
+    def layout(self, agent) -> dict[str, tuple[int, int]]:
+        """Per body part of ``agent``: (first, last + 1) point index in its ``touch`` vector
+        (3 floats a point, or 1 with ``normal_only``)."""
+        i = self._agent_index(agent)
+        a0 = self.agent_slices[i][0]
+        return {self.part_names[p]: (int(self.part_start[p] - a0), int(self.part_start[p + 1] - a0))
+                for p in self.agent_parts[i]}
+
+    def counts(self, agent) -> dict[str, int]:
+        """Number of skin points per body part of ``agent``."""
+        return {k: b - a for k, (a, b) in self.layout(agent).items()}
+
+    def view(self, agent, data: mujoco.MjData | None = None) -> dict[str, dict]:
+        """Per body part of ``agent``: ``points`` and ``normals`` (n, 3) in world coordinates,
+        ``forces`` (n, 3) world frame, ``normal_force`` (n,), ``local_points`` and
+        ``local_forces`` (n, 3) in the part's body frame, and ``spacing`` (m), as of the last
+        update."""
+        i = self._agent_index(agent)
+        d = self.world.data if data is None else data
+        xyz = self.force_xyz[:3 * self.n_points].reshape(-1, 3)
+        out = {}
+        for p in self.agent_parts[i]:
+            a, b = self.part_start[p], self.part_start[p + 1]
+            body = self.part_body[p]
+            R = d.xmat[body].reshape(3, 3)
+            f = xyz[a:b]
+            F, Fl = (f, f @ R) if self.part_world[p] else (f @ R.T, f)
+            out[self.part_names[p]] = {
+                "points": self.points[a:b] @ R.T + d.xpos[body],
+                "normals": self.normals[a:b] @ R.T,
+                "forces": np.array(F), "normal_force": self.force_normal[a:b].copy(),
+                "local_points": self.points[a:b].copy(), "local_forces": np.array(Fl),
+                "spacing": float(self.part_spacing[p]),
+            }
+        return out
+
+
+def build_touch(world, configs: Sequence[TouchConfig | None]):
+    """The env's hook: the shared touch system and each agent's sense (None where touch is off)."""
+    system = TouchSystem(world, configs)
+    senses = [AgentTouch(system, i) if cfg is not None else None for i, cfg in enumerate(configs)]
+    return system, senses
+
+
+# -- pictures --------------------------------------------------------------------------------
+def _touch_system(env) -> TouchSystem:
+    for s in getattr(env, "shared", []):
+        if getattr(s, "name", None) == "touch" and hasattr(s, "view"):  # run as __main__ too
+            return s
+    raise ValueError("this env has no touch skin; make it with touch=True")
+
+
+def save_skin_png(env, agent, path, parts: Sequence[str] | None = None,
+                  elev: float | None = None, azim: float | None = None,
+                  title: str | None = None, spheres: Sequence[tuple] = ()) -> str:
+    """Save a PNG of one agent's skin points coloured by the force they sense (paper Fig. 5b).
+
+    ``parts``: body parts to draw (default: all). Points without force are small and grey;
+    points with force are coloured by its magnitude (N) and sized by it. The default view looks
+    at the touched points from outside the body, from at most 40 degrees above or below
+    (``elev``, ``azim`` in degrees override it). ``spheres``: ``(centre, radius)`` of objects to
+    outline (e.g. a held ball).
+    """
+    import matplotlib
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
+
+    system = _touch_system(env)
+    view = system.view(agent)
+    if parts is not None:
+        unknown = sorted(set(parts) - set(view))
+        if unknown:
+            raise ValueError(f"unknown body parts {unknown}; parts with skin: {sorted(view)}")
+        view = {k: view[k] for k in parts}
+    P = np.concatenate([v["points"] for v in view.values()])
+    Nw = np.concatenate([v["normals"] for v in view.values()])
+    F = np.concatenate([np.linalg.norm(v["forces"], axis=1) for v in view.values()])
+    on = F > 1e-9
+    look = Nw[on].mean(0) if on.any() else np.array([1.0, -1.0, 0.5])
+    if np.linalg.norm(look) < 1e-6:
+        look = np.array([1.0, -1.0, 0.5])
+    look = look / np.linalg.norm(look)
+    if elev is None:
+        elev = float(np.clip(np.degrees(np.arcsin(np.clip(look[2], -1, 1))), -40, 40))
+    if azim is None:
+        azim = float(np.degrees(np.arctan2(look[1], look[0])))
+    fig = plt.figure(figsize=(7.5, 6.5), dpi=120)
+    ax = fig.add_subplot(projection="3d")
+    ax.scatter(*P[~on].T, s=4, c="0.45", alpha=0.5, depthshade=True, linewidths=0)
+    for centre, radius in spheres:
+        u, v = np.mgrid[0:2 * np.pi:25j, 0:np.pi:13j]
+        ax.plot_wireframe(centre[0] + radius * np.cos(u) * np.sin(v),
+                          centre[1] + radius * np.sin(u) * np.sin(v),
+                          centre[2] + radius * np.cos(v), color="tab:blue", alpha=0.25,
+                          linewidth=0.6)
+    if on.any():
+        order = np.argsort(F[on])
+        Fon = F[on][order]
+        sc = ax.scatter(*P[on][order].T, s=10 + 150 * Fon / Fon.max(), c=Fon, cmap="autumn_r",
+                        vmin=0.0, edgecolors="darkred", linewidths=0.4, depthshade=False)
+        fig.colorbar(sc, ax=ax, shrink=0.6, pad=0.1, label="force on the point (N)")
+    centre = (P.max(0) + P.min(0)) / 2
+    r = (P.max(0) - P.min(0)).max() / 2
+    ax.set_xlim(centre[0] - r, centre[0] + r)
+    ax.set_ylim(centre[1] - r, centre[1] + r)
+    ax.set_zlim(centre[2] - r, centre[2] + r)
+    ax.set_box_aspect((1, 1, 1))
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(4))
+    ax.tick_params(labelsize=7)
+    ax.view_init(elev=elev, azim=azim)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_zlabel("z (m)")
+    name = agent if isinstance(agent, str) else system.names[agent]
+    ax.set_title(title or f"{name}: {len(P)} skin points, {int(on.sum())} sensing force "
+                          f"(total {F.sum():.2f} N)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return str(path)
+
+
+# the right arm held forward, palm up, the hand tilted 12 degrees towards the fingertips
+# (degrees; found by minimising the palm's deviation from that pose over the arm's joints)
+HOLD_BALL_ARM = {"right_shoulder_horizontal": 95.7, "right_shoulder_abduction": 24.3,
+                 "right_shoulder_rotation": -89.7, "right_elbow": -84.2,
+                 "right_wrist_rotation": -76.9, "right_wrist_flexion": 34.7,
+                 "right_wrist_ulnar": 12.3}
+
+
+def hand_ball_scene(steps: int = 100, touch: dict | bool = True, ball_radius: float = 0.025,
+                    grip: float = -0.1, along: float = 0.015):
+    """A sitting infant holding a ball in its upturned right hand, the mitten closing over it.
+
+    Every joint but the mitten fingers is held (the arm forward, palm up: :data:`HOLD_BALL_ARM`);
+    the infant sits on the floor as one rigid body (so MuJoCo's parent-child contact filter
+    keeps the fingers from colliding with the palm). After the infant has settled, the ball
+    (``ball_radius``, 0.1 kg) is laid on the palm, ``along`` m from its centre towards the
+    fingers, and the mitten closes on it with action ``grip`` for ``steps`` control steps (the
+    ball then rests in the cup of palm, fingers and wrist). Returns the env.
+    """
+    from ..body.postures import POSTURES
+    from ..body.tables import load_body
+    from ..envs.parallel import MimoParallelEnv
+    from ..envs.tasks.base import held_posture
+    from ..envs.tasks.free_play import FreePlay
+    from ..envs.world import AgentSetup, Prop
+
+    class HoldBall(FreePlay):
+        def setup(self, i, config):
+            angles = dict(POSTURES["sitting"]["joints"])
+            angles.update(HOLD_BALL_ARM)
+            frozen = held_posture(load_body(config.hands), keep=("right_fingers",), angles=angles)
+            return AgentSetup(config, position=(0.0, 0.0), facing=(1.0, 0.0), frozen=frozen,
+                              actuated=("right_fingers",))
+
+        def props(self):
+            return [Prop("ball", "sphere", (ball_radius,), (0.5, 0.5, ball_radius), 0.1,
+                         (0.9, 0.25, 0.2, 1.0))]
+
+    env = MimoParallelEnv(HoldBall(1), touch=touch, posture="sitting", expressions=False,
+                          proprioception=False)
+    env.reset(seed=0)
+    w = env.world
+    m, d = w.model, w.data
+    a = w.agents[0]
+    name = env.agents[0]
+    rest = {name: np.zeros(1, np.float32)}
+    for _ in range(50):                                 # let the sitting infant settle
+        env.step(rest)
+    hand = m.site_bodyid[a.palm_sites[0]]
+    palm_normal = -d.xmat[hand].reshape(3, 3)[:, 1]   # the palm side of the right mitten
+    q = w.prop_qpos["ball"]
+    along_hand = d.xmat[hand].reshape(3, 3)[:, 2]
+    d.qpos[q:q + 3] = (d.site_xpos[a.palm_sites[0]] + (0.0105 + ball_radius) * palm_normal
+                       + along * along_hand)
+    d.qpos[q + 3:q + 7] = (1.0, 0.0, 0.0, 0.0)
+    mujoco.mj_forward(m, d)
+    hold = {name: np.array([grip], np.float32)}
+    for _ in range(steps):
+        env.step(hold)
+    return env
+
+
+def save_hand_ball_png(path, steps: int = 100) -> str:
+    """The paper's Fig. 5b: the skin of a hand holding a ball, coloured by force, as a PNG."""
+    env = hand_ball_scene(steps)
+    parts = ["right_lower_arm", "right_hand", "right_fingers"]
+    view = _touch_system(env).view(0)
+    total = sum(view[k]["normal_force"].sum() for k in parts)
+    w = env.world
+    ball = w.data.xpos[w.prop_bodies["ball"]]
+    radius = float(w.model.geom_size[w.model.geom("ball").id, 0])
+    side = w.data.xmat[w.model.site_bodyid[w.agents[0].palm_sites[0]]].reshape(3, 3)[:, 0]
+    out = save_skin_png(env, 0, path, parts=parts, spheres=[(ball, radius)], elev=35.0,
+                        azim=float(np.degrees(np.arctan2(side[1], side[0]))) + 35.0,
+                        title=f"right hand holding a ball (0.1 kg): {total:.2f} N normal force "
+                              "sensed")
+    env.close()
+    return out
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+    print(save_hand_ball_png(sys.argv[1] if len(sys.argv) > 1 else "hand_ball_touch.png"))
