@@ -184,3 +184,13 @@ def test_gaze_fixates_the_target():
     look = -d.cam_xmat[cam].reshape(3, 3)[:, 2]
     to_hand = hand1 - d.cam_xpos[cam]
     assert look @ to_hand / np.linalg.norm(to_hand) > np.cos(np.deg2rad(2.0))
+
+
+@pytest.mark.parametrize("posture, n", [("standing", 8), ("sitting", 4), ("lying", 3)])
+def test_infants_start_apart(posture, n):
+    env = free_play_v0.parallel_env(n_agents=n, posture=posture, expressions=False)
+    env.reset(seed=0)
+    d, ga = env.world.data, env.world.geom_agent
+    g1, g2 = d.contact.geom1[: d.ncon], d.contact.geom2[: d.ncon]
+    between = (ga[g1] != ga[g2]) & (ga[g1] >= 0) & (ga[g2] >= 0)
+    assert not between.any()

@@ -1,7 +1,8 @@
 """The PettingZoo ParallelEnv: N infants in one world, built from a task object.
 
-Actions per agent: a ``Box(-1, 1)`` of the agent's motors, or, when expressions are on, a
-``Dict({"motors": Box, "expression": Discrete(7)})``. Motor values outside [-1, 1] are
+Actions per agent: a ``Box`` of the agent's motor controls (spring-damper: one value in [-1, 1]
+per motor; muscles: two values in [0, 1] per motor), or, when expressions are on, a
+``Dict({"motors": Box, "expression": Discrete(7)})``. Motor values outside the Box are
 **clipped** (learners' Gaussian policies overshoot); NaN/inf, a wrong shape, an unknown agent or
 an expression id out of range raise ``ValueError`` naming the agent, the field and what is
 allowed. A simulation that goes unstable ends the episode for every agent with the reason in
@@ -55,7 +56,7 @@ class MimoParallelEnv(ParallelEnv):
         self.frame_skip = self.physics.frame_skip
         self.dt = self.physics.timestep * self.frame_skip
         self.metadata = dict(self.metadata, render_fps=int(round(1.0 / self.dt)))
-        setups = [task.setup(i, cfg) for i, cfg in enumerate(self.agent_configs)]
+        setups = [task.setup(i, cfg, self.agent_configs) for i, cfg in enumerate(self.agent_configs)]
         self.world = World(setups, task.props(), self.physics)
         self.possible_agents = list(self.world.names)
         self.agents = list(self.possible_agents)
@@ -233,12 +234,12 @@ class MimoParallelEnv(ParallelEnv):
             u = np.asarray(motors, dtype=np.float64)
             if u.shape != (act.n_controls,):
                 raise ValueError(f"{a}: motor action has shape {u.shape}; expected "
-                                 f"({act.n_controls},) for motors {self.world.agents[i].actuated_names}")
+                                 f"({act.n_controls},) for motors {act.control_names}")
             if not np.isfinite(u).all():
-                bad = [self.world.agents[i].actuated_names[k] for k in np.flatnonzero(~np.isfinite(u))]
+                bad = [act.control_names[k] for k in np.flatnonzero(~np.isfinite(u))]
                 raise ValueError(f"{a}: motor action has NaN/inf for {bad}; values must be finite, "
-                                 "in [-1, 1]")
-            u.clip(-1.0, 1.0, out=u)
+                                 f"in [{act.control_low.min():g}, {act.control_high.max():g}]")
+            np.clip(u, act.control_low, act.control_high, out=u)
             self._controls[i] = u
             act.apply(w.model, w.data, u)
 

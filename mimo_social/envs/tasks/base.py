@@ -6,7 +6,7 @@ One-agent tasks (reach ...) are tasks like any other; the Gymnasium adapter wrap
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import mujoco
 import numpy as np
@@ -55,16 +55,25 @@ class Task:
         """Default agent settings this task wants (users may override them)."""
         return {}
 
-    def setup(self, i: int, config: AgentConfig) -> AgentSetup:
-        pos, facing = self.placement(i)
+    def setup(self, i: int, config: AgentConfig, configs: Sequence[AgentConfig] = ()) -> AgentSetup:
+        pos, facing = self.placement(i, configs)
         return AgentSetup(config, position=config.position or pos,
                           facing=config.facing or facing)
 
-    def placement(self, i: int) -> tuple[tuple[float, float], tuple[float, float]]:
+    # How far (m) an infant in each posture reaches forward from its hip along the floor, and
+    # its width with arms and legs: the circle is made large enough that no two infants start
+    # interpenetrating (their forward parts converge toward the centre).
+    POSTURE_REACH = {"standing": 0.22, "sitting": 0.45, "lying": 0.48}
+    HALF_WIDTH = 0.2
+    CLEARANCE = 0.14
+
+    def placement(self, i: int, configs: Sequence[AgentConfig] = ()) -> tuple:
         """Agents on a circle around the origin, each facing the centre."""
         if self.n_agents == 1:
             return (0.0, 0.0), (1.0, 0.0)
-        radius = max(0.3, 0.12 * self.n_agents)
+        reach = max((self.POSTURE_REACH[c.posture] for c in configs), default=0.22)
+        sin = np.sin(np.pi / self.n_agents)
+        radius = max(0.3, reach + self.CLEARANCE / sin, self.HALF_WIDTH / sin)
         angle = np.pi + 2 * np.pi * i / self.n_agents
         pos = (radius * np.cos(angle), radius * np.sin(angle))
         return (float(pos[0]), float(pos[1])), (0.0, 0.0)
