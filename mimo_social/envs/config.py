@@ -18,7 +18,7 @@ __all__ = [
     "ConfigError", "resolve_agents", "parse_physics", "ACTUATION_MODELS", "POSTURES",
 ]
 
-ACTUATION_MODELS = ("spring_damper",)
+ACTUATION_MODELS = ("spring_damper", "muscle")
 POSTURES = ("standing", "sitting", "lying")
 PROPRIOCEPTION_COMPONENTS = ("qpos", "qvel", "torque", "limits", "actuation")
 VESTIBULAR_COMPONENTS = ("gyro", "accel")

@@ -56,7 +56,8 @@ class MimoParallelEnv(ParallelEnv):
         self.frame_skip = self.physics.frame_skip
         self.dt = self.physics.timestep * self.frame_skip
         self.metadata = dict(self.metadata, render_fps=int(round(1.0 / self.dt)))
-        setups = [task.setup(i, cfg, self.agent_configs) for i, cfg in enumerate(self.agent_configs)]
+        task.configs = tuple(self.agent_configs)
+        setups = [task.setup(i, cfg) for i, cfg in enumerate(self.agent_configs)]
         self.world = World(setups, task.props(), self.physics)
         self.possible_agents = list(self.world.names)
         self.agents = list(self.possible_agents)

@@ -46,6 +46,7 @@ class Task:
                              f"allowed: {sorted(self.option_defaults())}")
         self.n_agents = int(n_agents)
         self.options = {**self.option_defaults(), **options}
+        self.configs: Sequence[AgentConfig] = ()  # every agent's config, set by the env
 
     # -- building ------------------------------------------------------------------------------
     def option_defaults(self) -> dict:
@@ -55,8 +56,8 @@ class Task:
         """Default agent settings this task wants (users may override them)."""
         return {}
 
-    def setup(self, i: int, config: AgentConfig, configs: Sequence[AgentConfig] = ()) -> AgentSetup:
-        pos, facing = self.placement(i, configs)
+    def setup(self, i: int, config: AgentConfig) -> AgentSetup:
+        pos, facing = self.placement(i, self.configs)
         return AgentSetup(config, position=config.position or pos,
                           facing=config.facing or facing)
 

@@ -33,7 +33,7 @@ class HighFive(Task):
     def agent_defaults(self, i):
         return {"posture": "standing"}
 
-    def setup(self, i, config, configs=()):
+    def setup(self, i, config):
         dist = float(self.options["distance"])
         pos = (0.0, 0.0) if i == 0 else (dist, 0.0)
         facing = (dist, 0.0) if i == 0 else (0.0, 0.0)

@@ -37,7 +37,7 @@ class Reach(Task):
     def agent_defaults(self, i):
         return {"posture": "standing", "vestibular": False, "expressions": False}
 
-    def setup(self, i, config, configs=()):
+    def setup(self, i, config):
         tables = load_body(config.hands)
         frozen = held_posture(tables, keep=RIGHT_ARM_JOINTS + GAZE_JOINTS)
         return AgentSetup(config, position=(0.0, 0.0), facing=(1.0, 0.0), frozen=frozen,
