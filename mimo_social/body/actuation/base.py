@@ -1,4 +1,4 @@
-"""The interface every actuation model implements (spring-damper now, muscles later).
+"""The interface every actuation model implements (spring-damper, muscles).
 
 One instance drives one agent. The world calls, in this order:
 ``bind`` once after compiling, ``apply`` once per control step with the agent's validated
@@ -25,6 +25,11 @@ class Actuation(ABC):
     @property
     def n_controls(self) -> int:
         return len(self.control_low)
+
+    @property
+    def control_names(self) -> list[str]:
+        """One label per control value (the motor's joint), for messages and plots."""
+        return [j.name for j in self.joints]
 
     @property
     @abstractmethod
