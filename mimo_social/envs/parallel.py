@@ -314,6 +314,9 @@ class MimoParallelEnv(ParallelEnv):
         return cam
 
     def close(self):
+        for system in self.shared:
+            if hasattr(system, "close"):
+                system.close()
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
