@@ -20,7 +20,7 @@ from typing import Mapping
 import mujoco
 import numpy as np
 
-from .tables import BodyTables, load_body
+from .tables import BodyTables, load_body, subtree
 
 __all__ = ["InfantBuild", "build_infant", "axis_angle_quat", "quat_mul"]
 
@@ -34,7 +34,8 @@ LIMIT_SOLREF = (0.02, 1.0)
 SKIN_RGBA = (0.94, 0.78, 0.67, 1.0)
 EYE_RGBA = (0.12, 0.08, 0.05, 1.0)
 DEFAULT_CLOTHES_RGBA = (0.35, 0.55, 0.85, 1.0)
-# Segments shown in skin colour; the rest wear the agent's clothes colour.
+# Segments shown in skin colour (and every segment of the hands below them); the rest wear the
+# agent's clothes colour.
 SKIN_SEGMENTS = {"head", "right_hand", "left_hand", "right_fingers", "left_fingers",
                  "right_lower_arm", "left_lower_arm"}
 EYE_FOVY_DEG = 60.0
@@ -90,7 +91,7 @@ def build_infant(
     """Build one infant.
 
     Args:
-        hands: hand version (``"mitten"``).
+        hands: hand version: ``"mitten"`` (44 motors) or ``"five_fingers"`` (88 motors).
         frozen: joint name -> angle (rad) to hold the joint at. Frozen trunk joints drag their
             coupled partner along (at the coupling ratio) unless it is named too.
         base: ``"free"`` (a free joint at the hip: the infant can walk, fall, be pushed) or
@@ -123,6 +124,9 @@ def build_infant(
     for j in tables.joints:
         joints_of.setdefault(j.body, []).append(j)
 
+    skin = set(SKIN_SEGMENTS)
+    for side in ("right", "left"):
+        skin.update(subtree(tables, f"{side}_hand"))
     bodies = {}
     present, locked = [], []
     for seg in tables.segments:
@@ -149,16 +153,23 @@ def build_infant(
                 springref=np.deg2rad(j.springref_deg), stiffness=[j.stiffness, 0.0, 0.0],
                 damping=[j.damping, 0.0, 0.0], frictionloss=j.frictionloss,
                 armature=j.armature, solimp_limit=LIMIT_SOLIMP, solref_limit=LIMIT_SOLREF,
+                pos=j.pos,
             )
             present.append(j.name)
             if j.name in frozen:
                 locked.append(j.name)
-        _add_geoms(body, seg.name, tables, clothes_rgba)
+        _add_geoms(body, seg.name, tables, clothes_rgba, skin)
 
     _add_sites_cameras_sensors(spec, bodies, tables)
 
     for a, b in _excludes(hands):
         spec.add_exclude(bodyname1=a, bodyname2=b)
+    # MuJoCo skips parent-child contacts, except when the parent is welded to the world (a fixed
+    # hip with a frozen trunk): then the shoulders would hold the upper arms and the neck the
+    # head. Excluding every parent-child pair keeps the rule in every case.
+    for seg in tables.segments:
+        if seg.parent is not None:
+            spec.add_exclude(bodyname1=seg.parent, bodyname2=seg.name)
 
     for j in tables.joints:  # trunk coupling, when both joints are free to move
         if j.coupled_to and j.name in present and j.coupled_to in present \
@@ -184,8 +195,8 @@ def build_infant(
     return InfantBuild(spec, tables, present, actuated, actuators, frozen, locked)
 
 
-def _add_geoms(body, segment: str, tables: BodyTables, clothes_rgba) -> None:
-    rgba = SKIN_RGBA if segment in SKIN_SEGMENTS else clothes_rgba
+def _add_geoms(body, segment: str, tables: BodyTables, clothes_rgba, skin) -> None:
+    rgba = SKIN_RGBA if segment in skin else clothes_rgba
     group = 0
     if segment.endswith("_eye"):  # the face texture draws the visible eyes (with their lids)
         rgba, group = EYE_RGBA, HIDDEN_GROUP
@@ -199,7 +210,7 @@ def _add_geoms(body, segment: str, tables: BodyTables, clothes_rgba) -> None:
         size[: len(g.size)] = g.size
         body.add_geom(
             name=g.name, type=gtype, size=size, pos=g.pos, quat=_AXIS_QUATS[g.axis],
-            mass=g.mass, friction=g.friction or GEOM_FRICTION, condim=3,
+            mass=g.mass, friction=g.friction or GEOM_FRICTION, condim=g.condim,
             solimp=GEOM_SOLIMP, solref=GEOM_SOLREF, rgba=rgba, group=group,
         )
 
@@ -207,13 +218,9 @@ def _add_geoms(body, segment: str, tables: BodyTables, clothes_rgba) -> None:
 def _add_sites_cameras_sensors(spec, bodies, tables: BodyTables) -> None:
     head_geom = next(g for g in tables.geoms if g.name == "head")
     bodies["head"].add_site(name="head_centre", pos=head_geom.pos, size=[0.005, 0, 0])
+    for site in tables.sites:  # palm centres and fingertips, the same names in every hand version
+        bodies[site.body].add_site(name=site.name, pos=site.pos, size=[0.005, 0, 0])
     for side in ("right", "left"):
-        palm = next(g for g in tables.geoms if g.name == f"{side}_palm")
-        bodies[f"{side}_hand"].add_site(name=f"{side}_palm_centre", pos=palm.pos,
-                                        size=[0.005, 0, 0])
-        tips = next(g for g in tables.geoms if g.name == f"{side}_fingertips")
-        bodies[f"{side}_fingers"].add_site(name=f"{side}_fingertips", pos=tips.pos,
-                                           size=[0.005, 0, 0])
         # Eye camera: MuJoCo cameras look along their local -z with +y up; the eye looks
         # along its local +x with +z up.
         bodies[f"{side}_eye"].add_camera(

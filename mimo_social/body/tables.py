@@ -14,9 +14,12 @@ from importlib import resources
 
 import numpy as np
 
-__all__ = ["Segment", "GeomSpec", "JointSpec", "BodyTables", "load_body", "HAND_VERSIONS"]
+__all__ = ["Segment", "GeomSpec", "JointSpec", "SiteSpec", "BodyTables", "load_body",
+           "HAND_VERSIONS", "subtree", "arm_joints"]
 
-HAND_VERSIONS = ("mitten",)
+#: ``mitten``: the published v1 body (one-piece fingers, 44 motors); ``five_fingers``: the
+#: published v2 body (five articulated fingers per hand, two toes per foot, 88 motors).
+HAND_VERSIONS = ("mitten", "five_fingers")
 
 
 @dataclass(frozen=True)
@@ -37,6 +40,7 @@ class GeomSpec:
     axis: str  # local axis along which a capsule/cylinder runs: x | y | z
     mass: float
     friction: tuple[float, float, float] | None
+    condim: int = 3
 
 
 @dataclass(frozen=True)
@@ -59,6 +63,7 @@ class JointSpec:
     fmax_pos: float | None
     coupled_to: str | None
     coupling: float | None
+    pos: tuple[float, float, float] = (0.0, 0.0, 0.0)  # the hinge's pivot in its body
 
     @property
     def torque_neg(self) -> float:
@@ -72,12 +77,20 @@ class JointSpec:
 
 
 @dataclass(frozen=True)
+class SiteSpec:
+    name: str
+    body: str
+    pos: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
 class BodyTables:
     hands: str
     segments: tuple[Segment, ...]
     geoms: tuple[GeomSpec, ...]
     joints: tuple[JointSpec, ...]
     touch_spacing: dict
+    sites: tuple[SiteSpec, ...] = ()
 
     @property
     def total_mass(self) -> float:
@@ -100,6 +113,15 @@ def _opt(text: str, cast=float):
 def _rows(filename: str) -> list[dict]:
     with resources.files("mimo_social.body").joinpath("data", filename).open() as f:
         return list(csv.DictReader(f))
+
+
+def _muscle_rows(hands: str) -> dict:
+    """The calibrated muscle parameters (``<hands>_muscles.csv``), if shipped."""
+    path = resources.files("mimo_social.body").joinpath("data", f"{hands}_muscles.csv")
+    if not path.is_file():
+        return {}
+    return {r["joint"]: (float(r["vmax"]), float(r["fmax_neg"]), float(r["fmax_pos"]))
+            for r in _rows(f"{hands}_muscles.csv")}
 
 
 def _mirror_name(name: str | None) -> str | None:
@@ -137,6 +159,7 @@ def load_body(hands: str = "mitten") -> BodyTables:
         GeomSpec(
             r["body"], r["geom"], r["type"], _floats(r["size"]), _floats(r["pos"]), r["axis"],
             float(r["mass"]), _floats(r["friction"]) if r["friction"].strip() else None,
+            int(r.get("condim") or 3),
         )
         for r in _rows(f"{hands}_geoms.csv")
     ]
@@ -145,13 +168,18 @@ def load_body(hands: str = "mitten") -> BodyTables:
             r["joint"], r["body"], _floats(r["axis"]),
             (float(r["range_lo"]), float(r["range_hi"])),
             _opt(r["springref"]) or 0.0, float(r["stiffness"]), float(r["damping"]),
-            float(r["frictionloss"]), float(r["armature"]),
+            _opt(r["frictionloss"]) or 0.0, float(r["armature"]),
             r["actuator"] or None, _opt(r["gear"]), _opt(r["force_lo"]), _opt(r["force_hi"]),
             _opt(r["vmax"]), _opt(r["fmax_neg"]), _opt(r["fmax_pos"]),
             r["coupled_to"] or None, _opt(r["coupling"]),
+            _floats(r["pos"]) if (r.get("pos") or "").strip() else (0.0, 0.0, 0.0),
         )
         for r in _rows(f"{hands}_joints.csv")
     ]
+    sites = [SiteSpec(r["site"], r["body"], _floats(r["pos"])) for r in _rows(f"{hands}_sites.csv")]
+    muscles = _muscle_rows(hands)
+    joints = [replace(j, vmax=muscles[j.name][0], fmax_neg=muscles[j.name][1],
+                      fmax_pos=muscles[j.name][2]) if j.name in muscles else j for j in joints]
     spacing = {r["body"]: float(r["spacing"]) for r in _rows("touch_spacing.csv")}
 
     def right(name):
@@ -170,7 +198,13 @@ def load_body(hands: str = "mitten") -> BodyTables:
     joints_all = _with_left(
         joints, lambda j: right(j.name),
         lambda j: replace(j, name=_mirror_name(j.name), body=_mirror_name(j.body),
-                          axis=_mirror_axis(j.axis), actuator=_mirror_name(j.actuator)),
+                          axis=_mirror_axis(j.axis), actuator=_mirror_name(j.actuator),
+                          pos=_mirror_vec(j.pos)),
+    )
+    sites_all = _with_left(
+        sites, lambda t: right(t.name),
+        lambda t: replace(t, name=_mirror_name(t.name), body=_mirror_name(t.body),
+                          pos=_mirror_vec(t.pos)),
     )
     spacing.update({_mirror_name(k): v for k, v in list(spacing.items()) if right(k)})
     # Depth-first tree order (a parent before its children, a limb's segments together).
@@ -184,8 +218,26 @@ def load_body(hands: str = "mitten") -> BodyTables:
         stack.extend(reversed(children.get(s.name, [])))
     if len(order) != len(segments):
         raise ValueError("body table: a segment's parent is missing")
-    return BodyTables(hands, tuple(order), geoms_all, joints_all, spacing)
+    return BodyTables(hands, tuple(order), geoms_all, joints_all, spacing, sites_all)
 
 
 def joint_limits_rad(tables: BodyTables) -> np.ndarray:
     return np.deg2rad(np.array([j.range_deg for j in tables.joints]))
+
+
+def subtree(tables: BodyTables, root: str) -> list[str]:
+    """The segment ``root`` and every segment below it, in tree order."""
+    inside = {root}
+    out = []
+    for seg in tables.segments:  # tree order: a parent comes before its children
+        if seg.name == root or seg.parent in inside:
+            inside.add(seg.name)
+            out.append(seg.name)
+    return out
+
+
+def arm_joints(tables: BodyTables, side: str = "right") -> tuple[str, ...]:
+    """The joints of one arm, shoulder to fingertips, in table order (8 for the mitten body:
+    shoulder 3, elbow, wrist 3, fingers; 29 for the five-fingered one: 7 + 22 finger joints)."""
+    bodies = set(subtree(tables, f"{side}_upper_arm"))
+    return tuple(j.name for j in tables.joints if j.body in bodies)

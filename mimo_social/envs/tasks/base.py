@@ -27,6 +27,27 @@ RIGHT_ARM_JOINTS = ("right_shoulder_horizontal", "right_shoulder_abduction",
                     "right_wrist_flexion", "right_wrist_ulnar", "right_fingers")
 
 
+def right_arm_joints(tables) -> tuple[str, ...]:
+    """The right arm's joints of this body version: :data:`RIGHT_ARM_JOINTS` (8) for the mitten
+    hands, shoulder 3 + elbow + wrist 3 + 22 finger joints for the five-fingered hands."""
+    from ...body.tables import arm_joints
+    return arm_joints(tables, "right")
+
+
+def hand_geoms(world, i: int, side: int = 0) -> np.ndarray:
+    """Geoms of agent i's hand (``side`` 0: right, 1: left): the body holding the palm site and
+    every body below it (the mitten's fingers, or the five fingers' segments)."""
+    m = world.model
+    a = world.agents[i]
+    hand = int(m.site_bodyid[a.palm_sites[side]])
+    inside = np.zeros(m.nbody, bool)
+    inside[hand] = True
+    for b in sorted(a.body_ids.tolist()):  # MuJoCo numbers a parent before its children
+        if inside[m.body_parentid[b]]:
+            inside[b] = True
+    return a.geom_ids[inside[m.geom_bodyid[a.geom_ids]]]
+
+
 class Task:
     """Base task: N infants on the floor, reward 0, never terminates (truncated at max_steps)."""
 

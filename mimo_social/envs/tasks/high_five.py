@@ -4,7 +4,7 @@
 |---|---|
 | agents | 2 (`infant_0`, `infant_1`), 0.45 m apart, facing each other |
 | body | hip fixed in the world; trunk, legs, left arm held; head and eyes fixate the partner's right hand (set by the task each control step) |
-| action | the 8 right-arm motors (shoulder 3, elbow, wrist 3, mitten fingers) in [-1, 1], plus the expression when expressions are on |
+| action | the right-arm motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five fingers: 29), plus the expression when expressions are on |
 | observation | `proprioception` (head and eye angles tell where the partner's hand is), `vestibular` |
 | reward (both) | `-distance(right palms)` per step, `+touch_bonus` (100) on the step the right hands touch |
 | termination | both, when the right hands touch (if `end_on_touch`); truncation at `max_steps` (500) |
@@ -16,7 +16,8 @@ import numpy as np
 
 from ...body.tables import load_body
 from ..world import AgentSetup
-from .base import GAZE_JOINTS, RIGHT_ARM_JOINTS, ContactProbe, Gaze, Task, held_posture
+from .base import (GAZE_JOINTS, ContactProbe, Gaze, Task, hand_geoms, held_posture,
+                   right_arm_joints)
 
 DISTANCE = 0.45
 
@@ -38,17 +39,15 @@ class HighFive(Task):
         pos = (0.0, 0.0) if i == 0 else (dist, 0.0)
         facing = (dist, 0.0) if i == 0 else (0.0, 0.0)
         tables = load_body(config.hands)
-        frozen = held_posture(tables, keep=RIGHT_ARM_JOINTS + GAZE_JOINTS,
+        arm = right_arm_joints(tables)
+        frozen = held_posture(tables, keep=arm + GAZE_JOINTS,
                               angles={"right_knee": -5, "left_knee": -5})
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
-                          frozen=frozen, base="fixed", actuated=RIGHT_ARM_JOINTS,
+                          frozen=frozen, base="fixed", actuated=arm,
                           gaze_joints=GAZE_JOINTS)
 
     def _hand_geoms(self, env, i):
-        m = env.world.model
-        a = env.world.agents[i]
-        bodies = {m.site_bodyid[a.palm_sites[0]], m.site_bodyid[a.fingertip_sites[0]]}
-        return a.geom_ids[np.isin(m.geom_bodyid[a.geom_ids], list(bodies))]
+        return hand_geoms(env.world, i)
 
     def reset(self, env, rng):
         if not hasattr(self, "_gaze"):

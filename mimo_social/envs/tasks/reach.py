@@ -6,7 +6,7 @@
 | body | hip fixed; everything but the right arm held; head and eyes fixate the ball (set each step) |
 | scene | gravity off (as in the published task); a ball (r = 2.5 cm) placed at random within reach |
 | reset | the right arm starts in one of 10 postures (fixed set, drawn once from a seeded generator); the ball position is sampled |
-| action | the 8 right-arm motors in [-1, 1] |
+| action | the right-arm motors: 8 (mitten hands: shoulder 3, elbow, wrist 3, fingers) or 29 (five fingers: + 22 finger joints instead of 1) |
 | observation | `proprioception` only (the head and eye angles tell where the ball is) |
 | reward | `-distance(right fingertips, ball)`, or `+100` when the right hand or fingers touch the ball |
 | termination | on touching the ball; truncation at 1000 steps |
@@ -18,7 +18,8 @@ import numpy as np
 
 from ...body.tables import load_body
 from ..world import AgentSetup, Prop
-from .base import GAZE_JOINTS, RIGHT_ARM_JOINTS, ContactProbe, Gaze, Task, held_posture
+from .base import (GAZE_JOINTS, ContactProbe, Gaze, Task, hand_geoms, held_posture,
+                   right_arm_joints)
 
 BALL_RADIUS = 0.025
 N_START_POSTURES = 10
@@ -39,16 +40,17 @@ class Reach(Task):
 
     def setup(self, i, config):
         tables = load_body(config.hands)
-        frozen = held_posture(tables, keep=RIGHT_ARM_JOINTS + GAZE_JOINTS)
+        arm = right_arm_joints(tables)
+        frozen = held_posture(tables, keep=arm + GAZE_JOINTS)
         return AgentSetup(config, position=(0.0, 0.0), facing=(1.0, 0.0), frozen=frozen,
-                          base="fixed", actuated=RIGHT_ARM_JOINTS, gaze_joints=GAZE_JOINTS)
+                          base="fixed", actuated=arm, gaze_joints=GAZE_JOINTS)
 
     def props(self):
         return [Prop("ball", "sphere", (BALL_RADIUS,), (0.3, -0.05, 0.7), 0.05, (0.9, 0.2, 0.2, 1))]
 
     def _arm(self, env):
         a = env.world.agents[0]
-        k = [a.joint_names.index(n) for n in RIGHT_ARM_JOINTS]
+        k = [a.joint_names.index(n) for n in right_arm_joints(env.world.tables[0])]
         return a, np.array(k)
 
     def reset(self, env, rng):
@@ -62,8 +64,7 @@ class Reach(Task):
             self._postures = lo + span * (0.3 + 0.4 * fixed.random((N_START_POSTURES, len(k))))
             m_ = env.world.model
             a_ = env.world.agents[0]
-            self._hand = a_.geom_ids[np.isin(m_.geom_bodyid[a_.geom_ids], [
-                m_.site_bodyid[a_.palm_sites[0]], m_.site_bodyid[a_.fingertip_sites[0]]])]
+            self._hand = hand_geoms(env.world, 0)
             self._touch_ball = ContactProbe(m_.ngeom, self._hand, [m_.geom("ball").id])
             self._gaze = Gaze(env.world, 0)
             self._ball_body = env.world.prop_bodies["ball"]
