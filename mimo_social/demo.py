@@ -87,7 +87,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def _open_hint(path: Path) -> str:
     from .cli import SUBCOMMAND_MODULES
     hint = f"  rerun {path}"
-    if "replay" in SUBCOMMAND_MODULES:
+    if "replay_cli" in SUBCOMMAND_MODULES:
         hint += f"\n  mimo-social replay {path}"
     return hint
 
