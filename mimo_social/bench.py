@@ -172,6 +172,10 @@ CONFIGS: dict[str, BenchConfig] = {c.name: c for c in (
     _scene("no_vision", f"{_GRID}; no vision, touch x1", vision=None),
     _scene("physics_only", "the grid's scene (1 infant, 2 objects), bare mujoco.mj_step loop "
            "(the floor)", vision=None, touch=None, raw=True),
+    BenchConfig("basic_1", "free_play_v0",
+                {"n_agents": 1, "proprioception": True, "vestibular": True, "expressions": True},
+                "1 infant, free play, physics + actuation + proprioception + vestibular, not "
+                "recorded (the foundation's target)", group="tasks"),
     BenchConfig("free_play", "free_play_v0", {}, "free play task, defaults (2 infants, "
                 "proprioception + vestibular), recorded", record=True, group="tasks"),
     BenchConfig("high_five", "high_five_v0", {}, "high five task, defaults (2 infants), recorded",
@@ -942,13 +946,20 @@ def target_checks(report) -> list[dict]:
                               f"~{MIMO_REFERENCE['build_with_touch_s']:.0f} s",
                     "measured": f"at most {worst:.2f} s (`{name}`)",
                     "met": worst < MIMO_REFERENCE["build_with_touch_s"]})
-    if "agents_1" in res:
+    if "basic_1" in res:  # the whole step of an infant with exactly these senses
+        total = res["basic_1"]["real_s_per_sim_s"]
+        out.append({"target": "one infant (physics + proprioception + vestibular) "
+                              f"<= {TARGETS['agents_1_max']} real s / sim s",
+                    "measured": f"{total:.4f} (the whole step of `basic_1`)",
+                    "met": total <= TARGETS["agents_1_max"]})
+    elif "agents_1" in res:
         r = res["agents_1"]
         c = r["components"]
         pps = c["physics"] + c["proprioception"] + c["vestibular"]
         out.append({"target": "one infant (physics + proprioception + vestibular) "
                               f"<= {TARGETS['agents_1_max']} real s / sim s",
-                    "measured": f"{pps:.4f} (those three components of `agents_1`)",
+                    "measured": f"{pps:.4f} (those three components of `agents_1`, which also "
+                                "renders and feels: add `basic_1` for the exact figure)",
                     "met": pps <= TARGETS["agents_1_max"]})
     builds = []
     cold = report.get("cold_start") or {}
