@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-SUBCOMMAND_MODULES = ("demo", "bench", "calibration", "compliance", "replay_cli")
+SUBCOMMAND_MODULES = ("demo", "bench", "calibration", "compliance", "replay_cli", "train")
 
 
 def build_parser() -> argparse.ArgumentParser:

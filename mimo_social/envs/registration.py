@@ -2,7 +2,10 @@
 
 import gymnasium as gym
 
-IDS = {"mimo_social/Reach-v0": "mimo_social.envs.single:make_reach"}
+IDS = {"mimo_social/Reach-v0": "mimo_social.envs.single:make_reach",
+       "mimo_social/Standup-v0": "mimo_social.envs.single:make_standup",
+       "mimo_social/SelfBody-v0": "mimo_social.envs.single:make_selfbody",
+       "mimo_social/Catch-v0": "mimo_social.envs.single:make_catch"}
 
 
 def register_envs() -> None:

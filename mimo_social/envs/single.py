@@ -43,3 +43,18 @@ class SingleAgentEnv(gym.Env):
 def make_reach(**kwargs) -> SingleAgentEnv:
     from .reach_v0 import parallel_env
     return SingleAgentEnv(parallel_env(**kwargs))
+
+
+def make_standup(**kwargs) -> SingleAgentEnv:
+    from .standup_v0 import parallel_env
+    return SingleAgentEnv(parallel_env(**kwargs))
+
+
+def make_selfbody(**kwargs) -> SingleAgentEnv:
+    from .selfbody_v0 import parallel_env
+    return SingleAgentEnv(parallel_env(**kwargs))
+
+
+def make_catch(**kwargs) -> SingleAgentEnv:
+    from .catch_v0 import parallel_env
+    return SingleAgentEnv(parallel_env(**kwargs))

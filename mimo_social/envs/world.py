@@ -54,6 +54,10 @@ class Prop:
     mass: float = 0.1
     rgba: tuple[float, float, float, float] = (0.9, 0.2, 0.2, 1.0)
     fixed: bool = False
+    # bodies held to this prop by a weld equality, with their agent prefix
+    # ("infant_0/right_hand"); each is held at its pose relative to the prop in the world's
+    # initial pose, and :meth:`World.hold_welds` re-anchors them to the current one
+    welds: tuple[str, ...] = ()
 
 
 @dataclass
@@ -136,12 +140,14 @@ class World:
         full = np.empty(mujoco.mj_stateSize(m, self._STATE))
         mujoco.mj_getState(m, d, full, self._STATE)
         return {"recipe": self._recipe, "state": full, "mat_texid": m.mat_texid.copy(),
-                "bad_count": self._bad_count}
+                "eq_data": m.eq_data.copy(), "bad_count": self._bad_count}
 
     def __setstate__(self, state):
         self.__init__(*state["recipe"])
         mujoco.mj_setState(self.model, self.data, state["state"], self._STATE)
         self.model.mat_texid[:] = state["mat_texid"]
+        if "eq_data" in state:
+            self.model.eq_data[:] = state["eq_data"]
         self._bad_count = state["bad_count"]
         mujoco.mj_forward(self.model, self.data)
 
@@ -186,6 +192,7 @@ class World:
             for k, name in enumerate(a.joint_names):
                 self._initial_qpos[a.qpos_adr[k]] = pose_q.get(name, self._initial_qpos[a.qpos_adr[k]])
         self.reset()
+        self.hold_welds()
 
     @staticmethod
     def _set_options(spec, physics: PhysicsConfig):
@@ -237,6 +244,14 @@ class World:
         size[: len(p.size)] = p.size
         body.add_geom(name=p.name, type=shapes[p.shape], size=size, mass=p.mass, rgba=p.rgba,
                       condim=3)
+        for other in p.welds:
+            if spec.body(other) is None:
+                raise ValueError(f"prop {p.name}: cannot weld unknown body {other!r}")
+            eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_WELD, objtype=mujoco.mjtObj.mjOBJ_BODY,
+                                   name=f"{p.name}__{other}", name1=other, name2=p.name)
+            data = np.array(eq.data)
+            data[:3] = 0.0  # the anchor: the prop's origin
+            eq.data = data
 
     @staticmethod
     def _rest_pose(build, posture: str, setup: AgentSetup):
@@ -325,6 +340,8 @@ class World:
         self.prop_dof = {p.name: int(m.jnt_dofadr[m.body_jntadr[m.body(p.name).id]])
                          for p in self.props if not p.fixed}
         self.tables = [build.tables for build, _ in builds]
+        self.welds = np.array([(m.equality(f"{p.name}__{o}").id, m.body(o).id, m.body(p.name).id)
+                               for p in self.props for o in p.welds], dtype=np.intp).reshape(-1, 3)
 
     # -- state ---------------------------------------------------------------------------------
     def reset(self, qpos: np.ndarray | None = None):
@@ -334,6 +351,19 @@ class World:
             self.faces.show(self.model, a.head_material, 0)
         mujoco.mj_forward(self.model, self.data)
         self._bad_count = 0
+
+    def hold_welds(self) -> None:
+        """Anchor every prop weld (:attr:`Prop.welds`) at the bodies' current relative pose
+        (``data`` kinematics must be up to date): ``eq_data`` holds the welded body's pose in the
+        prop's frame as MuJoCo stores it (position of the anchor in the body's frame, then the
+        relative orientation ``q_body^-1 q_prop``)."""
+        m, d = self.model, self.data
+        for eq, b1, b2 in self.welds:
+            anchor = m.eq_data[eq, :3]
+            R1 = d.xmat[b1].reshape(3, 3)
+            m.eq_data[eq, 3:6] = R1.T @ (d.xpos[b2] + d.xmat[b2].reshape(3, 3) @ anchor - d.xpos[b1])
+            q1 = d.xquat[b1] * np.array([1.0, -1.0, -1.0, -1.0])
+            mujoco.mju_mulQuat(m.eq_data[eq, 6:10], q1, d.xquat[b2])
 
     @property
     def initial_qpos(self) -> np.ndarray:

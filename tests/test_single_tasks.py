@@ -1,0 +1,195 @@
+"""The one-agent demos of the paper (reach, standup, selfbody, catch): API checks, rewards, ends."""
+
+import pickle
+import warnings
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from pettingzoo.test import parallel_api_test
+
+import mimo_social  # noqa: F401  (registers the ids)
+from mimo_social.envs import catch_v0, reach_v0, selfbody_v0, standup_v0
+
+IDS = ["mimo_social/Reach-v0", "mimo_social/Standup-v0", "mimo_social/SelfBody-v0",
+       "mimo_social/Catch-v0"]
+A = "infant_0"
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_check_env(env_id):
+    env = gym.make(env_id).unwrapped
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # unbounded Box observations
+        check_env(env, skip_render_check=True)
+    env.close()
+
+
+@pytest.mark.parametrize("module", [standup_v0, selfbody_v0, catch_v0])
+def test_parallel_api(module):
+    env = module.parallel_env(max_steps=30)
+    assert env.possible_agents == [A]
+    parallel_api_test(env, num_cycles=40)
+    assert module.__doc__ and "| reward |" in module.__doc__  # the table travels with the env
+    env.close()
+
+
+def test_spaces_of_the_published_tasks():
+    st = standup_v0.parallel_env()
+    assert st.action_space(A).shape == (27,) and st.frame_skip == 1 and st.max_steps == 500
+    assert set(st.observation_space(A).spaces) == {"proprioception", "vestibular"}
+    sb = selfbody_v0.parallel_env()
+    assert sb.action_space(A).shape == (8,) and sb.max_steps == 500
+    obs = sb.observation_space(A).spaces
+    assert set(obs) == {"proprioception", "touch", "target"}
+    assert obs["target"].shape == (len(sb.task.targets),) == (15,)
+    ca = catch_v0.parallel_env()
+    assert ca.action_space(A).shape == (40,) and ca.max_steps == 800   # 20 axes x 2 muscles
+    assert float(ca.action_space(A).low.min()) == 0.0 and float(ca.action_space(A).high.max()) == 1.0
+    assert set(ca.observation_space(A).spaces) == {"proprioception", "touch", "ball_size"}
+    names = ca.world.agents[0].actuated_names
+    assert "right_wrist_flexion" in names and not any("thumb" in n for n in names)
+    with pytest.raises(ValueError, match="five_fingers"):
+        catch_v0.parallel_env(hands="mitten", touch=False)
+    for env in (st, sb, ca):
+        env.close()
+
+
+# -- standup ----------------------------------------------------------------------------------
+def test_standup_reward_rises_with_head_height_and_pays_for_controls():
+    env = standup_v0.parallel_env()
+    env.reset(seed=0)
+    w = env.world
+    m, d = w.model, w.data
+    r0 = float(env.task.rewards(env)[0])
+    assert abs(r0) < 0.02                       # the reference is the settled start height
+    d.qpos[w.agents[0].free_qpos + 2] += 0.05   # lift the whole body 5 cm
+    mujoco.mj_kinematics(m, d)
+    r1 = float(env.task.rewards(env)[0])
+    assert r1 - r0 == pytest.approx(0.05, abs=1e-6)
+    env.reset(seed=0)
+    _, rew, _, _, infos = env.step({A: np.ones(27, np.float32)})
+    assert infos[A]["control_cost"] == pytest.approx(0.01 * 27)
+    assert rew[A] == pytest.approx(infos[A]["head_gain"] - 0.27)
+    # the published reference height: head height minus 0.2 m
+    pub = standup_v0.parallel_env(task_options={"head_reference": 0.2})
+    pub.reset(seed=0)
+    _, rew, _, _, infos = pub.step({A: np.zeros(27, np.float32)})
+    assert rew[A] == pytest.approx(infos[A]["head_height"] - 0.2)
+    env.close()
+    pub.close()
+
+
+def test_standup_welds_hold_hands_and_feet_for_a_whole_episode():
+    env = standup_v0.parallel_env()
+    env.reset(seed=3)
+    w = env.world
+    m, d = w.model, w.data
+    hands = [m.body(f"{A}/{s}_hand").id for s in ("right", "left")]
+    feet = [m.body(f"{A}/{s}_foot").id for s in ("right", "left")]
+    start = d.xpos[hands + feet].copy()
+    assert np.all(np.abs(d.xpos[hands, 2] - 0.45) < 0.03)   # hands at the rail, 45 cm up
+    space = env.action_space(A)
+    space.seed(0)
+    steps = 0
+    while env.agents:
+        _, _, term, trunc, infos = env.step({A: space.sample()})
+        steps += 1
+    assert steps == 500 and trunc[A] and not term[A] and "instability" not in infos[A]
+    assert np.abs(d.xpos[hands + feet] - start).max() < 0.05
+    # a pickled env (a vector-env worker) keeps its welds' anchors
+    clone = pickle.loads(pickle.dumps(env))
+    np.testing.assert_array_equal(clone.world.model.eq_data, m.eq_data)
+    clone.reset(seed=3)
+    cm = clone.world.model
+    assert cm.geom_contype[cm.geom("crib_rail").id] == 0            # settings made again
+    np.testing.assert_array_equal(cm.eq_solref[clone.world.welds[:, 0]],
+                                  m.eq_solref[w.welds[:, 0]])
+    env.reset(seed=3)
+    np.testing.assert_allclose(clone.world.data.qpos, d.qpos)       # the same settled start
+    env.close()
+
+
+# -- selfbody ---------------------------------------------------------------------------------
+def test_selfbody_touching_the_target_ends_with_500():
+    env = selfbody_v0.parallel_env(task_options={"target": "right_upper_leg"})
+    obs, _ = env.reset(seed=0)
+    k = env.task.targets.index("right_upper_leg")
+    assert obs[A]["target"][k] == 1.0 and obs[A]["target"].sum() == 1.0
+    _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
+    assert rew[A] == -1.0 and not term[A] and infos[A]["touched"] == []   # starts touching nothing
+    gap = env.task.place_hand_on(env, "right_upper_leg")
+    assert gap <= 0.0
+    _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
+    assert rew[A] == 500.0 and term[A] and infos[A]["is_success"]
+    assert "right_upper_leg" in infos[A]["touched"]
+    assert env.agents == []
+    env.close()
+
+
+def test_selfbody_touching_another_part_costs_the_distance_to_the_target():
+    env = selfbody_v0.parallel_env(task_options={"target": "head"})
+    env.reset(seed=0)
+    assert env.task.place_hand_on(env, "right_upper_leg") <= 0.0
+    _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
+    assert not term[A] and not infos[A]["is_success"]
+    assert "right_upper_leg" in infos[A]["touched"] and "head" not in infos[A]["touched"]
+    assert -1.0 < rew[A] < -0.1 and rew[A] == pytest.approx(-infos[A]["distance"])
+    env.close()
+
+
+def test_selfbody_samples_the_target_per_episode():
+    env = selfbody_v0.parallel_env()
+    seen = set()
+    for s in range(12):
+        obs, _ = env.reset(seed=s)
+        seen.add(int(np.argmax(obs[A]["target"])))
+    assert len(seen) >= 5
+    env.close()
+
+
+# -- catch ------------------------------------------------------------------------------------
+def test_catch_fails_when_the_ball_drops_below_the_hand():
+    env = catch_v0.parallel_env()
+    env.reset(seed=0)
+    task = env.task
+    palm = env.world.data.site_xpos[env.world.agents[0].palm_sites[0]].copy()
+    task.place_ball(env, palm + np.array([0.0, 0.0, -0.2]))
+    _, rew, term, trunc, infos = env.step({A: np.zeros(40, np.float32)})
+    assert rew[A] == -100.0 and term[A] and not trunc[A]
+    assert infos[A]["dropped"] and not infos[A]["is_success"]
+    env.close()
+
+
+def test_catch_randomises_the_ball_and_pays_for_touch_and_holding():
+    env = catch_v0.parallel_env(task_options={"hold_time": 0.03})
+    sizes = set()
+    for s in range(4):
+        obs, infos = env.reset(seed=s)
+        r = env.task._radius
+        assert 0.005 <= r <= 0.025 and 0.05 <= env.task._mass <= 0.5
+        assert obs[A]["ball_size"][0] == pytest.approx(r)
+        assert env.world.model.geom_size[env.task._ball_geom, 0] == pytest.approx(r)
+        sizes.add(round(r, 5))
+    assert len(sizes) == 4
+    # the ball lying in the palm: reward N_c - c_w(a) while it touches, +100 once held 3 steps
+    env.reset(seed=1)
+    d = env.world.data
+    palm = d.site_xpos[env.world.agents[0].palm_sites[0]].copy()
+    env.task.place_ball(env, palm + np.array([0.0, 0.0, env.task._radius + 0.004]))
+    rewards, infos = [], None
+    while env.agents and len(rewards) < 10:
+        _, rew, term, _, infos = env.step({A: np.full(40, 0.2, np.float32)})
+        rewards.append(rew[A])
+    assert infos[A]["is_success"] and rewards[-1] == 100.0 and len(rewards) == 3
+    assert all(0.9 < r < 10 for r in rewards[:-1])      # >= 1 part touching, tiny muscle cost
+    env.close()
+
+
+def test_reach_is_unchanged():
+    env = reach_v0.parallel_env()
+    obs, _ = env.reset(seed=0)
+    assert env.action_space(A).shape == (8,) and set(obs[A]) == {"proprioception"}
+    env.close()

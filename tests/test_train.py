@@ -1,0 +1,102 @@
+"""The training tooling: ``mimo-social train | eval | compare`` (short runs on reach)."""
+
+import csv
+import importlib.util
+import json
+import shutil
+
+import numpy as np
+import pytest
+import torch
+
+from mimo_social import cli
+from mimo_social.train import compare, evaluate, read_progress, train
+
+torch.set_num_threads(1)
+
+FAST_PPO = {"n_steps": 128, "batch_size": 64, "n_epochs": 2}
+SHORT = {"max_steps": 60}
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("runs") / "reach_ppo"
+    res = train("reach", "ppo", 256, 0, out, eval_every=128, eval_episodes=2,
+                checkpoint_every=128, progress=False, env_kwargs=SHORT, algo_kwargs=FAST_PPO)
+    return out, res
+
+
+def test_train_writes_model_csv_png_and_checkpoints(run):
+    out, res = run
+    for name in ("model.zip", "best_model.zip", "config.json", "progress.csv", "episodes.csv",
+                 "learning_curve.png"):
+        assert (out / name).stat().st_size > 0, name
+    assert sorted(p.name for p in (out / "checkpoints").iterdir()) == [
+        "model_128_steps.zip", "model_256_steps.zip"]
+    p = read_progress(out / "progress.csv")
+    assert list(p["timesteps"]) == [128, 256]
+    assert np.isfinite(p["eval_return_mean"]).all() and np.isfinite(p["eval_success_rate"]).all()
+    with open(out / "episodes.csv", newline="") as f:
+        episodes = list(csv.DictReader(f))
+    assert episodes and all(int(e["length"]) <= 60 for e in episodes)
+    config = json.loads((out / "config.json").read_text())
+    assert config["task"] == "reach" and config["algo"] == "ppo" and config["timesteps_done"] >= 256
+    assert config["env_kwargs"] == SHORT and config["algo_kwargs"] == FAST_PPO
+    assert (out / "learning_curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert res["last_eval"]["timesteps"] == 256
+
+
+def test_eval_reloads_the_model_and_runs_episodes(run, tmp_path):
+    out, _ = run
+    a = evaluate(out, episodes=3, seed=5)
+    b = evaluate(out, episodes=3, seed=5, model="best")
+    assert len(a["returns"]) == 3 and all(n <= 60 for n in a["lengths"])
+    c = evaluate(out, episodes=3, seed=5)
+    assert a["returns"] == c["returns"]                       # deterministic policy, seeded
+    assert np.isfinite(b["return_mean"])
+    assert json.loads((out / "eval_results.json").read_text())["episodes"] == 3
+    # recording and frames through the command line
+    rrd, frames = tmp_path / "ep.rrd", tmp_path / "frames"
+    assert cli.main(["eval", str(out), "--episodes", "1", "--record", str(rrd),
+                     "--frames", str(frames), "--frame-every", "20"]) == 0
+    assert rrd.stat().st_size > 0
+    pngs = sorted(frames.glob("*.png"))
+    assert pngs and pngs[0].read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.skipif(importlib.util.find_spec("imageio") is not None or shutil.which("ffmpeg"),
+                    reason="an mp4 encoder is installed")
+def test_eval_video_without_an_encoder_says_so(run, tmp_path, capsys):
+    out, _ = run
+    assert cli.main(["eval", str(out), "--episodes", "1", "--video", str(tmp_path / "v.mp4")]) == 2
+    err = capsys.readouterr().err
+    assert "no MP4 encoder" in err and "--frames" in err
+    assert not (tmp_path / "v.mp4").exists()
+
+
+def test_cli_train_sac_and_unknown_task(tmp_path, capsys):
+    out = tmp_path / "sac"
+    assert cli.main(["train", "--task", "reach", "--algo", "sac", "--steps", "64", "--seed", "1",
+                     "--out", str(out), "--eval-every", "64", "--eval-episodes", "1",
+                     "--checkpoint-every", "0", "--no-progress",
+                     "--env-kwargs", '{"max_steps": 30}',
+                     "--algo-kwargs", '{"learning_starts": 32, "batch_size": 32}']) == 0
+    assert (out / "model.zip").exists() and not (out / "checkpoints").exists()
+    assert json.loads((out / "config.json").read_text())["algo_kwargs"]["buffer_size"] == 64
+    assert "trained SAC on reach" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        cli.main(["train", "--task", "juggle", "--algo", "ppo", "--steps", "1", "--out", "x"])
+
+
+def test_compare_trains_seeds_and_plots_them_together(tmp_path):
+    png = compare("reach", ["ppo"], seeds=2, steps=128, out=tmp_path, eval_every=64,
+                  eval_episodes=1, checkpoint_every=0, progress=False, env_kwargs={"max_steps": 30},
+                  algo_kwargs={"n_steps": 64, "batch_size": 32, "n_epochs": 1})
+    assert png == tmp_path / "compare.png" and png.stat().st_size > 0
+    with open(tmp_path / "compare.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert {(r["algo"], r["seed"]) for r in rows} == {("ppo", "0"), ("ppo", "1")}
+    png.unlink()
+    assert cli.main(["compare", "--task", "reach", "--algos", "ppo", "--seeds", "2", "--steps",
+                     "128", "--out", str(tmp_path), "--plot-only"]) == 0
+    assert png.exists()
