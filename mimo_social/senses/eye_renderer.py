@@ -128,6 +128,16 @@ def _coarse_planes(model):
     return planes, grid
 
 
+def _free_render_context(con) -> None:
+    """Free an MjrContext made on this process's shared GL context (no-op after a fork)."""
+    if con is not None and _GL is not None and _GL_PID == os.getpid():
+        try:
+            _GL.make_current()
+            con.free()
+        except Exception:  # noqa: BLE001 - freeing at shutdown must not raise
+            pass
+
+
 @dataclass
 class Tile:
     """One camera image: its size and where it sits in its batch's buffer."""
@@ -246,12 +256,7 @@ class TileRenderer:
         self._depth_b = np.float32(near / (far - near))
 
     def close(self):
-        if self._con is not None and _GL is not None and _GL_PID == os.getpid():
-            try:
-                _GL.make_current()
-                self._con.free()
-            except Exception:  # noqa: BLE001
-                pass
+        _free_render_context(self._con)
         self._con = self._scn = None
 
     def __getstate__(self):
@@ -473,12 +478,7 @@ class SceneRenderer:
         return np.ascontiguousarray(img)
 
     def close(self):
-        if self._con is not None and _GL is not None and _GL_PID == os.getpid():
-            try:
-                _GL.make_current()
-                self._con.free()
-            except Exception:  # noqa: BLE001
-                pass
+        _free_render_context(self._con)
         self._con = None
 
     def __getstate__(self):
