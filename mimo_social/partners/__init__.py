@@ -1,0 +1,7 @@
+"""Scripted partners: reusable policies that act for an agent through its action space, and
+:class:`ScriptedPartners`, the ParallelEnv wrapper that leaves only the learners."""
+
+from .base import Partner, Still, zero_action
+from .wrapper import ScriptedPartners
+
+__all__ = ["Partner", "Still", "zero_action", "ScriptedPartners"]

@@ -1,0 +1,57 @@
+"""What a scripted partner is: a policy for one agent that acts through that agent's actions.
+
+A partner sees the whole env (it is scripted, so it may read the world's state, for example
+where a toy lies) but it moves its infant only through the action space, exactly as a learner
+would: any scripted partner can be swapped for a learner, or for another partner, without
+changing the task.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from gymnasium import spaces
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..envs.parallel import MimoParallelEnv
+
+__all__ = ["Partner", "Still", "zero_action"]
+
+
+def zero_action(space: spaces.Space):
+    """The resting action of an agent: zero motor commands (muscles: no activation) and, when
+    the agent has expressions, the neutral face (id 0)."""
+    if isinstance(space, spaces.Dict):
+        return {k: zero_action(s) for k, s in space.spaces.items()}
+    if isinstance(space, spaces.Discrete):
+        return int(space.start)
+    if isinstance(space, spaces.Box):
+        return np.clip(np.zeros(space.shape, space.dtype), space.low, space.high)
+    raise TypeError(f"no resting action for space {space}")
+
+
+class Partner:
+    """Base class of scripted partners.
+
+    ``reset(env, agent, rng)`` is called after every env reset (``env`` is the
+    :class:`~mimo_social.envs.parallel.MimoParallelEnv`, ``agent`` the partner's name, ``rng``
+    a generator seeded from the reset seed); ``act(env, agent, observation)`` returns the
+    agent's action for the next step, in ``env.action_space(agent)``.
+    """
+
+    def reset(self, env: "MimoParallelEnv", agent: str, rng: np.random.Generator) -> None:
+        self.rng = rng
+
+    def act(self, env: "MimoParallelEnv", agent: str, observation) -> Any:
+        raise NotImplementedError
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+
+class Still(Partner):
+    """Does nothing: zero motor commands and a neutral face (a passive partner)."""
+
+    def act(self, env, agent, observation):
+        return zero_action(env.action_space(agent))

@@ -1,0 +1,114 @@
+"""``ScriptedPartners(env, {"infant_1": ExpressionShow()})``: some agents driven by scripts.
+
+A PettingZoo ParallelEnv around a :class:`~mimo_social.envs.parallel.MimoParallelEnv` whose
+agents are only the learners; every scripted agent's action is filled in by its
+:class:`~mimo_social.partners.base.Partner` each step. With one learner left, the result can be
+wrapped by :class:`~mimo_social.envs.single.SingleAgentEnv` for Gymnasium / SB3. Each learner's
+info gets ``partner_rewards`` (the scripted agents' rewards of the step), so a cooperative task
+can be judged from both sides.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import numpy as np
+from pettingzoo import ParallelEnv
+
+from .base import Partner
+
+__all__ = ["ScriptedPartners"]
+
+
+class ScriptedPartners(ParallelEnv):
+    def __init__(self, env: ParallelEnv, partners: Mapping[str, Partner]):
+        if not isinstance(env, ParallelEnv):
+            raise TypeError(f"ScriptedPartners wraps a pettingzoo ParallelEnv, got "
+                            f"{type(env).__name__}")
+        if not isinstance(partners, Mapping) or not partners:
+            raise ValueError("partners must be a non-empty mapping agent -> Partner, got "
+                             f"{partners!r}")
+        unknown = [a for a in partners if a not in env.possible_agents]
+        if unknown:
+            raise ValueError(f"scripted agent(s) {unknown} are not agents of this env; "
+                             f"agents: {env.possible_agents}")
+        for a, p in partners.items():
+            if not callable(getattr(p, "act", None)) or not callable(getattr(p, "reset", None)):
+                raise TypeError(f"partner for {a!r} must have reset(env, agent, rng) and "
+                                f"act(env, agent, observation); got {p!r}")
+        learners = [a for a in env.possible_agents if a not in partners]
+        if not learners:
+            raise ValueError("every agent is scripted: leave at least one learner")
+        self.env = env
+        self.partners = dict(partners)
+        self.possible_agents = learners
+        self.metadata = dict(getattr(env, "metadata", {}))
+        self.render_mode = getattr(env, "render_mode", None)
+        self._partner_obs: dict[str, Any] = {}
+
+    @property
+    def agents(self):
+        return [a for a in self.env.agents if a not in self.partners]
+
+    @property
+    def unwrapped(self):
+        return self.env.unwrapped
+
+    def observation_space(self, agent):
+        self._check(agent)
+        return self.env.observation_space(agent)
+
+    def action_space(self, agent):
+        self._check(agent)
+        return self.env.action_space(agent)
+
+    def _check(self, agent):
+        if agent not in self.possible_agents:
+            raise KeyError(f"unknown agent {agent!r}; learners of this env: {self.possible_agents}"
+                           f" (scripted: {list(self.partners)})")
+
+    def _split(self, d: Mapping[str, Any]) -> dict:
+        return {a: v for a, v in d.items() if a not in self.partners}
+
+    def reset(self, seed: int | None = None, options: dict | None = None):
+        obs, infos = self.env.reset(seed=seed, options=options)
+        base = np.random.SeedSequence(seed) if seed is not None else np.random.SeedSequence()
+        rngs = [np.random.default_rng(s) for s in base.spawn(len(self.partners))]
+        inner = self.env.unwrapped
+        for (name, partner), rng in zip(self.partners.items(), rngs):
+            partner.reset(inner, name, rng)
+        self._partner_obs = {a: obs[a] for a in self.partners if a in obs}
+        return self._split(obs), self._split(infos)
+
+    def step(self, actions: Mapping[str, Any]):
+        if not isinstance(actions, Mapping):
+            raise ValueError(f"actions must be a dict agent -> action, got {type(actions).__name__}")
+        scripted = [a for a in actions if a in self.partners]
+        if scripted:
+            raise ValueError(f"actions given for scripted agent(s) {scripted}; their partners "
+                             f"act for them. Learners: {self.possible_agents}")
+        inner = self.env.unwrapped
+        full = dict(actions)
+        for name, partner in self.partners.items():
+            if name in self.env.agents:
+                full[name] = partner.act(inner, name, self._partner_obs.get(name))
+        obs, rewards, terms, truncs, infos = self.env.step(full)
+        self._partner_obs = {a: obs[a] for a in self.partners if a in obs}
+        partner_rewards = {a: float(rewards[a]) for a in self.partners if a in rewards}
+        infos = self._split(infos)
+        for a in infos:
+            infos[a] = dict(infos[a], partner_rewards=partner_rewards)
+        return (self._split(obs), self._split(rewards), self._split(terms), self._split(truncs),
+                infos)
+
+    def render(self):
+        return self.env.render()
+
+    def close(self):
+        return self.env.close()
+
+    def state(self):
+        return self.env.state()
+
+    def state_space(self):
+        return self.env.state_space()
