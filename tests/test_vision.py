@@ -233,11 +233,16 @@ def test_spaces_follow_the_configuration():
             ray = R @ np.array([(col + 0.5 - 20) / f, -(row + 0.5 - 16) / f, -1.0])
             z = mujoco.mj_ray(m, d, d.cam_xpos[cam], ray, np.array([1, 1, 1, 0, 0, 0], np.uint8),
                               1, head_body, np.array([-1], np.int32))  # in units of ray: z-depth
+            # a ray near a silhouette can hit the true round surface and miss its polygon
+            # (or the reverse): there the rendered depth jumps between neighbouring pixels
+            near = depth[max(row - 1, 0):row + 2, max(col - 1, 0):col + 2]
+            edge = near.max() - near.min() > 0.05
             if z < 0:
-                assert depth[row, col] > 10
+                assert depth[row, col] > 10 or edge, (row, col, depth[row, col])
             else:
                 hits += 1
-                assert abs(depth[row, col] - z) < 0.01 + 0.02 * z, (row, col, depth[row, col], z)
+                assert abs(depth[row, col] - z) < 0.01 + 0.02 * z or edge, \
+                    (row, col, depth[row, col], z)
     assert hits > 50
     env.close()
 
