@@ -182,6 +182,12 @@ CONFIGS: dict[str, BenchConfig] = {c.name: c for c in (
                 record=True, group="tasks"),
     BenchConfig("reach", "reach_v0", {}, "reach task, defaults (1 infant), recorded",
                 record=True, group="tasks"),
+    BenchConfig("standup", "standup_v0", {}, "stand-up task, defaults (1 infant, 5 ms control "
+                "step), recorded", record=True, group="tasks"),
+    BenchConfig("selfbody", "selfbody_v0", {}, "self-body touch task, defaults (1 infant, "
+                "touch), recorded", record=True, group="tasks"),
+    BenchConfig("catch", "catch_v0", {}, "catch task, defaults (1 infant, five fingers, "
+                "muscles, touch), recorded", record=True, group="tasks"),
     _scene("five_fingers", "as default with five-fingered hands", group="bodies",
            hands="five_fingers"),
     _scene("muscle", "as default with the muscle model (controls in [0, 1], 2 per motor)",
