@@ -8,6 +8,9 @@ Joints a task wants held still are *frozen*: when a frozen joint comes before ev
 of its segment, its rotation is folded into the segment's orientation and the joint disappears
 from the model (no degree of freedom, no cost); otherwise it is held by an equality constraint.
 Motors of frozen joints are not built.
+
+A larger or stronger body (``scale``, ``strength``) is built from the scaled tables of
+:func:`~mimo_social.body.tables.load_body`; nothing here depends on the size.
 """
 
 from __future__ import annotations
@@ -20,14 +23,14 @@ from typing import Mapping
 import mujoco
 import numpy as np
 
-from .tables import BodyTables, load_body, subtree
+from .tables import DEFAULT_FRICTION, BodyTables, load_body, subtree
 
 __all__ = ["InfantBuild", "build_infant", "axis_angle_quat", "quat_mul"]
 
 # Contact and joint-limit solver settings of the published model's defaults.
 GEOM_SOLIMP = (0.95, 0.99, 0.001, 0.5, 1.0)
 GEOM_SOLREF = (0.005, 1.0)
-GEOM_FRICTION = (1.0, 0.005, 0.0002)
+GEOM_FRICTION = DEFAULT_FRICTION  # sliding, torsional (m), rolling (m)
 LIMIT_SOLIMP = (0.98, 0.99, 0.001, 0.5, 1.0)
 LIMIT_SOLREF = (0.02, 1.0)
 
@@ -87,6 +90,8 @@ def build_infant(
     frozen: Mapping[str, float] | None = None,
     base: str = "free",
     clothes_rgba=DEFAULT_CLOTHES_RGBA,
+    scale: float = 1.0,
+    strength: float = 1.0,
 ) -> InfantBuild:
     """Build one infant.
 
@@ -97,8 +102,12 @@ def build_infant(
         base: ``"free"`` (a free joint at the hip: the infant can walk, fall, be pushed) or
             ``"fixed"`` (the hip is fixed to the world at its placement).
         clothes_rgba: colour of the clothed segments, so infants can be told apart.
+        scale: body size factor, 0.5 to 2.5 (every length times ``scale``; masses, inertias,
+            torques, passive joint parameters, muscles and touch spacing follow the scaling laws
+            of :func:`~mimo_social.body.tables.scale_body`).
+        strength: factor on every motor's maximum torque and muscle's maximum force, 0.1 to 10.
     """
-    tables = load_body(hands)
+    tables = load_body(hands, scale, strength)
     if base not in ("free", "fixed"):
         raise ValueError(f"base={base!r}; allowed: 'free', 'fixed'")
     by_name = {j.name: j for j in tables.joints}

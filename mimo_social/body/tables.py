@@ -3,6 +3,11 @@
 The tables list the midline and the right side only; :func:`load_body` mirrors every
 ``right_*`` row into a ``left_*`` row across the sagittal (x-z) plane. See
 ``body/data/README.md`` for the sources and the meaning of each column.
+
+A body of another size or strength (an older child, a caregiver-sized partner) is the same
+tables scaled once, here, by :func:`load_body` (``scale``, ``strength``; see :func:`scale_body`
+and ``docs/bodies.md``): the builder, the actuation models and the touch skin read the scaled
+values and know nothing of the scaling.
 """
 
 from __future__ import annotations
@@ -15,11 +20,41 @@ from importlib import resources
 import numpy as np
 
 __all__ = ["Segment", "GeomSpec", "JointSpec", "SiteSpec", "BodyTables", "load_body",
-           "HAND_VERSIONS", "subtree", "arm_joints"]
+           "scale_body", "HAND_VERSIONS", "SCALE_RANGE", "STRENGTH_RANGE", "SCALING_EXPONENTS",
+           "DEFAULT_FRICTION", "subtree", "arm_joints"]
 
 #: ``mitten``: the published v1 body (one-piece fingers, 44 motors); ``five_fingers``: the
 #: published v2 body (five articulated fingers per hand, two toes per foot, 88 motors).
 HAND_VERSIONS = ("mitten", "five_fingers")
+
+#: Allowed body size factors (every length times ``scale``; 1: the 18-month-old, 77.8 cm) and
+#: strength factors (every motor's maximum torque and muscle's maximum force, on top of the size
+#: law).
+SCALE_RANGE = (0.5, 2.5)
+STRENGTH_RANGE = (0.1, 10.0)
+
+#: The exponent of ``scale`` each kind of table value is multiplied by (geometric similarity,
+#: constant density, and dynamic similarity under the same gravity: a body ``s`` times larger
+#: moves like the original on a time scale ``sqrt(s)``). ``strength`` multiplies motor torques
+#: and muscle forces on top. Angles (joint ranges, spring references, orientations), the sliding
+#: friction coefficient and dimensionless ratios (trunk couplings) do not change.
+SCALING_EXPONENTS = {
+    "length": 1.0,          # segment, geom, site and joint-pivot positions, geom sizes
+    "mass": 3.0,            # geom masses (MuJoCo derives inertias, x s^5, from mass and shape)
+    "torque": 4.0,          # motor gear (torque limits): m g L
+    "stiffness": 4.0,       # joint springs, Nm/rad: a torque per angle
+    "damping": 4.5,         # Nm s/rad: a torque per angular speed (speeds scale by s^-0.5)
+    "frictionloss": 4.0,    # dry joint friction, Nm
+    "armature": 5.0,        # rotor inertia added to a joint, kg m^2
+    "muscle_fmax": 4.0,     # the muscle model's fmax acts as a torque (the moment arm is a ratio)
+    "muscle_vmax": -0.5,    # the muscle model's vmax is an angular speed: slower by sqrt(s)
+    "touch_spacing": 1.0,   # sensor spacing: the same number of points on every part
+    "contact_length": 1.0,  # torsional and rolling friction coefficients (metres)
+}
+
+#: A geom's contact friction when its table row leaves it empty: sliding, torsional (m), rolling
+#: (m), the published model's default.
+DEFAULT_FRICTION = (1.0, 0.005, 0.0002)
 
 
 @dataclass(frozen=True)
@@ -91,6 +126,8 @@ class BodyTables:
     joints: tuple[JointSpec, ...]
     touch_spacing: dict
     sites: tuple[SiteSpec, ...] = ()
+    scale: float = 1.0      # the size factor these tables were scaled by (see scale_body)
+    strength: float = 1.0   # the strength factor on top of the size law
 
     @property
     def total_mass(self) -> float:
@@ -146,11 +183,95 @@ def _with_left(rows: list, is_right, mirror) -> tuple:
     return tuple(rows) + tuple(mirror(r) for r in rows if is_right(r))
 
 
-@functools.lru_cache(maxsize=None)
-def load_body(hands: str = "mitten") -> BodyTables:
-    """Read the measurement tables of one hand version and add the mirrored left side."""
+def _factor(name: str, value, allowed: tuple[float, float]) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name}={value!r}; allowed: a number from {allowed[0]:g} to "
+                         f"{allowed[1]:g}")
+    value = float(value)
+    if not allowed[0] <= value <= allowed[1]:  # NaN fails too
+        raise ValueError(f"{name}={value!r} is out of range; allowed: {allowed[0]:g} to "
+                         f"{allowed[1]:g}")
+    return value
+
+
+def load_body(hands: str = "mitten", scale: float = 1.0, strength: float = 1.0) -> BodyTables:
+    """The measurement tables of one hand version with the mirrored left side, scaled to a body
+    ``scale`` times the infant's size and ``strength`` times its strength (see
+    :func:`scale_body`). ``scale=1, strength=1`` gives the published tables unchanged.
+
+    Cached: the same arguments give the same (immutable) object.
+    """
     if hands not in HAND_VERSIONS:
         raise ValueError(f"hands={hands!r} is not a known hand version; allowed: {HAND_VERSIONS}")
+    return _load(hands, _factor("scale", scale, SCALE_RANGE),
+                 _factor("strength", strength, STRENGTH_RANGE))
+
+
+@functools.lru_cache(maxsize=None)
+def _load(hands: str, scale: float, strength: float) -> BodyTables:
+    tables = _published(hands)
+    if scale == 1.0 and strength == 1.0:
+        return tables
+    return scale_body(tables, scale, strength)
+
+
+def _cache_clear() -> None:
+    """Forget every loaded table (after the CSV files changed, e.g. a muscle calibration)."""
+    _load.cache_clear()
+    _published.cache_clear()
+
+
+load_body.cache_clear = _cache_clear
+
+
+def scale_body(tables: BodyTables, scale: float, strength: float = 1.0) -> BodyTables:
+    """The tables of a body ``scale`` times as large and ``strength`` times as strong.
+
+    Every value is multiplied by ``scale ** SCALING_EXPONENTS[kind]`` (and motor torques and
+    muscle forces by ``strength``): lengths and positions ``s``, masses ``s^3`` (inertias follow
+    as ``s^5``: MuJoCo computes them from the scaled masses and shapes), motor torque limits
+    ``s^4 strength``, joint stiffness ``s^4``, damping ``s^4.5``, friction loss ``s^4``,
+    armature ``s^5``, muscle ``fmax`` ``s^4 strength`` and ``vmax`` ``s^-0.5``, touch spacing
+    ``s``, torsional and rolling friction ``s``. Angles and ratios are kept. Applied to the
+    published tables (``tables.scale == 1``) or again to scaled ones (factors multiply).
+    """
+    s, k = float(scale), float(strength)
+    if not (s > 0 and k > 0 and np.isfinite(s) and np.isfinite(k)):
+        raise ValueError(f"scale_body: scale={scale!r}, strength={strength!r}; both must be "
+                         "positive numbers")
+    e = SCALING_EXPONENTS
+
+    def f(kind):
+        return s ** e[kind]
+
+    def vec(v):
+        return tuple(float(c) * f("length") for c in v)
+
+    def opt(v, factor):
+        return None if v is None else float(v) * factor
+
+    def friction(fr):
+        fr = fr or DEFAULT_FRICTION
+        return (float(fr[0]), fr[1] * f("contact_length"), fr[2] * f("contact_length"))
+
+    segments = tuple(replace(seg, pos=vec(seg.pos)) for seg in tables.segments)
+    geoms = tuple(replace(g, size=vec(g.size), pos=vec(g.pos), mass=g.mass * f("mass"),
+                          friction=friction(g.friction)) for g in tables.geoms)
+    joints = tuple(replace(
+        j, pos=vec(j.pos), stiffness=j.stiffness * f("stiffness"),
+        damping=j.damping * f("damping"), frictionloss=j.frictionloss * f("frictionloss"),
+        armature=j.armature * f("armature"), gear=opt(j.gear, f("torque") * k),
+        vmax=opt(j.vmax, f("muscle_vmax")), fmax_neg=opt(j.fmax_neg, f("muscle_fmax") * k),
+        fmax_pos=opt(j.fmax_pos, f("muscle_fmax") * k)) for j in tables.joints)
+    sites = tuple(replace(t, pos=vec(t.pos)) for t in tables.sites)
+    spacing = {b: v * f("touch_spacing") for b, v in tables.touch_spacing.items()}
+    return BodyTables(tables.hands, segments, geoms, joints, spacing, sites,
+                      scale=tables.scale * s, strength=tables.strength * k)
+
+
+@functools.lru_cache(maxsize=None)
+def _published(hands: str) -> BodyTables:
+    """Read the measurement tables of one hand version and add the mirrored left side."""
     segs = [
         Segment(r["body"], r["parent"] or None, _floats(r["pos"]), _floats(r["quat"]))
         for r in _rows(f"{hands}_segments.csv")

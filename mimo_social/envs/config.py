@@ -8,10 +8,12 @@ sense: ``False`` (off), ``True`` (defaults) or a mapping of settings.
 from __future__ import annotations
 
 import dataclasses
+import math
+import numbers
 from dataclasses import dataclass, field, fields
 from typing import Any, Mapping, Sequence
 
-from ..body.tables import HAND_VERSIONS
+from ..body.tables import HAND_VERSIONS, SCALE_RANGE, STRENGTH_RANGE
 
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "AgentConfig", "PhysicsConfig",
@@ -140,6 +142,12 @@ class AgentConfig:
     position: tuple[float, float] | None = None   # (x, y) on the floor; None: the task decides
     facing: tuple[float, float] | None = None     # a point (x, y) to face; None: the task decides
     clothes_rgba: tuple[float, float, float, float] | None = None
+    # Body size factor: every length of the body times `scale` (1: the 18-month-old, 77.8 cm;
+    # 1.3: about a 3-year-old's height; 2.2: a caregiver's, 1.7 m); masses, torques and the rest
+    # follow the scaling laws of docs/bodies.md.
+    scale: float = 1.0
+    # Multiplies every motor's maximum torque (muscles: maximum force) on top of the size law.
+    strength: float = 1.0
 
     def __post_init__(self):
         if self.hands not in HAND_VERSIONS:
@@ -155,6 +163,16 @@ class AgentConfig:
             v = getattr(self, key)
             if v is not None and (len(v) != 2 or not all(abs(float(c)) < 1e3 for c in v)):
                 raise ConfigError(f"{key}={v!r}; expected (x, y) in metres or None")
+        for key, (lo, hi), what in (("scale", SCALE_RANGE, "body size factor"),
+                                    ("strength", STRENGTH_RANGE, "strength factor")):
+            v = getattr(self, key)
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+                raise ConfigError(f"{key}={v!r} not allowed; allowed: a number from {lo:g} to "
+                                  f"{hi:g} ({what})")
+            if not lo <= v <= hi:
+                raise ConfigError(f"{key}={v!r} is out of range; allowed: {lo:g} to {hi:g} "
+                                  f"({what})")
+            object.__setattr__(self, key, float(v))
 
 
 def _parse_sense(name: str, value):

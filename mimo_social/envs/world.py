@@ -5,6 +5,10 @@ attached with ``MjSpec.attach`` under the prefix ``infant_<i>/``. After compilin
 agent needs is resolved to integer ids and address arrays (:class:`AgentIndex`); no string
 lookups or MuJoCo accessor views are kept, so a world pickles (it rebuilds its model from its
 recipe when unpickled).
+
+Agents may differ in body: hands, actuation, senses, and size and strength (``scale``,
+``strength`` of :class:`~mimo_social.envs.config.AgentConfig`). Each infant is built from its
+own scaled tables (:attr:`World.tables`) and lowered onto the floor from its own geometry.
 """
 
 from __future__ import annotations
@@ -17,7 +21,6 @@ import numpy as np
 
 from ..body.builder import axis_angle_quat, build_infant, quat_mul
 from ..body.postures import POSTURES
-from ..body.tables import load_body
 from ..expressions.switch import FaceTextures
 from .config import AgentConfig, PhysicsConfig
 
@@ -167,7 +170,8 @@ class World:
         for i, setup in enumerate(agents):
             cfg = setup.config
             rgba = cfg.clothes_rgba or CLOTHES_PALETTE[i % len(CLOTHES_PALETTE)]
-            build = build_infant(cfg.hands, setup.frozen, setup.base, rgba)
+            build = build_infant(cfg.hands, setup.frozen, setup.base, rgba,
+                                 scale=cfg.scale, strength=cfg.strength)
             unknown = sorted(set(setup.actuated or ()) - set(build.actuated))
             if unknown:
                 raise ValueError(f"{self.names[i]}: cannot actuate {unknown}: not motor joints "
@@ -339,6 +343,7 @@ class World:
                           for p in self.props if not p.fixed}
         self.prop_dof = {p.name: int(m.jnt_dofadr[m.body_jntadr[m.body(p.name).id]])
                          for p in self.props if not p.fixed}
+        # each agent's (scaled) body tables: what its actuation and skin are built from
         self.tables = [build.tables for build, _ in builds]
         self.welds = np.array([(m.equality(f"{p.name}__{o}").id, m.body(o).id, m.body(p.name).id)
                                for p in self.props for o in p.welds], dtype=np.intp).reshape(-1, 3)

@@ -30,6 +30,14 @@ Lookup grid (finding the point nearest to a contact)
     contact, moved ``s / 2`` outward along its normal (so that on a thin part it lands on the
     touched side), is looked up in the grid with a few array operations for all contacts at once.
 
+Scaled bodies
+    A body ``scale`` times the infant's size (``AgentConfig.scale``) has every length and every
+    spacing times ``scale``: its skin is the infant's skin, scaled. It is computed (and cached) on
+    the unit body (sizes, positions and spacings divided by ``scale``, read back to 10 significant
+    digits, which recovers the published table values exactly) and its points and distances are
+    then multiplied by ``scale``: every scale has the same points per part, bit for bit the same
+    choices, and shares one cache entry.
+
 Cache
     The arrays are saved as ``<sha1>.npz`` under ``$MIMO_SOCIAL_CACHE/skin/`` (default
     ``~/.cache/mimo_social/skin/``); the key hashes this module's algorithm version, the geometry
@@ -345,8 +353,22 @@ def cache_dir() -> Path:
     return base / "skin"
 
 
-def _skin_parts(model, body_ids, prefix: str, spacing: Mapping[str, float], exclude):
-    """(name, body id, published spacing, [(geom id, shape, size, pos, quat)]) per skinned part."""
+def _unit(values, scale: float) -> np.ndarray:
+    """Lengths of a body ``scale`` times the infant's, brought back to the infant's size.
+
+    Dividing ``v * scale`` by ``scale`` lands within an ulp or two of ``v``; the published table
+    values have at most 6 significant digits, so reading the quotient back to 10 significant
+    digits gives ``v`` exactly (and the same rounding decisions in the point layout)."""
+    values = np.asarray(values, dtype=float)
+    if scale == 1.0:
+        return values.copy()
+    return np.array([float(f"{v / scale:.10g}") for v in values.ravel()]).reshape(values.shape)
+
+
+def _skin_parts(model, body_ids, prefix: str, spacing: Mapping[str, float], exclude,
+                scale: float = 1.0):
+    """(name, body id, published spacing, [(geom id, shape, size, pos, quat)]) per skinned part,
+    lengths of the unit body (divided by ``scale``)."""
     parts = []
     for b in body_ids:
         name = model.body(int(b)).name
@@ -358,14 +380,14 @@ def _skin_parts(model, body_ids, prefix: str, spacing: Mapping[str, float], excl
             t = int(model.geom_type[g])
             if t not in SHAPES or not (model.geom_contype[g] or model.geom_conaffinity[g]):
                 continue
-            geoms.append((g, SHAPES[t], model.geom_size[g].copy(), model.geom_pos[g].copy(),
-                          model.geom_quat[g].copy()))
+            geoms.append((g, SHAPES[t], _unit(model.geom_size[g], scale),
+                          _unit(model.geom_pos[g], scale), model.geom_quat[g].copy()))
         if not geoms:
             continue
         if name not in spacing:
             raise ValueError(f"touch: body part {name!r} has no skin spacing in the touch "
                              f"spacing table (known: {sorted(spacing)})")
-        parts.append((name, int(b), float(spacing[name]), geoms))
+        parts.append((name, int(b), float(_unit([spacing[name]], scale)[0]), geoms))
     return parts
 
 
@@ -444,15 +466,20 @@ def _save(path: Path, arrays: dict) -> None:
 
 def build_skin(model: mujoco.MjModel, body_ids: Sequence[int], prefix: str,
                spacing: Mapping[str, float], density: float = 1.0,
-               exclude: Sequence[str] = (), cache: bool = True) -> Skin:
+               exclude: Sequence[str] = (), cache: bool = True, scale: float = 1.0) -> Skin:
     """The skin of one infant (its bodies ``body_ids``, names prefixed ``prefix``).
 
-    ``spacing``: published point spacing (m) per unprefixed body name; ``density`` multiplies the
-    point density (spacing / sqrt(density)); ``exclude``: body parts without skin; ``cache``:
-    read and write the disk cache (the in-process memory cache is always used).
+    ``spacing``: point spacing (m) per unprefixed body name (the body's own: the published one
+    times ``scale``); ``density`` multiplies the point density (spacing / sqrt(density));
+    ``exclude``: body parts without skin; ``cache``: read and write the disk cache (the
+    in-process memory cache is always used); ``scale``: the body's size factor (its tables'
+    ``scale``): the skin is laid out on the unit body and scaled (see the module docstring).
     """
     t0 = time.perf_counter()
-    parts = _skin_parts(model, body_ids, prefix, spacing, set(exclude))
+    scale = float(scale)
+    if not scale > 0:
+        raise ValueError(f"build_skin: scale={scale!r}; allowed: a positive size factor")
+    parts = _skin_parts(model, body_ids, prefix, spacing, set(exclude), scale)
     key = _key(parts, density)
     source = ""
     arrays = _MEMORY.get(key)
@@ -475,15 +502,20 @@ def build_skin(model: mujoco.MjModel, body_ids: Sequence[int], prefix: str,
     part_geoms = [np.array([g[0] for g in geoms], dtype=np.intp) for _, _, _, geoms in parts]
     point_geom = np.concatenate([part_geoms[k][arrays["geom_local"][arrays["point_part"] == k]]
                                  for k in range(len(parts))]) if parts else np.zeros(0, np.intp)
+    points, nbr_dist = arrays["points"], arrays["nbr_dist"]
+    if scale != 1.0:  # the unit body's skin, scaled (grid corners are in spacings: unchanged)
+        points, nbr_dist = points * scale, nbr_dist * np.float32(scale)
+        points.setflags(write=False)
+        nbr_dist.setflags(write=False)
     return Skin(
         part_names=[p[0] for p in parts],
         part_bodies=np.array([p[1] for p in parts], dtype=np.intp),
-        part_spacing=np.array([p[2] / np.sqrt(density) for p in parts]),
+        part_spacing=np.array([p[2] * scale / np.sqrt(density) for p in parts]),
         part_start=np.concatenate([[0], np.cumsum(counts)]).astype(np.intp),
         part_geoms=part_geoms,
-        points=arrays["points"], normals=arrays["normals"],
+        points=points, normals=arrays["normals"],
         point_part=arrays["point_part"].astype(np.intp), point_geom=point_geom,
-        nbr=arrays["nbr"], nbr_dist=arrays["nbr_dist"], grid=arrays["grid"],
+        nbr=arrays["nbr"], nbr_dist=nbr_dist, grid=arrays["grid"],
         grid_start=np.concatenate([[0], np.cumsum(arrays["grid_counts"])]).astype(np.intp),
         grid_lo=arrays["grid_lo"], grid_dims=arrays["grid_dims"],
         from_cache=source, build_seconds=time.perf_counter() - t0,

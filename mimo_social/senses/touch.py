@@ -143,7 +143,7 @@ class TouchSystem:
                 raise ConfigError(f"agent {world.names[i]}: touch: exclude removes every body "
                                   "part; use touch=False to turn touch off")
             self.skins.append(build_skin(m, agent.body_ids, prefix, spacing, cfg.density,
-                                         cfg.exclude, cfg.cache))
+                                         cfg.exclude, cfg.cache, world.tables[i].scale))
         self._concatenate(m)
         self.build_seconds = time.perf_counter() - t0
         self.reset(m, world.data)

@@ -82,20 +82,26 @@ class Task:
         return AgentSetup(config, position=config.position or pos,
                           facing=config.facing or facing)
 
-    # How far (m) an infant in each posture reaches forward from its hip along the floor, and
-    # its width with arms and legs: the circle is made large enough that no two infants start
-    # interpenetrating (their forward parts converge toward the centre).
+    # How far (m) an infant of scale 1 in each posture reaches forward from its hip along the
+    # floor, and its half width with arms and legs; both grow with the agent's `scale`. The
+    # circle is made large enough that no two infants start interpenetrating (their forward
+    # parts converge toward the centre).
     POSTURE_REACH = {"standing": 0.22, "sitting": 0.45, "lying": 0.48}
     HALF_WIDTH = 0.2
     CLEARANCE = 0.14
 
     def placement(self, i: int, configs: Sequence[AgentConfig] = ()) -> tuple:
-        """Agents on a circle around the origin, each facing the centre."""
+        """Agents on a circle around the origin, each facing the centre.
+
+        The radius leaves room for the largest agent's reach and half width (both times its
+        ``scale``)."""
         if self.n_agents == 1:
             return (0.0, 0.0), (1.0, 0.0)
-        reach = max((self.POSTURE_REACH[c.posture] for c in configs), default=0.22)
+        reach = max((self.POSTURE_REACH[c.posture] * c.scale for c in configs),
+                    default=self.POSTURE_REACH["standing"])
+        half = max((self.HALF_WIDTH * c.scale for c in configs), default=self.HALF_WIDTH)
         sin = np.sin(np.pi / self.n_agents)
-        radius = max(0.3, reach + self.CLEARANCE / sin, self.HALF_WIDTH / sin)
+        radius = max(0.3, reach + self.CLEARANCE / sin, half / sin)
         angle = np.pi + 2 * np.pi * i / self.n_agents
         pos = (radius * np.cos(angle), radius * np.sin(angle))
         return (float(pos[0]), float(pos[1])), (0.0, 0.0)
