@@ -2,6 +2,9 @@
 :class:`ScriptedPartners`, the ParallelEnv wrapper that leaves only the learners."""
 
 from .base import Partner, Still, zero_action
+from .expression import ExpressionShow
+from .gaze import GazeAtTarget
 from .wrapper import ScriptedPartners
 
-__all__ = ["Partner", "Still", "zero_action", "ScriptedPartners"]
+__all__ = ["Partner", "Still", "zero_action", "ScriptedPartners", "ExpressionShow",
+           "GazeAtTarget"]

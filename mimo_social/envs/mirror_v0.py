@@ -1,0 +1,31 @@
+"""`mirror_v0`: facial mimicry as a PettingZoo env (see :mod:`.tasks.mirror` for the table).
+
+``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns
+a :class:`~mimo_social.envs.parallel.MimoParallelEnv` with two learners (both see, both are
+rewarded for matching); ``env(...)`` the AEC version; ``scripted_env(partner=None, **kwargs)``
+a one-learner env (``infant_0`` learns) whose partner ``infant_1`` is driven by a scripted
+:class:`~mimo_social.partners.Partner`, by default
+:class:`~mimo_social.partners.expression.ExpressionShow` (the task option ``scripted_partner``
+is set: the partner has no eyes and no reward).
+"""
+
+from ._factory import make_aec, make_parallel
+from .tasks.mirror import Mirror
+
+__all__ = ["parallel_env", "env", "scripted_env", "Mirror"]
+
+
+def parallel_env(**kwargs):
+    return make_parallel(Mirror, **kwargs)
+
+
+def env(**kwargs):
+    return make_aec(Mirror, **kwargs)
+
+
+def scripted_env(partner=None, **kwargs):
+    from ..partners import ScriptedPartners
+    from ..partners.expression import ExpressionShow
+    options = {"scripted_partner": True, **(kwargs.pop("task_options", None) or {})}
+    return ScriptedPartners(parallel_env(task_options=options, **kwargs),
+                            {"infant_1": partner or ExpressionShow()})

@@ -1,0 +1,220 @@
+"""``GazeAtTarget``: a scripted partner that turns its head and eyes to one target after another.
+
+Every ``hold_s`` seconds (a time drawn uniformly from the range) it picks another target at
+random (never the same twice in a row) and turns to it with its own motors: a PD law with
+compensation of gravity, springs and any force the task applies drives its head (swivel, tilt; sideways tilt to 0) and eye
+joints (horizontal, vertical; torsion to 0) from their current angles to the angles that look at
+the target. Those angles come from the same geometry as :class:`~mimo_social.envs.tasks.base.Gaze`
+(the head turns, swivel then tilt, to face the target from the neck; each eye then turns,
+horizontal then vertical, to look at it from its own centre), computed on a private copy of the
+state: the partner never writes the world's ``qpos``, so its head turn is physical (it takes
+about 0.3 s) and visible to whoever watches it.
+
+Targets: by default the task's toys (``env.task.toy_bodies``, a list of body ids), else a list
+of body or site names of the world. ``target`` is the index of the current one. The agent needs
+the spring-damper actuation (the PD law computes torques) and motors on its head and eye joints.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import mujoco
+import numpy as np
+from gymnasium import spaces
+
+from .base import Partner
+from .expression import hold_range
+
+__all__ = ["GazeAtTarget", "look_angles"]
+
+HEAD = ("head_swivel", "head_tilt", "head_tilt_side")
+EYES = (("right", -1.0), ("left", 1.0))
+NEEDED = ("head_swivel", "head_tilt", "right_eye_horizontal", "right_eye_vertical",
+          "left_eye_horizontal", "left_eye_vertical")
+
+
+class _LookGeometry:
+    """The joint angles that point one agent's head and eyes at a world point (Gaze's geometry).
+
+    ``joints``: the agent's joint indices (into ``joint_names``) of the head and eye joints it
+    has; ``__call__`` returns their target angles (rad, within range) in that order, computed on
+    ``scratch`` (a private ``MjData``) from the state in ``data``.
+    """
+
+    def __init__(self, world, i: int):
+        m = world.model
+        a = world.agents[i]
+        names = list(a.joint_names)
+        self.joints = np.array([names.index(n) for n in HEAD + tuple(
+            f"{s}_eye_{k}" for s, _ in EYES for k in ("horizontal", "vertical", "torsional"))
+            if n in names], dtype=np.intp)
+        self.qpos = a.qpos_adr[self.joints]
+        self.lo, self.hi = a.joint_range[self.joints, 0], a.joint_range[self.joints, 1]
+        slot = {names[k]: n for n, k in enumerate(self.joints)}
+        self.swivel, self.tilt = slot.get("head_swivel"), slot.get("head_tilt")
+        self.head_body = int(m.site_bodyid[a.head_site])
+        self.eyes = [(int(m.cam_bodyid[cam]), sign, slot.get(f"{side}_eye_horizontal"),
+                      slot.get(f"{side}_eye_vertical"))
+                     for (side, sign), cam in zip(EYES, (a.eye_cameras[0], a.eye_cameras[1]))]
+
+    def __call__(self, model, data, scratch, kind: str, obj: int) -> np.ndarray:
+        s = scratch
+        s.qpos[:] = data.qpos
+        s.qpos[self.qpos] = 0.0
+        mujoco.mj_kinematics(model, s)
+        target = (s.xpos if kind == "body" else s.site_xpos)[obj].copy()
+        q = np.zeros(len(self.joints))
+        hb = self.head_body
+        if self.swivel is not None:
+            v = s.xmat[hb].reshape(3, 3).T @ (target - s.xpos[hb])
+            q[self.swivel] = np.arctan2(v[1], v[0])
+            if self.tilt is not None:
+                q[self.tilt] = -np.arctan2(v[2], np.hypot(v[0], v[1]))
+            np.clip(q, self.lo, self.hi, out=q)
+            s.qpos[self.qpos] = q
+            mujoco.mj_kinematics(model, s)
+        R = s.xmat[hb].reshape(3, 3)
+        for body, sign, horizontal, vertical in self.eyes:
+            v = R.T @ (target - s.xpos[body])
+            if horizontal is not None:
+                q[horizontal] = sign * np.arctan2(v[1], v[0])
+            if vertical is not None:
+                q[vertical] = np.arctan2(v[2], np.hypot(v[0], v[1]))
+        return np.clip(q, self.lo, self.hi)
+
+
+def look_angles(env, agent: str, kind: str, obj: int) -> dict[str, float]:
+    """Head and eye angles (rad) that make ``agent`` look at body/site ``obj``, by joint name
+    (a convenience for inspection; :class:`GazeAtTarget` keeps its geometry between steps)."""
+    i = env.possible_agents.index(agent)
+    geo = _LookGeometry(env.world, i)
+    scratch = mujoco.MjData(env.world.model)
+    q = geo(env.world.model, env.world.data, scratch, kind, obj)
+    names = env.world.agents[i].joint_names
+    return {names[k]: float(v) for k, v in zip(geo.joints, q)}
+
+
+class GazeAtTarget(Partner):
+    """Looks at one target after another (see the module docstring).
+
+    ``targets``: ``None`` (the task's toys, ``env.task.toy_bodies``) or a list of body/site
+    names; ``hold_s``: ``(min, max)`` seconds on each target; ``omega`` (rad/s) and ``zeta``:
+    the PD law's natural frequency and damping ratio (per joint, scaled by its inertia).
+    """
+
+    def __init__(self, targets: Sequence[str] | None = None, hold_s=(1.5, 3.0),
+                 omega: float = 15.0, zeta: float = 1.0):
+        self.hold_s = hold_range(hold_s, "GazeAtTarget")
+        if targets is not None:
+            if isinstance(targets, str) or not isinstance(targets, Sequence) or not targets \
+                    or not all(isinstance(t, str) for t in targets):
+                raise ValueError(f"GazeAtTarget: targets={targets!r}; expected None (the task's "
+                                 "toys) or a non-empty list of body or site names")
+        self.targets = None if targets is None else tuple(targets)
+        for key, v in (("omega", omega), ("zeta", zeta)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v < 1e3:
+                raise ValueError(f"GazeAtTarget: {key}={v!r}; allowed: a number in (0, 1000)")
+        self.omega, self.zeta = float(omega), float(zeta)
+        self.target: int | None = None
+        self._left = 0
+
+    # -- set up ------------------------------------------------------------------------------
+    def _resolve_targets(self, env) -> list[tuple[str, int]]:
+        m = env.world.model
+        if self.targets is None:
+            toys = getattr(env.task, "toy_bodies", None)
+            if toys is None or not len(toys):
+                raise ValueError(f"GazeAtTarget: the task {env.task.name!r} has no toys "
+                                 "(task.toy_bodies); pass targets=[body or site names]")
+            return [("body", int(b)) for b in toys]
+        out = []
+        for name in self.targets:
+            for kind, table in (("body", mujoco.mjtObj.mjOBJ_BODY),
+                                ("site", mujoco.mjtObj.mjOBJ_SITE)):
+                k = mujoco.mj_name2id(m, table, name)
+                if k >= 0:
+                    out.append((kind, k))
+                    break
+            else:
+                raise ValueError(f"GazeAtTarget: target {name!r} is neither a body nor a site of "
+                                 "the world (prefix an agent's parts with its name, e.g. "
+                                 "'infant_0/head')")
+        return out
+
+    def reset(self, env, agent, rng):
+        super().reset(env, agent, rng)
+        i = env.possible_agents.index(agent)
+        cfg = env.agent_configs[i]
+        if cfg.actuation != "spring_damper":
+            raise ValueError(f"GazeAtTarget drives torque motors: {agent} has actuation="
+                             f"{cfg.actuation!r}; allowed: 'spring_damper'")
+        a = env.world.agents[i]
+        missing = [n for n in NEEDED if n not in a.actuated_names]
+        if missing:
+            raise ValueError(f"GazeAtTarget: {agent} has no motor on {missing}; it turns its head "
+                             "and eyes with its own motors (the task must leave them actuated)")
+        self._found = self._resolve_targets(env)
+        self._geo = _LookGeometry(env.world, i)
+        self._scratch = mujoco.MjData(env.world.model)
+        act = env.actuation[i]
+        names = list(a.joint_names)
+        motor_of = {n: k for k, n in enumerate(a.actuated_names)}
+        joint_names = [names[k] for k in self._geo.joints]
+        keep = [n for n, j in enumerate(joint_names) if j in motor_of]
+        self._pick = np.array(keep, dtype=np.intp)              # geometry slots with a motor
+        self._motors = np.array([motor_of[joint_names[n]] for n in keep], dtype=np.intp)
+        joints = self._geo.joints[self._pick]
+        self._qpos = a.qpos_adr[joints]
+        self._dof = a.dof_adr[joints]
+        m = env.world.model
+        # the diagonal of the mass matrix: the last entry of each row of MjData.M (CSR, lower)
+        self._mdiag = (m.M_rowadr[self._dof] + m.M_rownnz[self._dof] - 1).astype(np.intp)
+        self._t_pos = np.asarray(act.torque_pos, float)[self._motors]
+        self._t_neg = np.asarray(act.torque_neg, float)[self._motors]
+        self._n_motors = act.n_controls
+        space = env.action_space(agent)
+        self._dict = isinstance(space, spaces.Dict)
+        self._dt = float(env.dt)
+        self.target = int(rng.integers(len(self._found)))
+        self._left = self._hold_steps()
+
+    def _hold_steps(self) -> int:
+        return max(1, int(round(self.rng.uniform(*self.hold_s) / self._dt)))
+
+    # -- acting ------------------------------------------------------------------------------
+    def desired_angles(self, env) -> np.ndarray:
+        """Angles (rad) of the head and eye joints with motors that look at the current target."""
+        kind, obj = self._found[self.target]
+        w = env.world
+        if self.__dict__.get("_scratch") is None:   # dropped when pickled
+            self._scratch = mujoco.MjData(w.model)
+        q = self._geo(w.model, w.data, self._scratch, kind, obj)
+        return q[self._pick]
+
+    def act(self, env, agent, observation):
+        if self.target is None:
+            raise RuntimeError("GazeAtTarget.act() before reset(); reset the env first")
+        if self._left <= 0 and len(self._found) > 1:
+            others = [k for k in range(len(self._found)) if k != self.target]
+            self.target = int(self.rng.choice(others))
+            self._left = self._hold_steps()
+        self._left -= 1
+        d = env.world.data
+        err = self.desired_angles(env) - d.qpos[self._qpos]
+        vel = d.qvel[self._dof]
+        inertia = d.M[self._mdiag]
+        w, z = self.omega, self.zeta
+        torque = (inertia * (w * w * err - 2.0 * z * w * vel)
+                  + d.qfrc_bias[self._dof] - d.qfrc_passive[self._dof] - d.qfrc_applied[self._dof])
+        u = np.zeros(self._n_motors, np.float32)
+        u[self._motors] = np.clip(torque / np.where(torque >= 0, self._t_pos, self._t_neg), -1, 1)
+        return {"motors": u, "expression": np.int64(0)} if self._dict else u
+
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state.pop("_scratch", None)   # MjData is rebuilt at the next reset
+        return state
+
+    def __repr__(self) -> str:
+        return f"GazeAtTarget(targets={self.targets}, hold_s={self.hold_s})"
