@@ -4,7 +4,8 @@
 from .base import Partner, Still, zero_action
 from .expression import ExpressionShow
 from .gaze import GazeAtTarget
+from .hand_offer import HandOffer
 from .wrapper import ScriptedPartners
 
 __all__ = ["Partner", "Still", "zero_action", "ScriptedPartners", "ExpressionShow",
-           "GazeAtTarget"]
+           "GazeAtTarget", "HandOffer"]

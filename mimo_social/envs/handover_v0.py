@@ -1,0 +1,30 @@
+"""`handover_v0`: the handover task as a PettingZoo env (see :mod:`.tasks.handover` for the table).
+
+``parallel_env(n_agents=2, task_options={...}, physics={...}, per_agent=[...], **agent_settings)``
+returns a :class:`~mimo_social.envs.parallel.MimoParallelEnv`; ``env(...)`` the AEC version;
+``scripted_env(partner=None, **kwargs)`` a one-learner env: the receiver ``infant_0`` learns and
+the giver ``infant_1`` is a scripted :class:`~mimo_social.partners.hand_offer.HandOffer` (its
+offer target follows the ``offer_target`` task option) unless another partner is given.
+"""
+
+from ._factory import make_aec, make_parallel
+from .tasks.handover import OFFER_TARGET, Handover
+
+__all__ = ["parallel_env", "env", "scripted_env", "Handover"]
+
+
+def parallel_env(**kwargs):
+    return make_parallel(Handover, **kwargs)
+
+
+def env(**kwargs):
+    return make_aec(Handover, **kwargs)
+
+
+def scripted_env(partner=None, **kwargs):
+    from ..partners import ScriptedPartners
+    from ..partners.hand_offer import HandOffer
+    if partner is None:
+        target = (kwargs.get("task_options") or {}).get("offer_target", OFFER_TARGET)
+        partner = HandOffer(target=target, grip=True, release="on_touch")
+    return ScriptedPartners(parallel_env(**kwargs), {"infant_1": partner})

@@ -1,0 +1,354 @@
+"""``HandOffer``: a scripted partner that holds its right hand out to the other infant.
+
+The partner drives its right arm, through its own motors only, from wherever it is to an *offer
+posture* in front of its body and holds it there; with ``grip=True`` it keeps its fingers closed
+(on a ball it holds, for a handover) and, with ``release="on_touch"``, opens them once another
+infant's hand touches the held object (optionally ``release_delay`` seconds later). A high-five
+partner uses ``HandOffer(grip=False)``: hand out, fingers open, nothing to release.
+
+| | |
+|---|---|
+| target | ``posture`` (joint -> degrees; default :data:`OFFER_POSTURE_DEG`: upper arm forward, elbow half bent, palm up) or, with ``target=(forward, left, up)`` (m, from the right shoulder in the infant's heading frame), the posture whose palm centre reaches that point; the wrist is then solved for ``palm``: ``"up"`` (default: the palm faces up, leaning 0.15 toward the thumb and 0.1 toward the fingers, a pocket a ball rests in), ``"forward"`` (facing ahead as far as the wrist's range allows, about 25 deg off at the default posture; for a high five) or ``"posture"`` (the posture's wrist angles); see :func:`offer_posture` (damped least squares, solved once per reset on a scratch copy of the state) |
+| arm | PD control per joint toward the target angles, gains from the joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio ``damping`` 1), plus gravity / Coriolis and passive-spring compensation read from MuJoCo (``qfrc_bias``, ``qfrc_spring``); the torque becomes the agent's controls: spring-damper motors ``u = tau / T_max`` (clipped to [-1, 1]); muscles: the agonist's activation giving ``tau`` at the current length on top of the passive muscle forces (isometric curve, clipped to [0, 1], antagonist off) |
+| fingers | closed (``grip`` and not released): a constant flexing command ``grip_strength`` (0.03 of the motor's strength or of full activation) on the four fingers' flexors (mcp, pip, dip, the little finger's cup; mitten: the one finger joint), ``thumb_strength`` (0: the thumb held at rest by the PD) on the thumb's; spread and pivot held by the PD. Open: PD toward straight fingers, the thumb at its rest angles. A gentle grip holds a ball lying in the palm; a strong one squeezes it out (measured: 0.3 and above lose a 3 cm ball within 6 s) |
+| release | ``None`` (never: the fingers stay as ``grip`` says) or ``"on_touch"``: open once a geom of another agent's hand (either hand) touches the object ``prop`` (a contact with dist <= 0), ``release_delay`` s later; with ``pour`` > 0 the wrist then also tips the palm over the fingertips (slope ``pour``) so the object rolls toward the partner |
+| state | ``released`` (bool), ``touched_at`` (env time of the first touch or ``None``), ``target_angles`` (rad, per motor: arm targets, open-finger targets), ``target_position`` (world, the palm centre of the holding posture) |
+
+Both hand versions and both actuation models are supported (tests: the palm within 3 cm of the
+target after 1 s from the hanging arm, within 2 cm after 1.5 s, for all four combinations). The
+muscles are driven from their isometric torque curve (the force-velocity factor is left out),
+which the PD loop absorbs; the tracking error is the same order as with spring-damper motors.
+
+Developmental note: holding out an object, and opening the hand when the other's hand closes on
+it, is the giver's half of the give-and-take games that 12-18-month-olds play with caregivers;
+the partner offers a stable, predictable target, as a caregiver does.
+"""
+
+from __future__ import annotations
+
+from typing import Mapping
+
+import mujoco
+import numpy as np
+
+from .base import Partner, zero_action
+
+__all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]
+
+# The right arm forward, the hand in front of the chest, elbow half bent, palm up (degrees): the
+# palm centre ~16 cm ahead of the right shoulder, 6 cm toward the midline, 10 cm lower.
+OFFER_POSTURE_DEG = {"right_shoulder_horizontal": 101.0, "right_shoulder_abduction": 15.0,
+                     "right_shoulder_rotation": -91.0, "right_elbow": -52.0,
+                     "right_wrist_rotation": -75.6, "right_wrist_flexion": -6.2,
+                     "right_wrist_ulnar": 9.3}
+# Open fingers: straight (0 deg) except the thumb at its rest angles; mitten: straight.
+OPEN_FINGERS_DEG = {"right_thumb_swivel": 40.0, "right_thumb_adduction": -35.0,
+                    "right_fingers": 0.0}
+SHOULDER_ELBOW = ("right_shoulder_horizontal", "right_shoulder_abduction",
+                  "right_shoulder_rotation", "right_elbow")
+ARM = SHOULDER_ELBOW + ("right_wrist_rotation", "right_wrist_flexion", "right_wrist_ulnar")
+RELEASES = (None, "on_touch")
+PALMS = ("up", "forward", "posture")
+# mitten: the finger joint closes towards its lower limit (-160 deg)
+MITTEN_CLOSE_SIGN = -1.0
+
+
+def finger_flexors(names) -> np.ndarray:
+    """Closing direction (+1 / -1) of each joint in ``names`` that flexes a right finger, 0 for
+    the others (arm joints, finger spread and thumb pivot)."""
+    out = np.zeros(len(names))
+    for k, n in enumerate(names):
+        if n == "right_fingers":
+            out[k] = MITTEN_CLOSE_SIGN
+        elif n.startswith("right_") and n.split("_")[1] in ("index", "middle", "ring", "little",
+                                                            "thumb"):
+            if n.split("_")[-1] not in ("spread", "pivot"):
+                out[k] = 1.0
+    return out
+
+
+def _number(name, value, lo, hi):
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(value) or not lo <= value <= hi:
+        raise ValueError(f"HandOffer: {name}={value!r}; allowed: a number in [{lo}, {hi}]")
+    return float(value)
+
+
+def _palm_at(w, a, qadr, q) -> np.ndarray:
+    """World position of agent ``a``'s right palm centre with joints ``qadr`` at ``q``."""
+    d = mujoco.MjData(w.model)
+    d.qpos[:] = w.data.qpos
+    d.qpos[qadr] = q
+    mujoco.mj_kinematics(w.model, d)
+    return d.site_xpos[a.palm_sites[0]].copy()
+
+
+def offer_posture(world, i: int, posture_deg: Mapping[str, float] | None = None,
+                  target=None, palm: str = "up",
+                  palm_tilt: tuple[float, float] = (0.15, -0.1)) -> dict[str, float]:
+    """The right arm's offer posture of agent ``i`` (joint -> rad, clipped to the ranges).
+
+    Starts from ``posture_deg`` (merged over :data:`OFFER_POSTURE_DEG`). With ``target =
+    (forward, left, up)`` (m, from the right shoulder in the infant's heading frame), the
+    shoulder and elbow are solved so the palm centre reaches the target. ``palm``: ``"up"``:
+    the wrist's 3 joints are solved so the palm faces up, leaning by ``palm_tilt`` (slopes:
+    toward the thumb, toward the wrist; the default leans toward the thumb and the fingers, so a
+    ball lying in the palm settles against them); ``"forward"``: the palm faces straight ahead
+    (the infant's heading, e.g. for a high five); ``"posture"``: the wrist keeps the posture's
+    angles. Damped least squares on a scratch copy of the state, alternating position and
+    orientation a few rounds."""
+    if palm not in PALMS:
+        raise ValueError(f"offer_posture: palm={palm!r}; allowed: {list(PALMS)}")
+    m = world.model
+    a = world.agents[i]
+    posture = {**OFFER_POSTURE_DEG, **(posture_deg or {})}
+    k = [a.joint_names.index(n) for n in ARM]
+    lo, hi = a.joint_range[k, 0], a.joint_range[k, 1]
+    q = np.clip(np.deg2rad([posture[n] for n in ARM]), lo, hi)
+    if target is None and palm == "posture":
+        return {name: float(v) for name, v in zip(ARM, q)}
+    d = mujoco.MjData(m)
+    d.qpos[:] = world.data.qpos
+    qadr, dadr = a.qpos_adr[k], a.dof_adr[k]
+    d.qpos[qadr] = q
+    mujoco.mj_kinematics(m, d)
+    site = int(a.palm_sites[0])
+    hand = int(m.site_bodyid[site])
+    n = len(SHOULDER_ELBOW)
+    arm, wrist = slice(0, n), slice(n, len(ARM))
+    goal = None
+    R = d.xmat[a.root_body].reshape(3, 3)
+    heading = np.arctan2(R[1, 0], R[0, 0])
+    c, s = np.cos(heading), np.sin(heading)
+    if target is not None:
+        shoulder = int(m.jnt_bodyid[m.dof_jntid[dadr[0]]])
+        f, left, up = target
+        goal = d.xpos[shoulder] + np.array([c * f - s * left, s * f + c * left, up])
+    jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+
+    def dls(J, err, part):
+        step = J.T @ np.linalg.solve(J @ J.T + 1e-4 * np.eye(3), err)
+        d.qpos[qadr[part]] = np.clip(d.qpos[qadr[part]] + np.clip(step, -0.2, 0.2),
+                                     lo[part], hi[part])
+
+    for _ in range(4):
+        for _ in range(60 if goal is not None else 0):
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            err = goal - d.site_xpos[site]
+            if np.linalg.norm(err) < 1e-4:
+                break
+            mujoco.mj_jacSite(m, d, jp, None, site)
+            dls(jp[:, dadr[arm]], err, arm)
+        for _ in range(60 if palm != "posture" else 0):
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            Rh = d.xmat[hand].reshape(3, 3)
+            normal = -Rh[:, 1]  # the right palm faces the hand's -y
+            if palm == "up":
+                want = np.array([0.0, 0.0, 1.0]) + palm_tilt[0] * Rh[:, 0] \
+                    - palm_tilt[1] * Rh[:, 2]
+                want[2] = 1.0
+            else:
+                want = np.array([c, s, 0.0])
+            err = np.cross(normal, want / np.linalg.norm(want))
+            if np.linalg.norm(err) < 1e-4:
+                break
+            mujoco.mj_jacBody(m, d, None, jr, hand)
+            dls(jr[:, dadr[wrist]], err, wrist)
+    q = d.qpos[qadr].copy()
+    return {name: float(v) for name, v in zip(ARM, q)}
+
+
+class HandOffer(Partner):
+    """Bring the right hand to an offer position and hold it there (see the module table).
+
+    ``posture``: arm joint angles in degrees (merged over :data:`OFFER_POSTURE_DEG`);
+    ``target``: ``(forward, left, up)`` metres from the right shoulder (heading frame) for the
+    palm centre, or ``None`` to use the posture as it is; ``grip``: close the fingers (hold an
+    object) until released; ``release``: ``None`` or ``"on_touch"``; ``release_delay``: seconds
+    between the touch and the opening; ``prop``: the held object's prop name; ``frequency`` (Hz)
+    and ``damping`` (ratio): the PD loop; ``grip_strength`` / ``thumb_strength``: the
+    fingers' / thumb's flexing command in [0, 1]; ``pour``: after the release, tip the palm over
+    the fingertips with this slope (0: keep it level); ``palm``: ``"up"`` (hold an object),
+    ``"forward"`` (facing the partner, e.g. for a high five) or ``"posture"`` (the wrist angles
+    of ``posture``), see :func:`offer_posture`.
+    """
+
+    def __init__(self, posture: Mapping[str, float] | None = None, target=None,
+                 grip: bool = True, release: str | None = "on_touch",
+                 release_delay: float = 0.0, prop: str = "ball", frequency: float = 3.0,
+                 damping: float = 1.0, grip_strength: float = 0.03, thumb_strength: float = 0.0,
+                 pour: float = 0.0, palm: str = "up"):
+        if posture is not None:
+            if not isinstance(posture, Mapping):
+                raise ValueError(f"HandOffer: posture={posture!r}; allowed: a mapping of right "
+                                 f"arm joints {list(ARM)} to degrees")
+            bad = sorted(set(posture) - set(ARM))
+            if bad:
+                raise ValueError(f"HandOffer: posture joints {bad} unknown; allowed: {list(ARM)}")
+            for k, v in posture.items():
+                _number(f"posture[{k!r}]", v, -360.0, 360.0)
+        if target is not None:
+            t = np.asarray(target, dtype=float) if not isinstance(target, str) else None
+            if t is None or t.shape != (3,) or not np.isfinite(t).all() \
+                    or np.linalg.norm(t) > 0.5:
+                raise ValueError(f"HandOffer: target={target!r}; allowed: None or (forward, "
+                                 "left, up) in metres from the right shoulder, within 0.5 m")
+            target = tuple(float(x) for x in t)
+        if not isinstance(grip, bool):
+            raise ValueError(f"HandOffer: grip={grip!r}; allowed: True or False")
+        if release not in RELEASES:
+            raise ValueError(f"HandOffer: release={release!r}; allowed: {list(RELEASES)}")
+        if not isinstance(prop, str) or not prop:
+            raise ValueError(f"HandOffer: prop={prop!r}; allowed: the name of a prop of the env")
+        self.posture_deg = {**OFFER_POSTURE_DEG, **(posture or {})}
+        self.target = target
+        self.grip = grip
+        self.release = release
+        self.release_delay = _number("release_delay", release_delay, 0.0, 60.0)
+        self.prop = prop
+        self.frequency = _number("frequency", frequency, 0.1, 20.0)
+        self.damping = _number("damping", damping, 0.1, 5.0)
+        self.grip_strength = _number("grip_strength", grip_strength, 0.0, 1.0)
+        self.thumb_strength = _number("thumb_strength", thumb_strength, 0.0, 1.0)
+        self.pour = _number("pour", pour, 0.0, 3.0)
+        if palm not in PALMS:
+            raise ValueError(f"HandOffer: palm={palm!r}; allowed: {list(PALMS)}")
+        if pour > 0 and palm != "up":
+            raise ValueError(f"HandOffer: pour={pour} needs palm='up' (it tips an upturned "
+                             f"palm), got palm={palm!r}")
+        self.palm = palm
+
+    def __repr__(self):
+        return (f"HandOffer(target={self.target}, grip={self.grip}, release={self.release!r}, "
+                f"release_delay={self.release_delay})")
+
+    # -- reset: index tables, the target posture, the gains ------------------------------------
+    def reset(self, env, agent, rng):
+        super().reset(env, agent, rng)
+        w = env.world
+        m, d = w.model, w.data
+        i = env.possible_agents.index(agent)
+        a = w.agents[i]
+        self._i = i
+        names = list(a.actuated_names)
+        missing = [n for n in ARM if n not in names]
+        if missing:
+            raise ValueError(f"HandOffer: {agent} does not actuate {missing}; it needs the "
+                             "right arm's motors (shoulder, elbow, wrist) in its action")
+        jk = a.actuated_joint_idx
+        self._qadr = a.qpos_adr[jk]
+        self._dadr = a.dof_adr[jk]
+        lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]
+        self._act = env.actuation[i]
+        self._muscle = self._act.name == "muscle"
+        self._flex = finger_flexors(names)
+        thumb = np.array(["thumb" in n for n in names])
+        self._strength = np.where(thumb, self.thumb_strength, self.grip_strength)
+        self._gripping = (self._flex != 0) & (self._strength > 0)
+        self._is_finger = np.array([n not in ARM for n in names])
+        arm = offer_posture(w, i, self.posture_deg, self.target, self.palm)
+        open_deg = np.array([OPEN_FINGERS_DEG.get(n, 0.0) for n in names])
+        q_target = np.array([arm.get(n, np.deg2rad(open_deg[k])) for k, n in enumerate(names)])
+        self.target_angles = self._hold_angles = np.clip(q_target, lo, hi)
+        self.target_position = _palm_at(w, a, self._qadr, self.target_angles)
+        self._pour_angles = self._hold_angles
+        if self.pour > 0:
+            poured = offer_posture(w, i, self.posture_deg, self.target, "up",
+                                   palm_tilt=(0.0, -self.pour))
+            self._pour_angles = np.clip([poured.get(n, q_target[k]) for k, n in enumerate(names)],
+                                        lo, hi)
+        # PD gains from each joint's own inertia (the diagonal of the joint-space mass matrix)
+        M = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, M)
+        inertia = np.diag(M)[self._dadr]
+        omega = 2 * np.pi * self.frequency
+        self._kp = inertia * omega ** 2
+        self._kd = inertia * 2 * self.damping * omega
+        if not self._muscle:
+            self._tneg, self._tpos = self._act.torque_neg, self._act.torque_pos
+        # who may take the object: the hands of every other agent
+        self._object_geom = -1
+        if self.release == "on_touch":
+            if self.prop not in w.prop_bodies:
+                raise ValueError(f"HandOffer: prop {self.prop!r} is not in this env; props: "
+                                 f"{sorted(w.prop_bodies)}")
+            from ..envs.tasks.base import hand_geoms
+            self._object_geom = int(np.flatnonzero(m.geom_bodyid == w.prop_bodies[self.prop])[0])
+            self._others = np.zeros(m.ngeom, bool)
+            for j in range(len(w.agents)):
+                if j != i:
+                    self._others[hand_geoms(w, j, 0)] = True
+                    self._others[hand_geoms(w, j, 1)] = True
+        self._delay_steps = int(round(self.release_delay / env.dt))
+        self.released = False
+        self.touched_at = None
+        self._since_touch = -1
+
+    # -- acting --------------------------------------------------------------------------------
+    def _touched(self, d) -> bool:
+        n = d.ncon
+        if n == 0:
+            return False
+        c = d.contact
+        g1, g2 = c.geom1[:n], c.geom2[:n]
+        ob = self._object_geom
+        hit = ((g1 == ob) & self._others[g2]) | ((g2 == ob) & self._others[g1])
+        return bool(np.any(hit & (c.dist[:n] <= 0.0)))
+
+    def _update_release(self, env):
+        if self.release != "on_touch" or self.released:
+            return
+        if self._since_touch < 0 and self._touched(env.world.data):
+            self._since_touch = 0
+            self.touched_at = float(env.world.data.time)
+        if self._since_touch >= 0:
+            if self._since_touch >= self._delay_steps:
+                self.released = True
+                self.target_angles = self._pour_angles
+            self._since_touch += 1
+
+    @property
+    def closing(self) -> bool:
+        """Whether the fingers are being closed now (``grip`` and not yet released)."""
+        return self.grip and not self.released
+
+    def torques(self, env) -> np.ndarray:
+        """The joint torques the partner wants now (PD + compensation), one per motor."""
+        d = env.world.data
+        q = d.qpos[self._qadr]
+        qd = d.qvel[self._dadr]
+        tau = self._kp * (self.target_angles - q) - self._kd * qd
+        tau += d.qfrc_bias[self._dadr] - d.qfrc_spring[self._dadr]
+        return tau
+
+    def act(self, env, agent, observation):
+        self._update_release(env)
+        tau = self.torques(env)
+        closing = self.closing
+        grip = self._gripping
+        if self._muscle:
+            act = self._act
+            q = env.world.data.qpos[self._qadr]
+            n_full, p_full = act.isometric_torque(q, 1.0)
+            n_rest, p_rest = act.isometric_torque(q, 0.0)
+            need = tau - (n_rest + p_rest)
+            neg = np.clip(need / np.minimum(n_full - n_rest, -1e-9), 0.0, 1.0)
+            pos = np.clip(need / np.maximum(p_full - p_rest, 1e-9), 0.0, 1.0)
+            if closing:
+                g = self._strength
+                pos = np.where(grip & (self._flex > 0), g, pos)
+                neg = np.where(grip & (self._flex > 0), 0.0, neg)
+                neg = np.where(grip & (self._flex < 0), g, neg)
+                pos = np.where(grip & (self._flex < 0), 0.0, pos)
+            u = np.concatenate([neg, pos])
+        else:
+            u = np.clip(np.where(tau >= 0, tau / self._tpos, tau / self._tneg), -1.0, 1.0)
+            if closing:
+                u = np.where(grip, self._flex * self._strength, u)
+        action = zero_action(env.action_space(agent))
+        if isinstance(action, dict):
+            action["motors"] = u.astype(np.float32)
+            return action
+        return u.astype(np.float32)
