@@ -1037,8 +1037,9 @@ class Recorder:
             before = np.zeros(n, dtype=np.intp)
             np.cumsum(per_row[:-1], out=before[1:])
             sel = np.repeat(row_start + first - before, per_row) + np.arange(per_row.sum())
+            # (np.bincount gives integers, not floats, when no row has a point)
             total = np.bincount(np.repeat(np.arange(n), per_row), weights=normal[sel],
-                                minlength=n)
+                                minlength=n).astype(np.float64)
             # every row has a (maybe empty) list of points: an empty one clears the last points
             offsets = _offsets(per_row)
             columns += [
