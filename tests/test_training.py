@@ -17,6 +17,8 @@ torch.set_num_threads(1)
 
 PPO_KWARGS = dict(n_steps=64, batch_size=64, n_epochs=1, device="cpu", seed=0, verbose=0)
 N_EXPR = 7
+# high five: proprioception 84, touch 232 (the right hand's skin), vestibular 6
+HF_OBS = 84 + 232 + 6
 
 
 def _params(model):
@@ -41,7 +43,7 @@ def test_flatten_parallel_passes_parallel_api_test():
     for a in env.possible_agents:
         obs_space, act_space = env.observation_space(a), env.action_space(a)
         assert obs_space is env.observation_space(a) and act_space is env.action_space(a)
-        assert obs_space.shape == (84 + 6,) and obs_space.dtype == np.float32
+        assert obs_space.shape == (HF_OBS,) and obs_space.dtype == np.float32
         assert act_space.shape == (8 + N_EXPR,) and act_space.dtype == np.float32
     parallel_api_test(env, num_cycles=1000)
     env.close()
@@ -54,7 +56,8 @@ def test_flatten_parallel_observations_actions_and_passthrough():
     obs, infos = env.reset(seed=5)
     assert env.agents == env.possible_agents == raw.possible_agents
     for a in env.agents:  # keys concatenated in the Dict space's order
-        expected = np.concatenate([raw_obs[a]["proprioception"], raw_obs[a]["vestibular"]])
+        expected = np.concatenate([raw_obs[a]["proprioception"], raw_obs[a]["touch"],
+                                   raw_obs[a]["vestibular"]])
         np.testing.assert_array_equal(obs[a], expected)
         assert obs[a].dtype == np.float32 and env.observation_space(a).contains(obs[a])
     # motors then 7 logits; the argmax picks the expression
@@ -93,7 +96,7 @@ def test_flatten_parallel_pickle_round_trip():
         for act in actions:
             obs, rew, term, trunc, info = e.step(act)
         results.append((obs, rew))
-        assert all(np.isfinite(o).all() and o.shape == (90,) for o in obs.values())
+        assert all(np.isfinite(o).all() and o.shape == (HF_OBS,) for o in obs.values())
     for a in env.possible_agents:  # the copy is the same simulation
         np.testing.assert_array_equal(results[0][0][a], results[1][0][a])
         assert results[0][1][a] == results[1][1][a]
@@ -117,7 +120,7 @@ def test_ppo_learns_on_reach_single_agent():
 def test_ppo_learns_on_high_five_with_parameter_sharing():
     vec = sb3_vec_env(high_five_v0.parallel_env)
     assert vec.num_envs == 2
-    assert vec.observation_space.shape == (90,) and vec.action_space.shape == (8 + N_EXPR,)
+    assert vec.observation_space.shape == (HF_OBS,) and vec.action_space.shape == (8 + N_EXPR,)
     model = PPO("MlpPolicy", vec, **PPO_KWARGS)  # seed=0 -> vec.seed(0): crashed before the fix
     before = _params(model)
     model.learn(total_timesteps=256)
@@ -149,17 +152,17 @@ def test_vec_seed_is_used_by_the_next_reset():
 def test_vec_step_api_and_terminal_observation():
     vec = sb3_vec_env(_high_five_short, n_envs=2)
     first = vec.reset()
-    assert first.shape == (4, 90)
+    assert first.shape == (4, HF_OBS)
     assert vec.get_attr("max_steps") == [3, 3, 3, 3]
     assert vec.env_is_wrapped(object) == [False] * 4
     for t in range(3):
         out = vec.step(np.zeros((4, 8 + N_EXPR), np.float32))
         assert len(out) == 4
         obs, rewards, dones, infos = out
-        assert obs.shape == (4, 90) and rewards.shape == (4,) and dones.dtype == bool
+        assert obs.shape == (4, HF_OBS) and rewards.shape == (4,) and dones.dtype == bool
     assert dones.all()
     for info in infos:
-        assert info["terminal_observation"].shape == (90,)
+        assert info["terminal_observation"].shape == (HF_OBS,)
         assert info["TimeLimit.truncated"] is True
     np.testing.assert_array_equal(obs, first)  # auto reset (high five starts deterministically)
     vec.close()
@@ -207,3 +210,32 @@ def test_ppo_with_spawn_workers():
         assert _changed(before, _params(model))
     finally:
         vec.close()
+
+
+def test_flat_observations_scale_eye_images_to_unit_range():
+    """Learners get eye pixels in [0, 1] (raw 0-255 values saturate an MLP's first layer)."""
+    from mimo_social.envs import mirror_v0
+    from mimo_social.envs.single import SingleAgentEnv
+    env = mirror_v0.parallel_env()
+    flat = FlattenParallel(env)
+    raw, _ = env.reset(seed=0)
+    obs, _ = flat.reset(seed=0)
+    space = flat.observation_space("infant_0")
+    parts = env.observation_space("infant_0").spaces
+    start = 0
+    for key, sub in parts.items():
+        size = int(np.prod(sub.shape))
+        chunk = obs["infant_0"][start:start + size]
+        value = raw["infant_0"][key].astype(np.float32).ravel()
+        if key.startswith("eye_"):
+            assert np.allclose(chunk, value / 255)
+            assert space.low[start:start + size].min() == 0
+            assert space.high[start:start + size].max() == 1
+            assert chunk.max() > 0.2  # a real image
+        else:
+            assert np.array_equal(chunk, value), key
+        start += size
+    assert start == space.shape[0]
+    single = make_sb3_single(SingleAgentEnv(mirror_v0.scripted_env()))
+    o, _ = single.reset(seed=0)
+    assert single.observation_space.contains(o) and o.shape == space.shape

@@ -1,0 +1,41 @@
+"""`social_touch_v0`: the social touch task as a PettingZoo env (see :mod:`.tasks.social_touch`).
+
+``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns a
+:class:`~mimo_social.envs.parallel.MimoParallelEnv` with the toucher ``infant_0`` and the touched
+infant ``infant_1`` (both learners); ``env(...)`` the AEC version; ``scripted_env(partner=None,
+**kwargs)`` a one-learner env in which ``infant_0`` learns to touch and ``infant_1`` is driven by
+a scripted :class:`~mimo_social.partners.Partner` (default :class:`~mimo_social.partners.Still`:
+it sits still and feels).
+
+The toucher's skin covers its right arm by default, the touched infant's its whole body;
+``touch=...`` (all agents) or ``per_agent=[{...}, {"touch": ...}]`` change that, as long as the
+toucher's right hand and the touched infant's target parts keep their skin.
+"""
+
+from pettingzoo.utils.conversions import parallel_to_aec
+
+from .parallel import MimoParallelEnv
+from .tasks import social_touch as _task
+from .tasks.high_five import hands_of
+from .tasks.social_touch import DEFAULT_TARGETS, SocialTouch
+
+__doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
+
+__all__ = ["parallel_env", "env", "scripted_env", "SocialTouch", "DEFAULT_TARGETS"]
+
+
+def parallel_env(n_agents=None, task_options=None, **kwargs) -> MimoParallelEnv:
+    task = SocialTouch(SocialTouch.default_n_agents if n_agents is None else n_agents,
+                       **(task_options or {}))
+    task.agent_hands = hands_of(task.n_agents, kwargs)
+    return MimoParallelEnv(task, **kwargs)
+
+
+def env(**kwargs):
+    return parallel_to_aec(parallel_env(**kwargs))
+
+
+def scripted_env(partner=None, **kwargs):
+    from ..partners import ScriptedPartners, Still
+    return ScriptedPartners(parallel_env(**kwargs),
+                            {"infant_1": partner if partner is not None else Still()})

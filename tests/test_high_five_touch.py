@@ -1,0 +1,223 @@
+"""High five sensed through touch: both right hands must feel the partner on their skin."""
+
+import mujoco
+import numpy as np
+import pytest
+from pettingzoo.test import parallel_api_test, parallel_seed_test
+
+from mimo_social.envs import high_five_v0
+from mimo_social.envs.config import ConfigError
+from mimo_social.envs.tasks.high_five import hand_touch, touch_system
+from mimo_social.envs.tasks.standup import reach_sites
+from mimo_social.partners import Still
+from mimo_social.partners.hand_offer import HandOffer
+
+HAND = {"right_hand", "right_fingers"}
+CLOSE = 0.35  # m between the infants in tests that put the hands together by hand
+
+
+def _zero(env):
+    return {a: np.zeros(env.action_space(a).shape, np.float32) for a in env.agents}
+
+
+def _place_palm(env, i, target):
+    """Move agent i's right arm (joint angles, no physics) so its palm centre goes to target."""
+    w = env.world
+    m, d = w.model, w.data
+    a = w.agents[i]
+    k = a.actuated_joint_idx
+    reach_sites(m, d, a.qpos_adr[k], a.dof_adr[k], a.joint_range[k, 0], a.joint_range[k, 1],
+                a.palm_sites[0], np.asarray(target), 300)
+    mujoco.mj_forward(m, d)
+
+
+def _hands_together(env):
+    """infant_1's arm forward, its palm in front of the midpoint between the infants, then
+    infant_0's palm onto infant_1's palm (the infants stand ``CLOSE`` apart)."""
+    w = env.world
+    d = w.data
+    _place_palm(env, 1, [CLOSE / 2 + 0.02, 0.0, 0.58])
+    _place_palm(env, 0, d.site_xpos[w.agents[1].palm_sites[0]].copy())
+
+
+def test_api_and_seed():
+    parallel_api_test(high_five_v0.parallel_env(max_steps=40), num_cycles=50)
+    parallel_seed_test(lambda: high_five_v0.parallel_env(max_steps=40))
+
+
+def test_the_default_skin_covers_the_right_hand_only():
+    env = high_five_v0.parallel_env(expressions=False)
+    obs, _ = env.reset(seed=0)
+    touch = touch_system(env)
+    for a in env.possible_agents:
+        layout = touch.layout(a)
+        assert set(layout) == HAND
+        n = sum(b - a_ for a_, b in layout.values())
+        assert env.observation_space(a)["touch"].shape == (n,) == obs[a]["touch"].shape
+        assert not obs[a]["touch"].any()                       # nothing touches at the start
+    # the user can turn on more skin
+    whole = high_five_v0.parallel_env(expressions=False, touch=True)
+    assert {"hip", "head", "right_hand"} <= set(touch_system(whole).layout("infant_1"))
+
+
+def test_hands_together_are_felt_by_both_skins_and_give_the_bonus():
+    env = high_five_v0.parallel_env(expressions=False, task_options={"distance": CLOSE})
+    env.reset(seed=0)
+    _, r, term, trunc, info = env.step(_zero(env))
+    assert r["infant_0"] == pytest.approx(-info["infant_0"]["hand_distance"])
+    assert not term["infant_0"] and not info["infant_0"]["is_success"]
+    _hands_together(env)
+    obs, r, term, trunc, info = env.step(_zero(env))
+    touch = touch_system(env)
+    for me, other in (("infant_0", "infant_1"), ("infant_1", "infant_0")):
+        assert info[me]["is_success"] and info[me]["hands_touching"]
+        assert info[me]["hand_feels_partner"]
+        felt = {p: e for p, e in info[me]["touch"].items() if p in HAND}
+        assert felt and any(other in e["agents"] for e in felt.values())
+        # the force is in the agent's own observation, on its hand's skin points
+        lo = min(touch.layout(me)[p][0] for p in HAND)
+        hi = max(touch.layout(me)[p][1] for p in HAND)
+        assert obs[me]["touch"][lo:hi].sum() > 0.0
+        assert r[me] == pytest.approx(100.0 - info[me]["hand_distance"])
+        assert term[me]
+    assert env.agents == []
+
+
+def _palm_on_partners_forearm(partner_palm, **kwargs):
+    """infant_1's palm to ``partner_palm``, then infant_0's palm onto infant_1's right forearm
+    (0.3 m apart); one step with zero actions."""
+    env = high_five_v0.parallel_env(expressions=False, task_options={"distance": 0.3}, **kwargs)
+    env.reset(seed=0)
+    w = env.world
+    forearm = w.model.body("infant_1/right_lower_arm").id
+    _place_palm(env, 1, partner_palm)
+    _place_palm(env, 0, w.data.xipos[forearm].copy())
+    return env, env.step(_zero(env))
+
+
+def test_a_hand_on_the_partners_forearm_is_not_a_high_five():
+    env, (_, r, term, _, info) = _palm_on_partners_forearm([0.184, -0.043, 0.587],
+                                                           per_agent=[{}, {"touch": True}])
+    assert info["infant_0"]["hand_feels_partner"]                  # my hand feels the partner ...
+    felt = info["infant_1"]["touch"]                               # ... on its arm only
+    assert "right_lower_arm" in felt and set(felt) <= {"right_lower_arm", "right_upper_arm"}
+    assert info["infant_1"]["touch"]["right_lower_arm"]["agents"] == ["infant_0"]
+    assert not info["infant_1"]["hand_feels_partner"]              # its hand feels nothing
+    assert not info["infant_0"]["is_success"] and not info["infant_1"]["is_success"]
+    assert not term["infant_0"]
+    assert r["infant_0"] == pytest.approx(-info["infant_0"]["hand_distance"])
+
+
+def test_crossed_arms_both_hands_feel_the_partner_but_not_each_other():
+    """Each right hand lies on the other's arm: both skins feel the partner, yet the hands do
+    not meet, so it is no high five."""
+    env, (_, r, term, _, info) = _palm_on_partners_forearm([0.1, 0.0, 0.55])
+    assert info["infant_0"]["hand_feels_partner"] and info["infant_1"]["hand_feels_partner"]
+    assert not info["infant_0"]["is_success"] and not term["infant_1"]
+    assert r["infant_1"] < 0.0
+
+
+def test_without_end_on_touch_the_bonus_comes_every_touching_step():
+    env = high_five_v0.parallel_env(expressions=False, task_options={"end_on_touch": False,
+                                                                     "touch_bonus": 7.5,
+                                                                     "distance": CLOSE})
+    env.reset(seed=0)
+    _hands_together(env)
+    _, r, term, _, info = env.step(_zero(env))
+    assert info["infant_1"]["is_success"] and not term["infant_1"]
+    assert r["infant_1"] == pytest.approx(7.5 - info["infant_1"]["hand_distance"])
+    assert env.agents == ["infant_0", "infant_1"]
+
+
+def test_five_fingered_hands_get_their_own_hand_skin():
+    env = high_five_v0.parallel_env(expressions=False, per_agent=[{}, {"hands": "five_fingers"}],
+                                    max_steps=5, task_options={"distance": CLOSE})
+    obs, _ = env.reset(seed=0)
+    touch = touch_system(env)
+    assert set(touch.layout("infant_0")) == HAND
+    parts1 = set(touch.layout("infant_1"))
+    assert "right_hand" in parts1 and "right_index_distal" in parts1 and len(parts1) == 17
+    assert hand_touch("five_fingers")["exclude"] and "right_hand" not in hand_touch()["exclude"]
+    _hands_together(env)
+    _, _, term, _, info = env.step(_zero(env))
+    assert info["infant_1"]["is_success"] and term["infant_1"]
+
+
+def test_same_seed_same_touch_observations():
+    def run(seed):
+        env = high_five_v0.parallel_env(max_steps=30, task_options={"distance": 0.3})
+        env.reset(seed=seed)
+        for a in env.possible_agents:
+            env.action_space(a).seed(seed)
+        out = []
+        while env.agents:
+            obs, *_ = env.step({a: env.action_space(a).sample() for a in env.agents})
+            out.append(np.concatenate([obs[a]["touch"] for a in obs]
+                                      + [obs[a]["proprioception"] for a in obs]))
+        return np.array(out)
+    np.testing.assert_array_equal(run(3), run(3))
+
+
+def test_scripted_env_offers_a_hand():
+    env = high_five_v0.scripted_env(expressions=False, max_steps=60)
+    assert env.possible_agents == ["infant_0"]
+    assert isinstance(env.partners["infant_1"], HandOffer)
+    inner = env.unwrapped
+    obs, _ = env.reset(seed=0)
+    w = inner.world
+    start = w.data.site_xpos[w.agents[1].palm_sites[0]].copy()
+    for _ in range(60):
+        obs, r, term, trunc, info = env.step({"infant_0": np.zeros(8, np.float32)})
+        if term["infant_0"] or trunc["infant_0"]:
+            break
+    hand = w.data.site_xpos[w.agents[1].palm_sites[0]]
+    offer = env.partners["infant_1"].target_position
+    assert np.linalg.norm(hand - offer) < 0.03 < np.linalg.norm(start - offer)
+    assert "is_success" in info["infant_0"] and "infant_1" in info["infant_0"]["partner_rewards"]
+    assert set(obs["infant_0"]) == {"proprioception", "vestibular", "touch"}
+    still = high_five_v0.scripted_env(partner=Still())
+    assert isinstance(still.partners["infant_1"], Still)
+
+
+@pytest.mark.parametrize("kwargs, pattern", [
+    ({"touch": False}, r"infant_0 has touch=False.*turn touch on"),
+    ({"per_agent": [{}, {"touch": {"exclude": ["right_fingers"]}}]},
+     r"infant_1's touch excludes \['right_fingers'\]"),
+    ({"task_options": {"distance": 0.1}}, r"distance=0.1 not allowed; a number from 0.25 to 0.6"),
+    ({"task_options": {"distance": "far"}}, r"distance='far' not allowed"),
+    ({"task_options": {"end_on_touch": "yes"}}, r"end_on_touch='yes'.*True or False"),
+    ({"task_options": {"touch_bonus": float("nan")}}, r"touch_bonus=nan.*finite"),
+    ({"task_options": {"bonus": 1}}, r"unknown task option.*'touch_bonus'"),
+    ({"n_agents": 3}, r"n_agents=3.*2 to 2"),
+])
+def test_bad_options_say_what_is_allowed(kwargs, pattern):
+    with pytest.raises(ValueError, match=pattern):
+        high_five_v0.parallel_env(**kwargs)
+    with pytest.raises(ConfigError):
+        hand_touch("claws")
+
+
+def test_two_hand_offers_meeting_in_the_middle_make_a_high_five_at_the_default_distance():
+    """The task is solvable at its default distance (0.45 m) by a fixed arm posture: both
+    infants driven (through their own motors) to hold the right palm at the midpoint between
+    them, at shoulder height, feel each other's hand within half a second."""
+    env = high_five_v0.parallel_env()
+    mid = (env.task.options["distance"] / 2 + 0.02, 0.105, 0.0)   # from the right shoulder
+    partners = {a: HandOffer(grip=False, release=None, target=mid) for a in env.possible_agents}
+    env.reset(seed=0)
+    for a, p in partners.items():
+        p.reset(env, a, np.random.default_rng(0))
+    for step in range(1, 61):
+        _, r, term, _, info = env.step({a: p.act(env, a, None) for a, p in partners.items()})
+        if term["infant_0"]:
+            break
+    assert info["infant_0"]["is_success"] and info["infant_1"]["is_success"] and step <= 50
+    assert r["infant_0"] == r["infant_1"] > 99.0
+
+
+def test_the_infants_start_apart_and_feel_nothing_of_each_other():
+    env = high_five_v0.parallel_env(touch=True)
+    _, infos = env.reset(seed=0)
+    assert env.task.options["distance"] == 0.35
+    for a in env.possible_agents:
+        assert not any(e["agents"] for e in infos[a]["touch"].values())
