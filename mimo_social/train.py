@@ -1,4 +1,25 @@
-"""Train, evaluate and compare policies on the one-agent tasks: ``mimo-social train | eval | compare``.
+"""Train, evaluate and compare policies: ``mimo-social train | eval | compare``.
+
+One-agent tasks (:data:`TASKS`: reach, standup, selfbody, catch) and the multi-agent social tasks
+(:data:`MULTI_TASKS`: high_five, mirror, joint_attention, social_touch, handover; each a
+PettingZoo module ``mimo_social.envs.<task>_v0``). For a multi-agent task ``--mode`` chooses how
+it learns (details and limits in docs/training_multi.md and :mod:`mimo_social.train_multi`):
+
+* ``shared`` (default): parameter sharing, one policy for every agent through SuperSuit
+  (:func:`~mimo_social.envs.vector.sb3_vec_env`; one VecEnv slot per agent, ``--n-envs`` worlds,
+  ``--n-cpus`` worker processes); every agent needs the same observation and action space;
+* ``independent``: one policy per agent, all acting in one world at the same time (each model's
+  ``learn()`` in its own thread on a lockstep Gymnasium view of the shared ParallelEnv);
+* ``scripted``: one learner, its partner driven by the task's default scripted partner
+  (``SingleAgentEnv(module.scripted_env())``, then the one-agent path).
+
+``--steps`` counts environment steps in every mode. Multi-agent runs add per-agent columns to
+``progress.csv`` (``eval_return_mean_<agent>``, ``eval_success_rate_<agent>``; the summary
+columns average the agents), an ``agent`` column to ``episodes.csv``, one line per agent to
+``learning_curve.png``; ``independent`` saves ``model_<agent>.zip`` (and ``best_model_<agent>``,
+``checkpoints/model_<agent>_<steps>_steps.zip``). ``eval`` reloads every kind and prints
+per-agent numbers; ``compare`` plots the across-agent mean. The last evaluation and checkpoint of
+a run are made after the last update (of the model that is saved as ``model.zip``).
 
 ``mimo-social train --task reach --algo ppo --steps 200000 --seed 0 --out runs/reach_ppo``
     Stable-Baselines3 with its default hyperparameters (as in the paper: PPO with two hidden layers
@@ -17,7 +38,8 @@
       eval_success_rate, train_return_mean, train_episodes`` (the evaluation runs
       ``--eval-episodes`` deterministic episodes on a separate env, the same seeded episodes
       every time; the train columns summarise the training episodes since the last row);
-    * ``episodes.csv``: every training episode (``timesteps, return, length, success``);
+    * ``episodes.csv``: every training episode (``timesteps, return, length, success``; multi-agent
+      runs: ``timesteps, agent, return, length, success``, one row per agent and episode);
     * ``learning_curve.png``: evaluation return (mean and std) and training returns against steps,
       and the success rate where the task reports one.
 
@@ -52,11 +74,19 @@ from typing import Any, Mapping
 
 import numpy as np
 
-__all__ = ["TASKS", "ALGOS", "make_env", "train", "evaluate", "compare", "plot_compare",
-           "add_parser", "VideoUnavailable"]
+__all__ = ["TASKS", "MULTI_TASKS", "ALL_TASKS", "ALGOS", "make_env", "train", "evaluate",
+           "compare", "plot_compare", "add_parser", "read_progress", "write_progress",
+           "progress_agents", "VideoUnavailable", "TrainInputError"]
 
 TASKS = {"reach": "mimo_social/Reach-v0", "standup": "mimo_social/Standup-v0",
          "selfbody": "mimo_social/SelfBody-v0", "catch": "mimo_social/Catch-v0"}
+# multi-agent (social) tasks: task -> PettingZoo module with parallel_env and scripted_env
+MULTI_TASKS = {"high_five": "mimo_social.envs.high_five_v0",
+               "mirror": "mimo_social.envs.mirror_v0",
+               "joint_attention": "mimo_social.envs.joint_attention_v0",
+               "social_touch": "mimo_social.envs.social_touch_v0",
+               "handover": "mimo_social.envs.handover_v0"}
+ALL_TASKS = (*TASKS, *MULTI_TASKS)
 ALGOS = ("ppo", "sac")
 COLORS = {"ppo": "tab:red", "sac": "tab:blue"}
 PROGRESS_FIELDS = ("timesteps", "wall_time_s", "eval_return_mean", "eval_return_std",
@@ -67,21 +97,32 @@ class VideoUnavailable(RuntimeError):
     """No MP4 encoder on this machine."""
 
 
+class TrainInputError(ValueError):
+    """A task, mode or option that ``train`` / ``eval`` / ``compare`` cannot use (says why)."""
+
+
 def _check_task(task: str) -> str:
+    if task in MULTI_TASKS:
+        return MULTI_TASKS[task]
     if task not in TASKS:
-        raise ValueError(f"task {task!r} not allowed; allowed: {', '.join(TASKS)}")
+        raise TrainInputError(f"task {task!r} not allowed; allowed: {', '.join(ALL_TASKS)} "
+                         f"(one-agent: {', '.join(TASKS)}; multi-agent: {', '.join(MULTI_TASKS)})")
     return TASKS[task]
 
 
 def _check_algo(algo: str) -> str:
     if algo not in ALGOS:
-        raise ValueError(f"algo {algo!r} not allowed; allowed: {', '.join(ALGOS)}")
+        raise TrainInputError(f"algo {algo!r} not allowed; allowed: {', '.join(ALGOS)}")
     return algo
 
 
 def make_env(task: str, render_mode: str | None = None, **env_kwargs):
-    """The task's Gymnasium env with Box observations and actions (for SB3)."""
+    """The task's Gymnasium env with Box observations and actions (for SB3); for a multi-agent
+    task the one-learner env of its scripted mode (the partner scripted)."""
     from .envs.wrappers import make_sb3_single
+    if task in MULTI_TASKS:
+        from .train_multi import _scripted_gym, _with_render
+        return _scripted_gym(task, **_with_render(env_kwargs, render_mode))
     kwargs = dict(env_kwargs)
     if render_mode is not None:
         kwargs["render_mode"] = render_mode
@@ -163,16 +204,19 @@ def _callbacks(out: Path, eval_env, eval_every: int, eval_episodes: int, eval_se
                                             "" if success is None else int(bool(success))])
             if self.bar is not None:
                 self.bar.update(n - self.bar.n)
-            if n >= self.next_ckpt:
-                (out / "checkpoints").mkdir(exist_ok=True)
-                self.model.save(out / "checkpoints" / f"model_{n}_steps.zip")
+            if total > n >= self.next_ckpt:  # the last ones follow the last update
+                self.checkpoint(n)
                 while self.next_ckpt <= n:
                     self.next_ckpt += checkpoint_every
-            if n >= self.next_eval:
+            if total > n >= self.next_eval:
                 self.evaluate()
                 while self.next_eval <= n:
                     self.next_eval += eval_every
             return True
+
+        def checkpoint(self, n):
+            (out / "checkpoints").mkdir(exist_ok=True)
+            self.model.save(out / "checkpoints" / f"model_{n}_steps.zip")
 
         def evaluate(self):
             n = self.num_timesteps
@@ -198,9 +242,12 @@ def _callbacks(out: Path, eval_env, eval_every: int, eval_episodes: int, eval_se
                     post["success"] = f"{res['success_rate']:.0%}"
                 self.bar.set_postfix(post)
 
-        def _on_training_end(self):
-            if not self.rows or self.rows[-1]["timesteps"] != self.num_timesteps:
-                self.evaluate()
+        def _on_training_end(self):  # after the model's last update: what model.zip holds
+            if self.next_ckpt <= self.num_timesteps:
+                self.checkpoint(self.num_timesteps)
+            if self.bar is not None:
+                self.bar.update(self.num_timesteps - self.bar.n)
+            self.evaluate()
             if self.bar is not None:
                 self.bar.close()
             self.episodes_file.close()
@@ -209,27 +256,51 @@ def _callbacks(out: Path, eval_env, eval_every: int, eval_episodes: int, eval_se
 
 
 def write_progress(path: Path, rows) -> None:
+    """``progress.csv``: :data:`PROGRESS_FIELDS` then any further columns of the rows (the
+    per-agent ``eval_return_mean_<agent>`` / ``eval_success_rate_<agent>`` of multi-agent runs)."""
+    fields = list(PROGRESS_FIELDS)
+    for row in rows[:1]:
+        fields += [k for k in row if k not in fields]
     with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=PROGRESS_FIELDS)
+        w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
         for row in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
 
 
 def read_progress(path: Path) -> dict[str, np.ndarray]:
+    """Every column of a ``progress.csv`` as a float array (empty cells: NaN)."""
     with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
-    return {k: np.array([float(r[k]) if r[k] not in ("", None) else np.nan for r in rows])
-            for k in PROGRESS_FIELDS}
+        reader = csv.DictReader(f)
+        rows = list(reader)
+        fields = list(reader.fieldnames or PROGRESS_FIELDS)
+    return {k: np.array([float(r[k]) if r.get(k) not in ("", None) else np.nan for r in rows])
+            for k in fields}
+
+
+def progress_agents(p: Mapping[str, np.ndarray]) -> list[str]:
+    """The agents with per-agent columns in a progress table (none for one-agent runs)."""
+    prefix = "eval_return_mean_"
+    return [k[len(prefix):] for k in p if k.startswith(prefix)]
 
 
 def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           eval_every: int | None = None, eval_episodes: int = 5,
           checkpoint_every: int | None = None, progress: bool = True,
           env_kwargs: Mapping[str, Any] | None = None,
-          algo_kwargs: Mapping[str, Any] | None = None, verbose: int = 0) -> dict:
-    """Train one policy; returns a summary (paths, last evaluation, wall time). See the module
-    docstring for what it writes."""
+          algo_kwargs: Mapping[str, Any] | None = None, verbose: int = 0,
+          mode: str | None = None, n_envs: int = 1, n_cpus: int = 0) -> dict:
+    """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
+    time). See the module docstring for what it writes. ``mode`` (``shared``, ``independent``,
+    ``scripted``; default ``shared``), ``n_envs`` and ``n_cpus`` (shared mode: worlds and worker
+    processes) are for the multi-agent tasks (:mod:`mimo_social.train_multi`)."""
+    from .train_multi import check_mode, task_module
+    mode = check_mode(task, mode)
+    if mode is not None:
+        task_module(task)  # a clear error before anything is written
+    if mode is None and (n_envs != 1 or n_cpus != 0):
+        raise TrainInputError(f"n_envs={n_envs}, n_cpus={n_cpus}: several worlds are for the "
+                         f"multi-agent tasks in --mode shared; {task!r} trains on one env")
     import torch
     from stable_baselines3.common.monitor import Monitor
     from stable_baselines3.common.vec_env import DummyVecEnv
@@ -238,7 +309,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     cls = _algo_class(algo)
     steps, seed = int(steps), int(seed)
     if steps < 1:
-        raise ValueError(f"steps={steps}; allowed: a positive integer")
+        raise TrainInputError(f"steps={steps}; allowed: a positive integer")
     eval_every = int(eval_every) if eval_every else max(steps // 20, 1)
     checkpoint_every = int(checkpoint_every) if checkpoint_every is not None else max(steps // 5, 1)
     torch.set_num_threads(1)
@@ -248,9 +319,18 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     kwargs = dict(algo_kwargs or {})
     if algo == "sac":
         kwargs.setdefault("buffer_size", min(1_000_000, steps))
-    config = {"task": task, "env_id": TASKS[task], "algo": algo, "steps": steps, "seed": seed,
+    config = {"task": task, "env_id": _check_task(task), "algo": algo, "steps": steps,
+              "seed": seed,
               "env_kwargs": env_kwargs, "algo_kwargs": kwargs, "eval_every": eval_every,
               "eval_episodes": eval_episodes, "checkpoint_every": checkpoint_every}
+    if mode is not None:
+        from .train_multi import train_multi
+        config["algo_kwargs_given"] = sorted(algo_kwargs or {})
+        return train_multi(task, algo, steps, seed, out, mode=mode, eval_every=eval_every,
+                           eval_episodes=eval_episodes, checkpoint_every=checkpoint_every,
+                           progress=progress, env_kwargs=env_kwargs, algo_kwargs=kwargs,
+                           n_envs=int(n_envs), n_cpus=int(n_cpus), verbose=verbose,
+                           config=config)
     (out / "config.json").write_text(json.dumps(config, indent=2))
 
     venv = DummyVecEnv([lambda: Monitor(make_env(task, **env_kwargs))])
@@ -281,6 +361,9 @@ def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path
     path = Path(path) if path else run / "learning_curve.png"
     p = read_progress(run / "progress.csv")
     config = json.loads((run / "config.json").read_text()) if (run / "config.json").exists() else {}
+    agents = progress_agents(p)
+    if agents:
+        return _plot_agents(run, path, p, config, agents)
     has_success = np.isfinite(p["eval_success_rate"]).any()
     fig, axes = plt.subplots(1, 2 if has_success else 1, figsize=(11 if has_success else 6.5, 4),
                              squeeze=False)
@@ -308,6 +391,56 @@ def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path
         ax.set_ylim(-5, 105)
         ax.set_xlabel("environment steps")
         ax.set_ylabel("evaluation success rate (%)")
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> Path:
+    """Learning curve of a multi-agent run: one line per agent (return; success rate)."""
+    import matplotlib.pyplot as plt
+
+    success_keys = [f"eval_success_rate_{a}" for a in agents]
+    has_success = any(np.isfinite(p[k]).any() for k in success_keys if k in p)
+    fig, axes = plt.subplots(1, 2 if has_success else 1, figsize=(11 if has_success else 6.5, 4),
+                             squeeze=False)
+    colors = {a: f"C{i}" for i, a in enumerate(agents)}
+    # line style and marker per agent too: cooperative tasks give the agents the same numbers
+    styles = {a: (("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"))[i % 4]
+              for i, a in enumerate(agents)}
+    ax = axes[0, 0]
+    ep_path = run / "episodes.csv"
+    if ep_path.exists():
+        with open(ep_path, newline="") as f:
+            eps = list(csv.DictReader(f))
+        for a in agents:
+            xy = [(float(r["timesteps"]), float(r["return"])) for r in eps if r.get("agent") == a]
+            if xy:
+                x, y = np.array(xy).T
+                ax.plot(x, y, ".", ms=2, color=colors[a], alpha=0.25)
+    t = p["timesteps"]
+    for a in agents:
+        ls, mk = styles[a]
+        ax.plot(t, p[f"eval_return_mean_{a}"], ls=ls, marker=mk, ms=4, color=colors[a],
+                label=f"{a} (evaluation)")
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("episode return")
+    ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
+                 f"{config.get('mode', '')} (seed {config.get('seed', '?')})")
+    ax.legend(loc="best", fontsize=8)
+    ax.grid(alpha=0.3)
+    if has_success:
+        ax = axes[0, 1]
+        for a in agents:
+            ls, mk = styles[a]
+            ax.plot(t, 100 * p[f"eval_success_rate_{a}"], ls=ls, marker=mk, ms=4, color=colors[a],
+                    label=a)
+        ax.set_ylim(-5, 105)
+        ax.set_xlabel("environment steps")
+        ax.set_ylabel("evaluation success rate (%)")
+        ax.legend(loc="best", fontsize=8)
         ax.grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -361,6 +494,11 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
         raise FileNotFoundError(f"{run}/config.json not found: give a directory written by "
                                 "'mimo-social train'")
     config = json.loads((run / "config.json").read_text())
+    if config.get("mode") is not None:
+        from .train_multi import evaluate_multi
+        return evaluate_multi(run, config, episodes, model=model, seed=seed,
+                              deterministic=deterministic, record=record, video=video,
+                              frames=frames, frame_every=frame_every, env_kwargs=env_kwargs)
     path = {"final": run / "model.zip", "best": run / "best_model.zip"}.get(model, Path(model))
     if not path.exists():
         raise FileNotFoundError(f"model {path} not found (--model final, best or a .zip path)")
@@ -434,11 +572,18 @@ def _train_quiet(kwargs):
 
 def compare(task: str, algos=ALGOS, seeds: int = 3, steps: int = 50_000,
             out: str | Path = "runs/compare", *, jobs: int = 1, plot_only: bool = False,
-            **train_kwargs) -> Path:
-    """Train every algorithm with seeds 0..seeds-1 and plot them together; returns the PNG."""
+            mode: str | None = None, **train_kwargs) -> Path:
+    """Train every algorithm with seeds 0..seeds-1 and plot them together; returns the PNG.
+    Multi-agent tasks train in ``mode``; the plot shows the evaluation return and success rate
+    averaged across agents, ``compare.csv`` has the per-agent columns too."""
+    from .train_multi import check_mode, task_module
     out = Path(out)
     algos = [_check_algo(a) for a in algos]
     _check_task(task)
+    mode = check_mode(task, mode)
+    if mode is not None:
+        task_module(task)
+        train_kwargs["mode"] = mode
     runs = [dict(task=task, algo=a, steps=steps, seed=s, out=str(out / f"{a}_seed{s}"),
                  **train_kwargs) for a in algos for s in range(int(seeds))]
     if not plot_only:
@@ -477,6 +622,10 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
     fig, axes = plt.subplots(1, 2 if has_success else 1, figsize=(11 if has_success else 6.5, 4),
                              squeeze=False)
     rows = []
+    fields = ["algo", "seed", *PROGRESS_FIELDS]
+    for runs in by_algo.values():
+        for _, p in runs:
+            fields += [k for k in p if k not in fields]
     for algo, runs in sorted(by_algo.items()):
         color = COLORS.get(algo, None)
         end = min(p["timesteps"][-1] for _, p in runs)
@@ -495,8 +644,11 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
         for config, p in runs:
             for i in range(len(p["timesteps"])):
                 rows.append({"algo": algo, "seed": config["seed"],
-                             **{k: p[k][i] for k in PROGRESS_FIELDS}})
-    task = task or next(iter(by_algo.values()))[0][0]["task"]
+                             **{k: p[k][i] for k in p}})
+    first = next(iter(by_algo.values()))[0][0]
+    task = task or first["task"]
+    if first.get("mode"):
+        task = f"{task} ({first['mode']}, mean over agents)"
     axes[0, 0].set_title(f"{task}: evaluation return (mean over seeds, min-max band)")
     axes[0, 0].set_xlabel("environment steps")
     axes[0, 0].set_ylabel("episode return")
@@ -513,7 +665,7 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
     fig.savefig(png, dpi=110)
     plt.close(fig)
     with open(out / "compare.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["algo", "seed", *PROGRESS_FIELDS])
+        w = csv.DictWriter(f, fieldnames=fields)
         w.writeheader()
         for r in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
@@ -532,7 +684,12 @@ def _json_arg(text: str) -> dict:
 
 
 def _common(p):
-    p.add_argument("--task", required=True, choices=sorted(TASKS))
+    p.add_argument("--task", required=True, choices=sorted(ALL_TASKS),
+                   help=f"one-agent: {', '.join(TASKS)}; multi-agent: {', '.join(MULTI_TASKS)}")
+    p.add_argument("--mode", default=None, choices=("shared", "independent", "scripted"),
+                   help="multi-agent tasks: shared (one policy for all agents, the default), "
+                   "independent (one policy per agent) or scripted (one learner, the partner "
+                   "scripted)")
     p.add_argument("--steps", type=int, required=True, help="environment steps to train for")
     p.add_argument("--eval-every", type=int, default=None,
                    help="steps between evaluations (default: steps / 20)")
@@ -546,16 +703,28 @@ def _common(p):
 
 
 def _train_main(args) -> int:
-    res = train(args.task, args.algo, args.steps, args.seed, args.out,
-                eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
-                env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs)
+    try:
+        res = train(args.task, args.algo, args.steps, args.seed, args.out,
+                    eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+                    checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
+                    env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs, mode=args.mode,
+                    n_envs=args.n_envs, n_cpus=args.n_cpus)
+    except TrainInputError as e:
+        print(f"mimo-social train: {e}", file=sys.stderr)
+        return 2
     last = res["last_eval"]
     success = last["eval_success_rate"]
-    print(f"trained {args.algo.upper()} on {args.task} for {res['timesteps']} steps in "
+    mode = f" ({res['mode']})" if res.get("mode") else ""
+    print(f"trained {args.algo.upper()} on {args.task}{mode} for {res['timesteps']} steps in "
           f"{res['wall_time_s']:.0f} s; last evaluation: return {last['eval_return_mean']:.3g}"
-          + ("" if math.isnan(success) else f", success {success:.0%}")
-          + f"\nwrote {res['out']}/model.zip, progress.csv, learning_curve.png")
+          + ("" if math.isnan(success) else f", success {success:.0%}"))
+    for a in res.get("agents", ()):
+        s = last[f"eval_success_rate_{a}"]
+        print(f"  {a}: return {last[f'eval_return_mean_{a}']:.3g}"
+              + ("" if math.isnan(s) else f", success {s:.0%}"))
+    models = sorted({Path(m).name for m in res.get("models", {"": res["model"]}).values()})
+    print(f"wrote {res['out']}/" + ("{" + ", ".join(models) + "}" if len(models) > 1 else models[0])
+          + ", progress.csv, learning_curve.png")
     return 0
 
 
@@ -565,14 +734,19 @@ def _eval_main(args) -> int:
                        deterministic=not args.stochastic, record=args.record, video=args.video,
                        frames=args.frames, frame_every=args.frame_every,
                        env_kwargs=args.env_kwargs)
-    except (VideoUnavailable, FileNotFoundError) as e:
+    except (VideoUnavailable, FileNotFoundError, TrainInputError) as e:
         print(f"mimo-social eval: {e}", file=sys.stderr)
         return 2
     success = res["success_rate"]
-    print(f"{res['task']} {res['algo'].upper()} {Path(res['model']).name}: {res['episodes']} "
-          f"episodes, return {res['return_mean']:.4g} +- {res['return_std']:.3g}, "
-          f"length {res['length_mean']:.0f}"
+    mode = f" {res['mode']}" if res.get("mode") else ""
+    print(f"{res['task']} {res['algo'].upper()}{mode} {Path(res['model']).name}: "
+          f"{res['episodes']} episodes, return {res['return_mean']:.4g} +- "
+          f"{res['return_std']:.3g}, length {res['length_mean']:.0f}"
           + ("" if math.isnan(success) else f", success {success:.0%}"))
+    for a, r in res.get("agents", {}).items():
+        s = r["success_rate"]
+        print(f"  {a} ({Path(res['models'][a]).name}): return {r['return_mean']:.4g} +- "
+              f"{r['return_std']:.3g}" + ("" if math.isnan(s) else f", success {s:.0%}"))
     for key in ("record", "video", "frames"):
         if key in res:
             print(f"wrote {res[key]}")
@@ -581,16 +755,24 @@ def _eval_main(args) -> int:
 
 def _compare_main(args) -> int:
     algos = [a.strip() for a in args.algos.split(",") if a.strip()]
-    png = compare(args.task, algos, args.seeds, args.steps, args.out, jobs=args.jobs,
-                  plot_only=args.plot_only, eval_every=args.eval_every,
-                  eval_episodes=args.eval_episodes, checkpoint_every=args.checkpoint_every,
-                  env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs)
+    try:
+        png = _compare_run(args, algos)
+    except TrainInputError as e:
+        print(f"mimo-social compare: {e}", file=sys.stderr)
+        return 2
     print(f"wrote {png} and {png.with_suffix('.csv')}")
     return 0
 
 
+def _compare_run(args, algos):
+    return compare(args.task, algos, args.seeds, args.steps, args.out, jobs=args.jobs,
+                   plot_only=args.plot_only, mode=args.mode, eval_every=args.eval_every,
+                   eval_episodes=args.eval_episodes, checkpoint_every=args.checkpoint_every,
+                   env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs)
+
+
 def add_parser(subparsers) -> None:
-    p = subparsers.add_parser("train", help="train PPO or SAC on a one-agent task",
+    p = subparsers.add_parser("train", help="train PPO or SAC on a one-agent or social task",
                               description="Train a Stable-Baselines3 policy (default "
                               "hyperparameters) with periodic evaluation, checkpoints and a "
                               "learning curve (CSV and PNG).")
@@ -599,6 +781,10 @@ def add_parser(subparsers) -> None:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--n-envs", type=int, default=1, help="--mode shared: worlds stepped "
+                   "together (one VecEnv slot per agent of each)")
+    p.add_argument("--n-cpus", type=int, default=0, help="--mode shared: worker processes for "
+                   "the worlds (0: all in this process)")
     p.set_defaults(func=_train_main)
 
     p = subparsers.add_parser("eval", help="run a trained policy (optionally record or film it)",
