@@ -3,8 +3,8 @@
 ``FlattenParallel(env)``
     A PettingZoo ``ParallelEnv`` around any ParallelEnv of this package. Each agent's observation
     becomes one float32 ``Box``: the entries of its ``Dict`` observation flattened and concatenated
-    in the order of the ``Dict`` space (``proprioception`` then ``vestibular`` ...). Each agent's
-    action becomes one float32 ``Box``:
+    in the order of the ``Dict`` space (``proprioception`` then ``vestibular`` ...), eye images
+    (``uint8``) scaled to [0, 1]. Each agent's action becomes one float32 ``Box``:
 
     * motors only (``expressions=False``): the motor ``Box`` itself, ``[-1, 1]^n``;
     * with expressions: ``n`` motor values followed by 7 expression *logits* in ``[-1, 1]``; the
@@ -31,15 +31,19 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-__all__ = ["FlattenParallel", "FlatActionWrapper", "make_sb3_single", "flat_action_space",
-           "flat_observation_space"]
+__all__ = ["FlattenParallel", "FlatActionWrapper", "FlatObservationWrapper", "make_sb3_single",
+           "flat_action_space", "flat_observation_space"]
 
 LOGIT_LOW, LOGIT_HIGH = -1.0, 1.0
 
 
 # -- observations -------------------------------------------------------------------------------
 class _ObsFlattener:
-    """Turns one agent's observation (a ``Dict``, a ``Box`` or another space) into a float32 vector."""
+    """Turns one agent's observation (a ``Dict``, a ``Box`` or another space) into a float32 vector.
+
+    Images (``uint8`` Boxes, e.g. the eyes) are scaled to [0, 1]: learners' networks expect
+    inputs of order one, and raw 0-255 pixels saturate their first layer.
+    """
 
     def __init__(self, space: spaces.Space):
         self.source = space
@@ -48,24 +52,44 @@ class _ObsFlattener:
         else:
             self.parts = [(None, space)]
         lows, highs = [], []
+        self._scale = []
         for _, sub in self.parts:
             flat = spaces.flatten_space(sub)
             if not isinstance(flat, spaces.Box):
                 raise TypeError(f"cannot flatten observation space {sub} to a Box")
-            lows.append(np.asarray(flat.low, dtype=np.float32).ravel())
-            highs.append(np.asarray(flat.high, dtype=np.float32).ravel())
+            image = isinstance(sub, spaces.Box) and sub.dtype == np.uint8
+            scale = np.float32(1.0 / 255.0) if image else None
+            self._scale.append(scale)
+            lo = np.asarray(flat.low, dtype=np.float32).ravel()
+            hi = np.asarray(flat.high, dtype=np.float32).ravel()
+            lows.append(lo * scale if image else lo)
+            highs.append(hi * scale if image else hi)
         self.space = spaces.Box(np.concatenate(lows), np.concatenate(highs), dtype=np.float32)
         self._box = [isinstance(sub, spaces.Box) for _, sub in self.parts]
 
     def __call__(self, obs) -> np.ndarray:
         chunks = []
-        for (key, sub), is_box in zip(self.parts, self._box):
+        for (key, sub), is_box, scale in zip(self.parts, self._box, self._scale):
             value = obs if key is None else obs[key]
             if is_box:
-                chunks.append(np.asarray(value, dtype=np.float32).ravel())
+                v = np.asarray(value, dtype=np.float32).ravel()
+                chunks.append(v * scale if scale is not None else v)
             else:
                 chunks.append(np.asarray(spaces.flatten(sub, value), dtype=np.float32).ravel())
         return np.concatenate(chunks)
+
+
+class FlatObservationWrapper(gym.ObservationWrapper):
+    """A Gymnasium env's observation as the float32 Box of :class:`FlattenParallel` (the parts
+    of a ``Dict`` in order, images scaled to [0, 1])."""
+
+    def __init__(self, env: gym.Env):
+        super().__init__(env)
+        self._flatten = _ObsFlattener(env.observation_space)
+        self.observation_space = self._flatten.space
+
+    def observation(self, observation):
+        return self._flatten(observation)
 
 
 def flat_observation_space(space: spaces.Space) -> spaces.Box:
@@ -224,8 +248,8 @@ def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
     """A one-agent Gymnasium env with a ``Box`` observation and a ``Box`` action, for SB3.
 
     ``env_id_or_env``: a registered id (``"mimo_social/Reach-v0"``; ``make_kwargs`` go to
-    ``gymnasium.make``) or a ``gymnasium.Env``. A non-Box observation is flattened with
-    ``gymnasium.wrappers.FlattenObservation``; a ``Dict(motors, expression)`` action becomes the
+    ``gymnasium.make``) or a ``gymnasium.Env``. A non-Box observation is flattened by
+    :class:`FlatObservationWrapper` (images scaled to [0, 1]); a ``Dict(motors, expression)`` action becomes the
     flat Box of :class:`FlatActionWrapper`.
     """
     if isinstance(env_id_or_env, str):
@@ -238,8 +262,8 @@ def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
     else:
         raise TypeError(f"make_sb3_single takes an env id or a gymnasium.Env, got "
                         f"{type(env_id_or_env).__name__}")
-    if not isinstance(env.observation_space, spaces.Box):
-        env = gym.wrappers.FlattenObservation(env)
+    if not isinstance(env.observation_space, spaces.Box) or env.observation_space.dtype == np.uint8:
+        env = FlatObservationWrapper(env)
     if not isinstance(env.action_space, spaces.Box):
         env = FlatActionWrapper(env)
     return env
