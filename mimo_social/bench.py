@@ -188,6 +188,14 @@ CONFIGS: dict[str, BenchConfig] = {c.name: c for c in (
                 "touch), recorded", record=True, group="tasks"),
     BenchConfig("catch", "catch_v0", {}, "catch task, defaults (1 infant, five fingers, "
                 "muscles, touch), recorded", record=True, group="tasks"),
+    BenchConfig("mirror", "mirror_v0", {}, "mirror task, defaults (2 infants, 2 x 64x64 eyes "
+                "each), recorded", record=True, group="tasks"),
+    BenchConfig("joint_attention", "joint_attention_v0", {}, "joint attention task, defaults "
+                "(2 sitting infants, 4 toys, eyes), recorded", record=True, group="tasks"),
+    BenchConfig("social_touch", "social_touch_v0", {}, "social touch task, defaults (2 sitting "
+                "infants, touch), recorded", record=True, group="tasks"),
+    BenchConfig("handover", "handover_v0", {}, "handover task, defaults (2 infants, five fingers, "
+                "a ball in the giver's hand, touch), recorded", record=True, group="tasks"),
     _scene("five_fingers", "as default with five-fingered hands", group="bodies",
            hands="five_fingers"),
     _scene("muscle", "as default with the muscle model (controls in [0, 1], 2 per motor)",
