@@ -307,8 +307,10 @@ class MimoParallelEnv(ParallelEnv):
         cam = mujoco.MjvCamera()
         centre = roots.mean(axis=0)
         spread = float(np.max(np.linalg.norm(roots[:, :2] - centre[:2], axis=1))) if len(roots) > 1 else 0.0
-        cam.lookat[:] = (centre[0], centre[1], 0.3)
-        cam.distance = 1.4 + 2.0 * spread
+        # frame the tallest head too (a caregiver-sized body is twice an infant's height)
+        top = float(np.max(d.site_xpos[[a.head_site for a in self.world.agents], 2]))
+        cam.lookat[:] = (centre[0], centre[1], max(0.3, 0.45 * top))
+        cam.distance = max(1.4 + 2.0 * spread, 2.2 * top)
         cam.azimuth = 60.0
         cam.elevation = -20.0
         return cam
