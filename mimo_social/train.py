@@ -482,6 +482,56 @@ def _mp4_writer(path: Path, fps: int):
     return write, close
 
 
+class EvalOutputs:
+    """What an evaluation writes besides its numbers: a Rerun recording of the inner
+    ParallelEnv ``penv``, an MP4 and/or PNG frames of ``env.render()`` every ``frame_every``
+    steps. ``on_reset()`` / ``on_step(actions, rewards)`` after each reset / step; ``close()``."""
+
+    def __init__(self, env, penv, record=None, video=None, frames=None, frame_every: int = 1):
+        self.env, self.frames, self.frame_every = env, frames, int(frame_every)
+        self.want_frames = video is not None or frames is not None
+        self.write = self._close_video = None
+        if video is not None:
+            self.write, self._close_video = _mp4_writer(
+                Path(video), int(penv.metadata.get("render_fps", 100)))
+        if frames is not None:
+            Path(frames).mkdir(parents=True, exist_ok=True)
+        self.recorder = None
+        if record is not None:
+            from .replay import Recorder
+            self.recorder = Recorder(penv, record)
+        self.episode, self.step = -1, 0
+
+    def on_reset(self) -> None:
+        self.episode += 1
+        self.step = 0
+        if self.recorder is not None:
+            self.recorder.log_reset()
+        self._frame()
+
+    def on_step(self, actions: Mapping[str, Any], rewards: Mapping[str, float]) -> None:
+        self.step += 1
+        if self.recorder is not None:
+            self.recorder.log_step(actions, rewards)
+        self._frame()
+
+    def _frame(self) -> None:
+        if not self.want_frames or self.step % self.frame_every:
+            return
+        frame = self.env.render()
+        if self.write is not None:
+            self.write(frame)
+        if self.frames is not None:
+            import matplotlib.image as mpimg
+            mpimg.imsave(Path(self.frames) / f"ep{self.episode:03d}_{self.step:05d}.png", frame)
+
+    def close(self) -> None:
+        if self.recorder is not None:
+            self.recorder.close()
+        if self._close_video is not None:
+            self._close_video()
+
+
 def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed: int = 0,
              deterministic: bool = True, record: str | Path | None = None,
              video: str | Path | None = None, frames: str | Path | None = None,
@@ -508,45 +558,20 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     want_frames = video is not None or frames is not None
     env = make_env(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
     penv = env.unwrapped.parallel
-    write = close = None
-    if video is not None:
-        write, close = _mp4_writer(Path(video), int(penv.metadata.get("render_fps", 100)))
-    if frames is not None:
-        Path(frames).mkdir(parents=True, exist_ok=True)
-    recorder = None
-    if record is not None:
-        from .replay import Recorder
-        recorder = Recorder(penv, record)
-    counter = {"episode": -1, "step": 0}
+    outputs = EvalOutputs(env, penv, record, video, frames, frame_every)
+    agent = penv.possible_agents[0]
 
     def on_step(action, reward, info, reset):
         if reset:
-            counter["episode"] += 1
-            counter["step"] = 0
-            if recorder is not None:
-                recorder.log_reset()
+            outputs.on_reset()
         else:
-            counter["step"] += 1
-            if recorder is not None:
-                agent = penv.possible_agents[0]
-                recorder.log_step({agent: np.asarray(action)}, {agent: float(reward)})
-        if want_frames and counter["step"] % frame_every == 0:
-            frame = env.render()
-            if write is not None:
-                write(frame)
-            if frames is not None:
-                import matplotlib.image as mpimg
-                mpimg.imsave(Path(frames) / f"ep{counter['episode']:03d}_{counter['step']:05d}.png",
-                             frame)
+            outputs.on_step({agent: np.asarray(action)}, {agent: float(reward)})
 
     t0 = time.perf_counter()
     try:
         res = _evaluate_policy(policy, env, episodes, seed, deterministic, on_step)
     finally:
-        if recorder is not None:
-            recorder.close()
-        if close is not None:
-            close()
+        outputs.close()
         env.close()
     res.update({"task": config["task"], "algo": config["algo"], "model": str(path),
                 "episodes": episodes, "deterministic": deterministic, "seed": seed,

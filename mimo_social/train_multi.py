@@ -51,7 +51,7 @@ from typing import Any, Callable, Mapping
 import gymnasium as gym
 import numpy as np
 
-from .train import (MULTI_TASKS, TASKS, TrainInputError, _algo_class, _mp4_writer,
+from .train import (MULTI_TASKS, TASKS, EvalOutputs, TrainInputError, _algo_class,
                     plot_learning_curve, write_progress)
 
 __all__ = ["MODES", "DEFAULT_MODE", "task_module", "check_mode", "make_parallel_env",
@@ -755,45 +755,20 @@ def evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed: 
     make = make_scripted_env if config["mode"] == "scripted" else make_parallel_env
     env = make(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
     inner = env.unwrapped
-    write = close = None
-    if video is not None:
-        write, close = _mp4_writer(Path(video), int(inner.metadata.get("render_fps", 100)))
-    if frames is not None:
-        Path(frames).mkdir(parents=True, exist_ok=True)
-    recorder = None
-    if record is not None:
-        from .replay import Recorder
-        recorder = Recorder(inner, record)
+    outputs = EvalOutputs(env, inner, record, video, frames, frame_every)
     motors = _motor_slicer(env)
-    counter = {"episode": -1, "step": 0}
 
     def on_step(actions, rewards, obs, reset):
         if reset:
-            counter["episode"] += 1
-            counter["step"] = 0
-            if recorder is not None:
-                recorder.log_reset()
+            outputs.on_reset()
         else:
-            counter["step"] += 1
-            if recorder is not None:
-                recorder.log_step({a: motors(a, act) for a, act in actions.items()}, rewards)
-        if want_frames and counter["step"] % frame_every == 0:
-            frame = env.render()
-            if write is not None:
-                write(frame)
-            if frames is not None:
-                import matplotlib.image as mpimg
-                mpimg.imsave(Path(frames) / f"ep{counter['episode']:03d}_{counter['step']:05d}.png",
-                             frame)
+            outputs.on_step({a: motors(a, act) for a, act in actions.items()}, rewards)
 
     t0 = time.perf_counter()
     try:
         res = evaluate_agents(policies, env, episodes, seed, deterministic, on_step)
     finally:
-        if recorder is not None:
-            recorder.close()
-        if close is not None:
-            close()
+        outputs.close()
         env.close()
     res.update({"task": config["task"], "algo": config["algo"], "mode": config["mode"],
                 "model": paths[next(iter(paths))], "models": paths, "episodes": episodes,

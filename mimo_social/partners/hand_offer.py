@@ -31,6 +31,7 @@ from typing import Mapping
 import mujoco
 import numpy as np
 
+from ..envs.tasks.base import check_number
 from .base import Partner, zero_action
 
 __all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]
@@ -68,10 +69,7 @@ def finger_flexors(names) -> np.ndarray:
 
 
 def _number(name, value, lo, hi):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(value) or not lo <= value <= hi:
-        raise ValueError(f"HandOffer: {name}={value!r}; allowed: a number in [{lo}, {hi}]")
-    return float(value)
+    return check_number("HandOffer", name, value, lo, hi)
 
 
 def _palm_at(w, a, qadr, q) -> np.ndarray:

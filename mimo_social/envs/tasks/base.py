@@ -144,6 +144,36 @@ def held_posture(tables, keep: tuple[str, ...], angles: Mapping[str, float] | No
     return out
 
 
+def check_number(owner: str, name: str, value, lo: float, hi: float) -> float:
+    """``value`` as a float if it is a finite number in [lo, hi], else a ValueError naming the
+    owner (task or partner), the setting and the allowed range."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(value) or not lo <= value <= hi:
+        raise ValueError(f"{owner}: {name}={value!r}; allowed: a number in [{lo}, {hi}]")
+    return float(value)
+
+
+def parts_outside(tables, roots: tuple[str, ...]) -> tuple[str, ...]:
+    """Every body part with geoms that is not in the subtree of one of ``roots``: the touch
+    ``exclude`` list that leaves skin on those subtrees only."""
+    from ...body.tables import subtree
+    keep = set()
+    for r in roots:
+        keep |= set(subtree(tables, r))
+    out = []
+    for g in tables.geoms:
+        if g.body not in keep and g.body not in out:
+            out.append(g.body)
+    return tuple(out)
+
+
+def face_to_face(i: int, distance: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Position and point to face of agent ``i`` of a pair ``distance`` apart on the x axis."""
+    pos = (0.0, 0.0) if i == 0 else (float(distance), 0.0)
+    facing = (float(distance), 0.0) if i == 0 else (0.0, 0.0)
+    return pos, facing
+
+
 class ContactProbe:
     """Tells whether any active contact joins a geom of set a with a geom of set b.
 

@@ -21,7 +21,7 @@ from gymnasium import spaces
 
 from ...body.tables import load_body, subtree
 from ..world import AgentSetup, Prop
-from .base import GAZE_JOINTS, Gaze, Task, hand_geoms, held_posture
+from .base import GAZE_JOINTS, Gaze, Task, hand_geoms, held_posture, parts_outside
 from .standup import settle
 
 ARM_DEG = {"right_shoulder_horizontal": 92.0, "right_shoulder_abduction": 44.0,
@@ -40,12 +40,7 @@ def catch_joints(tables) -> tuple[str, ...]:
 
 def touch_exclude(tables) -> tuple[str, ...]:
     """Every body part with skin outside the right arm (upper arm to fingertips)."""
-    arm = set(subtree(tables, "right_upper_arm"))
-    parts = []
-    for g in tables.geoms:
-        if g.body not in arm and g.body not in parts:
-            parts.append(g.body)
-    return tuple(parts)
+    return parts_outside(tables, ("right_upper_arm",))
 
 
 class Catch(Task):

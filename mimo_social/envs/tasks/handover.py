@@ -30,10 +30,11 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from ...body.tables import load_body, subtree
+from ...body.tables import load_body
 from ...partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
 from ..world import AgentSetup, Prop
-from .base import GAZE_JOINTS, Gaze, Task, hand_geoms, held_posture, right_arm_joints
+from .base import (GAZE_JOINTS, Gaze, Task, check_number, hand_geoms, held_posture,
+                   parts_outside, right_arm_joints)
 
 RECEIVER, GIVER = 0, 1
 PARKED = (0.2, 1.5, 0.5)             # where the ball is built (the reset moves it to the palm)
@@ -43,20 +44,12 @@ BALL_TOWARD_FINGERS = 0.01           # m from the palm centre toward the fingers
 
 def arms_only_touch(tables) -> dict:
     """Touch settings: skin on both arms and hands only, the normal force only."""
-    arms = set(subtree(tables, "right_upper_arm")) | set(subtree(tables, "left_upper_arm"))
-    exclude = []
-    for g in tables.geoms:
-        if g.body not in arms and g.body not in exclude:
-            exclude.append(g.body)
-    return {"normal_only": True, "exclude": tuple(exclude)}
+    return {"normal_only": True,
+            "exclude": parts_outside(tables, ("right_upper_arm", "left_upper_arm"))}
 
 
 def _check_number(name, value, lo, hi):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(value) or not lo <= value <= hi:
-        raise ValueError(f"handover: task option {name}={value!r}; allowed: a number in "
-                         f"[{lo}, {hi}]")
-    return float(value)
+    return check_number("handover: task option", name, value, lo, hi)
 
 
 class Handover(Task):

@@ -35,7 +35,7 @@ import numpy as np
 from ...body.tables import HAND_VERSIONS, load_body, subtree
 from ..config import ConfigError
 from ..world import AgentSetup
-from .base import (GAZE_JOINTS, ContactProbe, Gaze, Task, hand_geoms, held_posture,
+from .base import (GAZE_JOINTS, ContactProbe, Gaze, Task, face_to_face, hand_geoms, held_posture,
                    right_arm_joints)
 
 # 0.35 m: the right hands meet with the arms forward, half stretched; at 0.45 m (the first
@@ -181,8 +181,7 @@ class HighFive(Task):
 
     def setup(self, i, config):
         dist = float(self.options["distance"])
-        pos = (0.0, 0.0) if i == 0 else (dist, 0.0)
-        facing = (dist, 0.0) if i == 0 else (0.0, 0.0)
+        pos, facing = face_to_face(i, dist)
         tables = load_body(config.hands)
         require_skin(self.name, f"infant_{i}", config, right_hand_parts(tables),
                      "the high five (the right hands meeting)")

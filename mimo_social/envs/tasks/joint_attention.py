@@ -37,7 +37,7 @@ import numpy as np
 from ...body.postures import POSTURES
 from ...body.tables import load_body
 from ..world import AgentSetup, Prop
-from .base import GAZE_JOINTS, Task, held_posture
+from .base import GAZE_JOINTS, Task, check_number, face_to_face, held_posture
 
 DISTANCE = 0.7
 EYE_SIZE = 96
@@ -49,9 +49,7 @@ MAX_TRIES = 500
 
 
 def _number(name, value, lo, hi):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not lo <= value <= hi:
-        raise ValueError(f"joint_attention: {name}={value!r}; allowed: a number from {lo} to {hi}")
-    return float(value)
+    return check_number("joint_attention", name, value, lo, hi)
 
 
 class GazeRays:
@@ -123,8 +121,7 @@ class JointAttention(Task):
 
     def setup(self, i, config):
         dist = float(self.options["distance"])
-        pos = (0.0, 0.0) if i == 0 else (dist, 0.0)
-        facing = (dist, 0.0) if i == 0 else (0.0, 0.0)
+        pos, facing = face_to_face(i, dist)
         tables = load_body(config.hands)
         frozen = held_posture(tables, keep=GAZE_JOINTS, angles=POSTURES["sitting"]["joints"])
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,

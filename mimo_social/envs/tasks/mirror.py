@@ -28,7 +28,7 @@ import numpy as np
 
 from ...body.tables import load_body
 from ..world import AgentSetup
-from .base import GAZE_JOINTS, Gaze, Task, held_posture
+from .base import GAZE_JOINTS, Gaze, Task, face_to_face, held_posture
 
 DISTANCE = 0.3
 EYE_SIZE = 64
@@ -60,8 +60,7 @@ class Mirror(Task):
 
     def setup(self, i, config):
         dist = float(self.options["distance"])
-        pos = (0.0, 0.0) if i == 0 else (dist, 0.0)
-        facing = (dist, 0.0) if i == 0 else (0.0, 0.0)
+        pos, facing = face_to_face(i, dist)
         tables = load_body(config.hands)
         frozen = held_posture(tables, keep=GAZE_JOINTS,
                               angles={"right_knee": -5, "left_knee": -5})
