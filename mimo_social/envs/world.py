@@ -349,6 +349,17 @@ class World:
                                for p in self.props for o in p.welds], dtype=np.intp).reshape(-1, 3)
 
     # -- state ---------------------------------------------------------------------------------
+    def place_prop(self, name: str, position, quat=(1.0, 0.0, 0.0, 0.0)) -> None:
+        """Put free prop ``name`` at a world position and orientation, at rest (kinematics
+        updated, so positions read right away are the new ones)."""
+        if name not in self.prop_qpos:
+            raise KeyError(f"no free prop {name!r}; free props: {sorted(self.prop_qpos)}")
+        q, v = self.prop_qpos[name], self.prop_dof[name]
+        self.data.qpos[q:q + 3] = position
+        self.data.qpos[q + 3:q + 7] = quat
+        self.data.qvel[v:v + 6] = 0.0
+        mujoco.mj_kinematics(self.model, self.data)
+
     def reset(self, qpos: np.ndarray | None = None):
         mujoco.mj_resetData(self.model, self.data)
         self.data.qpos[:] = self._initial_qpos if qpos is None else qpos

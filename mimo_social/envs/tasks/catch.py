@@ -118,12 +118,7 @@ class Catch(Task):
 
     def place_ball(self, env, position) -> None:
         """Put the ball at a world position, at rest."""
-        d = env.world.data
-        q = self._ball_q
-        d.qpos[q:q + 3] = position
-        d.qpos[q + 3:q + 7] = (1.0, 0.0, 0.0, 0.0)
-        d.qvel[self._ball_v:self._ball_v + 6] = 0.0
-        mujoco.mj_kinematics(env.world.model, d)
+        env.world.place_prop("ball", position)
 
     def reset(self, env, rng):
         if getattr(self, "_world", None) is not env.world:
