@@ -61,7 +61,7 @@ def test_the_default_skin_covers_the_right_hand_only():
 
 
 def test_hands_together_are_felt_by_both_skins_and_give_the_bonus():
-    env = high_five_v0.parallel_env(expressions=False, task_options={"distance": CLOSE})
+    env = high_five_v0.parallel_env(expressions=False, task_options={"distance": CLOSE, "start_spread": 0.0})
     env.reset(seed=0)
     _, r, term, trunc, info = env.step(_zero(env))
     assert r["infant_0"] == pytest.approx(-info["infant_0"]["hand_distance"])
@@ -86,7 +86,7 @@ def test_hands_together_are_felt_by_both_skins_and_give_the_bonus():
 def _palm_on_partners_forearm(partner_palm, **kwargs):
     """infant_1's palm to ``partner_palm``, then infant_0's palm onto infant_1's right forearm
     (0.3 m apart); one step with zero actions."""
-    env = high_five_v0.parallel_env(expressions=False, task_options={"distance": 0.3}, **kwargs)
+    env = high_five_v0.parallel_env(expressions=False, task_options={"distance": 0.3, "start_spread": 0.0}, **kwargs)
     env.reset(seed=0)
     w = env.world
     forearm = w.model.body("infant_1/right_lower_arm").id
@@ -118,7 +118,7 @@ def test_crossed_arms_both_hands_feel_the_partner_but_not_each_other():
 
 
 def test_without_end_on_touch_the_bonus_comes_every_touching_step():
-    env = high_five_v0.parallel_env(expressions=False, task_options={"end_on_touch": False,
+    env = high_five_v0.parallel_env(expressions=False, task_options={"end_on_touch": False, "start_spread": 0.0,
                                                                      "touch_bonus": 7.5,
                                                                      "distance": CLOSE})
     env.reset(seed=0)
@@ -131,7 +131,7 @@ def test_without_end_on_touch_the_bonus_comes_every_touching_step():
 
 def test_five_fingered_hands_get_their_own_hand_skin():
     env = high_five_v0.parallel_env(expressions=False, per_agent=[{}, {"hands": "five_fingers"}],
-                                    max_steps=5, task_options={"distance": CLOSE})
+                                    max_steps=5, task_options={"distance": CLOSE, "start_spread": 0.0})
     obs, _ = env.reset(seed=0)
     touch = touch_system(env)
     assert set(touch.layout("infant_0")) == HAND
@@ -221,3 +221,28 @@ def test_the_infants_start_apart_and_feel_nothing_of_each_other():
     assert env.task.options["distance"] == 0.35
     for a in env.possible_agents:
         assert not any(e["agents"] for e in infos[a]["touch"].values())
+
+
+def test_arms_start_in_seeded_random_postures():
+    """Each episode starts from other arm postures (a policy cannot replay one trajectory);
+    the same seed gives the same start."""
+    env = high_five_v0.parallel_env()
+    w = env.world
+
+    def arms(seed):
+        env.reset(seed=seed)
+        return np.concatenate([w.data.qpos[a.qpos_adr[a.actuated_joint_idx]] for a in w.agents])
+
+    a0, a1, again = arms(0), arms(1), arms(0)
+    assert np.array_equal(a0, again)
+    assert np.abs(a0 - a1).max() > 0.05
+    assert np.abs(a0[:8] - a0[8:]).max() > 0.01   # the two infants differ too
+    still = high_five_v0.parallel_env(task_options={"start_spread": 0.0})
+    s = still.world
+    b = []
+    for seed in (0, 1):
+        still.reset(seed=seed)
+        b.append(np.concatenate([s.data.qpos[a.qpos_adr[a.actuated_joint_idx]] for a in s.agents]))
+    assert np.array_equal(b[0], b[1])
+    with pytest.raises(ValueError, match="start_spread"):
+        high_five_v0.parallel_env(task_options={"start_spread": 2.0})

@@ -3,6 +3,7 @@
 | | |
 |---|---|
 | agents | 2 (`infant_0`, `infant_1`), `distance` (0.35 m) apart hip to hip, facing each other |
+| reset | each right arm starts in its own random posture: every joint at its standing-pose angle plus U(-1/2, 1/2) x `start_spread` (0.3) x its range (seeded by `reset(seed=...)`) |
 | body | hip fixed in the world; trunk, legs, left arm held; head and eyes fixate the partner's right hand (set by the task each control step) |
 | action | the right-arm motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five fingers: 29), plus the expression when expressions are on |
 | observation | `proprioception` (head and eye angles tell where the partner's hand is), `vestibular`, `touch`: the skin of the right hand only by default (hand and fingers, a tenth of the published point density, normal force only: 232 floats for the mitten hand); `touch=True` or a mapping gives more skin |
@@ -30,6 +31,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence
 
+import mujoco
 import numpy as np
 
 from ...body.tables import HAND_VERSIONS, load_body, subtree
@@ -158,6 +160,9 @@ def touch_system(env):
 
 
 # -- the task ----------------------------------------------------------------------------------
+START_TRIES = 50   # random start postures tried until the hands touch nothing
+
+
 class HighFive(Task):
     name = "high_five"
     n_agents_range = (2, 2)
@@ -170,11 +175,13 @@ class HighFive(Task):
         o["touch_bonus"] = check_number(self.name, "touch_bonus", o["touch_bonus"])
         o["end_on_touch"] = check_bool(self.name, "end_on_touch", o["end_on_touch"])
         o["distance"] = check_number(self.name, "distance", o["distance"], *DISTANCE_RANGE)
+        o["start_spread"] = check_number(self.name, "start_spread", o["start_spread"], 0.0, 1.0)
         # the hand version of each agent, for the default skin; set by ``high_five_v0``
         self.agent_hands: list[str] = ["mitten"] * self.n_agents
 
     def option_defaults(self) -> dict:
-        return {"touch_bonus": 100.0, "end_on_touch": True, "distance": DISTANCE}
+        return {"touch_bonus": 100.0, "end_on_touch": True, "distance": DISTANCE,
+                "start_spread": 0.3}
 
     def agent_defaults(self, i):
         return {"posture": "standing", "touch": hand_touch(self.agent_hands[i])}
@@ -202,10 +209,32 @@ class HighFive(Task):
         touch = touch_system(env)
         self._feels = [SkinSource(w, touch, i, hands[i], right_hand_parts(w.tables[i]), 1 - i)
                        for i in range(2)]
+        self._hand_mask = np.zeros(w.model.ngeom, bool)
+        self._hand_mask[np.concatenate(hands)] = True
+        # each arm's joints: qpos/dof addresses, the standing pose's angles (rad) and ranges
+        self._arms = []
+        rest = w.initial_qpos
+        for a in w.agents:
+            k = a.actuated_joint_idx
+            lo, hi = a.joint_range[k, 0], a.joint_range[k, 1]
+            self._arms.append((a.qpos_adr[k], a.dof_adr[k], rest[a.qpos_adr[k]].copy(), lo, hi))
 
     def reset(self, env, rng):
         if getattr(self, "_world", None) is not env.world:
             self._bind(env)
+        m, d = env.world.model, env.world.data
+        spread = self.options["start_spread"]
+        for _ in range(START_TRIES):  # each arm in its own random posture, the hands touching nothing
+            for q, v, mid, lo, hi in self._arms:
+                u = rng.uniform(-0.5, 0.5, len(q))
+                d.qpos[q] = np.clip(mid + u * spread * (hi - lo), lo, hi)
+                d.qvel[v] = 0.0
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_collision(m, d)
+            n = d.ncon
+            g1, g2 = d.contact.geom1[:n], d.contact.geom2[:n]
+            if not np.any((self._hand_mask[g1] | self._hand_mask[g2]) & (d.contact.dist[:n] < 0)):
+                break
         self._touching = False
         self._felt = [False, False]
         self._distance = float("nan")
