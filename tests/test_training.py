@@ -243,3 +243,20 @@ def test_flat_observations_scale_eye_images_to_unit_range():
     single = make_sb3_single(SingleAgentEnv(mirror_v0.scripted_env()))
     o, _ = single.reset(seed=0)
     assert single.observation_space.contains(o) and o.shape == space.shape
+
+
+def test_a_face_only_agent_learns_a_discrete_expression():
+    """The mirror learner has no motors: its SB3 action is the expression id itself."""
+    from gymnasium import spaces
+    from mimo_social.envs import mirror_v0
+    from mimo_social.envs.single import SingleAgentEnv
+    single = SingleAgentEnv(mirror_v0.scripted_env())
+    env = make_sb3_single(single)
+    assert env.action_space == spaces.Discrete(7)
+    env.reset(seed=0)
+    world = single.parallel.unwrapped.world
+    for face in (3, 5):
+        env.step(face)
+        assert world.expression_of(0) == face
+    with pytest.raises(ValueError):
+        env.step(7)

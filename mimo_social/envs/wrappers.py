@@ -31,7 +31,8 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-__all__ = ["FlattenParallel", "FlatActionWrapper", "FlatObservationWrapper", "make_sb3_single",
+__all__ = ["FlattenParallel", "FlatActionWrapper", "FlatObservationWrapper",
+           "ExpressionActionWrapper", "is_expression_only", "make_sb3_single",
            "flat_action_space", "flat_observation_space"]
 
 LOGIT_LOW, LOGIT_HIGH = -1.0, 1.0
@@ -244,13 +245,40 @@ class FlatActionWrapper(gym.ActionWrapper):
         return self._decoder(action, "action")
 
 
+class ExpressionActionWrapper(gym.ActionWrapper):
+    """An agent whose only action is its face (``Dict(motors=Box((0,)), expression=Discrete(7))``,
+    e.g. the mirror task's learner) takes the expression id itself: a ``Discrete(7)`` action,
+    which PPO / A2C learn as a categorical choice (better than argmax over Box logits)."""
+
+    def __init__(self, env: gym.Env):
+        super().__init__(env)
+        space = env.action_space
+        if not is_expression_only(space):
+            raise TypeError(f"ExpressionActionWrapper needs Dict(motors=Box of size 0, "
+                            f"expression=Discrete), got {space}")
+        self._motors = np.zeros(space["motors"].shape, space["motors"].dtype)
+        self.action_space = spaces.Discrete(space["expression"].n, start=space["expression"].start)
+
+    def action(self, action):
+        return {"motors": self._motors, "expression": int(action)}
+
+
+def is_expression_only(space: spaces.Space) -> bool:
+    """True for ``Dict(motors=Box with no values, expression=Discrete)``."""
+    return (isinstance(space, spaces.Dict) and set(space.spaces) == {"motors", "expression"}
+            and isinstance(space["motors"], spaces.Box) and space["motors"].shape
+            and int(np.prod(space["motors"].shape)) == 0
+            and isinstance(space["expression"], spaces.Discrete))
+
+
 def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
     """A one-agent Gymnasium env with a ``Box`` observation and a ``Box`` action, for SB3.
 
     ``env_id_or_env``: a registered id (``"mimo_social/Reach-v0"``; ``make_kwargs`` go to
     ``gymnasium.make``) or a ``gymnasium.Env``. A non-Box observation is flattened by
-    :class:`FlatObservationWrapper` (images scaled to [0, 1]); a ``Dict(motors, expression)`` action becomes the
-    flat Box of :class:`FlatActionWrapper`.
+    :class:`FlatObservationWrapper` (images scaled to [0, 1]); a ``Dict(motors, expression)``
+    action becomes the flat Box of :class:`FlatActionWrapper`, or, when the agent has no motors,
+    the ``Discrete`` expression of :class:`ExpressionActionWrapper`.
     """
     if isinstance(env_id_or_env, str):
         import mimo_social  # noqa: F401  (registers the ids)
@@ -264,7 +292,9 @@ def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
                         f"{type(env_id_or_env).__name__}")
     if not isinstance(env.observation_space, spaces.Box) or env.observation_space.dtype == np.uint8:
         env = FlatObservationWrapper(env)
-    if not isinstance(env.action_space, spaces.Box):
+    if is_expression_only(env.action_space):
+        env = ExpressionActionWrapper(env)
+    elif not isinstance(env.action_space, spaces.Box):
         env = FlatActionWrapper(env)
     return env
 
