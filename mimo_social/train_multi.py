@@ -157,7 +157,7 @@ def _motor_slicer(env) -> Callable[[str, np.ndarray], dict]:
         space = inner.action_space(a)
         motors = space["motors"] if hasattr(space, "spaces") and "motors" in space.spaces else space
         counts[a] = int(np.prod(motors.shape))
-    return lambda a, act: {"motors": np.asarray(act)[:counts[a]]}
+    return lambda a, act: {"motors": np.asarray(act).ravel()[:counts[a]]}
 
 
 def run_episode(policies: Mapping[str, Any], env, seed: int | None, deterministic: bool = True,

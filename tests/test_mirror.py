@@ -124,16 +124,17 @@ def test_partner_expression_only_in_the_eye_images():
 
 
 def test_flat_wrappers_work_with_the_empty_motor_box():
+    """A face-only agent's flat action is the expression id (Discrete(7)) in both wrappers."""
     flat = FlattenParallel(mirror_v0.parallel_env())
-    assert flat.action_space("infant_0").shape == (7,)
+    assert flat.action_space("infant_0") == spaces.Discrete(7)
     flat.reset(seed=0)
-    logits = np.full(7, -1.0, np.float32)
-    logits[3] = 1.0
-    _, rew, *_ = flat.step({a: logits for a in flat.agents})
+    _, rew, *_ = flat.step({a: 3 for a in flat.agents})
     assert rew["infant_0"] == 1.0
+    _, rew, *_ = flat.step({"infant_0": 3, "infant_1": 4})
+    assert rew["infant_0"] == 0.0
     single = make_sb3_single(SingleAgentEnv(mirror_v0.scripted_env()))
     assert isinstance(single.observation_space, spaces.Box)
-    assert single.action_space.shape == (7,)
+    assert single.action_space == spaces.Discrete(7)
     obs, _ = single.reset(seed=0)
     assert obs.shape == single.observation_space.shape
     obs, r, term, trunc, info = single.step(single.action_space.sample())

@@ -364,6 +364,21 @@ def test_scripted_mode_trains_and_evaluates_on_the_same_observations():
     assert a[1] == b[1]["infant_0"]
 
 
+def test_a_face_only_learner_trains_and_evaluates_with_a_discrete_expression(tmp_path):
+    """Mirror with its scripted partner: the learner's only action is its face, a Discrete(7)
+    in training and in evaluation alike."""
+    from mimo_social import train as train_mod
+    out = tmp_path / "mirror"
+    train_mod.train("mirror", "ppo", 128, 0, out, mode="scripted", eval_every=128,
+                    eval_episodes=1, checkpoint_every=0, progress=False,
+                    env_kwargs={"max_steps": 16},
+                    algo_kwargs={"n_steps": 64, "batch_size": 32, "n_epochs": 1})
+    res = train_mod.evaluate(out, episodes=1)
+    assert res["episodes"] == 1
+    flat = make_scripted_env("mirror", max_steps=16)
+    assert flat.action_space("infant_0").n == 7
+
+
 # -- bad input ----------------------------------------------------------------------------------
 def test_bad_mode_task_and_options_say_what_is_allowed(tmp_path, monkeypatch, capsys):
     with pytest.raises(TrainInputError, match="one agent"):

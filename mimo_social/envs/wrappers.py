@@ -7,6 +7,8 @@
     (``uint8``) scaled to [0, 1]. Each agent's action becomes one float32 ``Box``:
 
     * motors only (``expressions=False``): the motor ``Box`` itself, ``[-1, 1]^n``;
+    * a face-only agent (no motors, e.g. the mirror task's learner): ``Discrete(7)``, the
+      expression id;
     * with expressions: ``n`` motor values followed by 7 expression *logits* in ``[-1, 1]``; the
       expression played is ``argmax(logits)`` (ties go to the lowest id, so "neutral" wins when
       all logits are equal, e.g. all clipped to the same bound).
@@ -103,11 +105,20 @@ class _ActionDecoder:
     """Maps a flat float32 action onto an agent's action space of this package.
 
     Supported: a ``Box`` (returned reshaped), or ``Dict({"motors": Box, "expression": Discrete})``
-    (the Box holds the motors then one logit per expression).
+    (the Box holds the motors then one logit per expression; with no motors at all, the action
+    is the ``Discrete`` expression id itself).
     """
 
     def __init__(self, space: spaces.Space):
         self.source = space
+        self.discrete = is_expression_only(space)
+        if self.discrete:  # a face-only agent: its action is the expression id itself
+            expression = space["expression"]
+            self.n_motors, self.n_expressions = 0, int(expression.n)
+            self.expression_start = int(expression.start)
+            self._motors = np.zeros(space["motors"].shape, space["motors"].dtype)
+            self.space = spaces.Discrete(expression.n, start=expression.start)
+            return
         if isinstance(space, spaces.Box):
             self.n_motors = int(np.prod(space.shape))
             self.n_expressions = 0
@@ -132,6 +143,12 @@ class _ActionDecoder:
                                 dtype=np.float32)
 
     def __call__(self, action, who: str = "agent"):
+        if self.discrete:
+            e = np.asarray(action)
+            if e.size != 1 or not np.isfinite(e).all():
+                raise ValueError(f"{who}: a face-only agent's action is one expression id, got "
+                                 f"{action!r}")
+            return {"motors": self._motors, "expression": np.int64(int(e.ravel()[0]))}
         a = np.asarray(action, dtype=np.float32)
         if a.shape != self.space.shape:
             layout = (f"{self.n_motors} motors + {self.n_expressions} expression logits"
@@ -148,8 +165,9 @@ class _ActionDecoder:
                 "expression": np.int64(self.expression_start + int(np.argmax(logits)))}
 
 
-def flat_action_space(space: spaces.Space) -> spaces.Box:
-    """The float32 ``Box`` that :class:`FlattenParallel` accepts for an action space."""
+def flat_action_space(space: spaces.Space) -> spaces.Space:
+    """The float32 ``Box`` (``Discrete`` for a face-only agent) that :class:`FlattenParallel`
+    accepts for an action space."""
     return _ActionDecoder(space).space
 
 
