@@ -674,13 +674,14 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
     task = task or first["task"]
     if first.get("mode"):
         task = f"{task} ({first['mode']}, mean over agents)"
-    axes[0, 0].set_title(f"{task}: evaluation return (mean over seeds, min-max band)")
+    fig.suptitle(task)
+    axes[0, 0].set_title("evaluation return (mean over seeds, min-max band)", fontsize=10)
     axes[0, 0].set_xlabel("environment steps")
     axes[0, 0].set_ylabel("episode return")
     axes[0, 0].legend(loc="best", fontsize=8)
     axes[0, 0].grid(alpha=0.3)
     if has_success:
-        axes[0, 1].set_title(f"{task}: evaluation success rate")
+        axes[0, 1].set_title("evaluation success rate", fontsize=10)
         axes[0, 1].set_xlabel("environment steps")
         axes[0, 1].set_ylabel("success (%)")
         axes[0, 1].set_ylim(-5, 105)
