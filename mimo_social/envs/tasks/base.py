@@ -174,6 +174,18 @@ def face_to_face(i: int, distance: float) -> tuple[tuple[float, float], tuple[fl
     return pos, facing
 
 
+def geoms_touching(data, geom: int) -> np.ndarray:
+    """The geoms in active contact (distance <= 0) with ``geom`` this step (one gather over the
+    contacts, no loop)."""
+    n = data.ncon
+    if n == 0:
+        return np.zeros(0, dtype=np.intp)
+    c = data.contact
+    g1, g2 = c.geom1[:n], c.geom2[:n]
+    on = ((g1 == geom) | (g2 == geom)) & (c.dist[:n] <= 0.0)
+    return np.where(g1 == geom, g2, g1)[on]
+
+
 class ContactProbe:
     """Tells whether any active contact joins a geom of set a with a geom of set b.
 

@@ -21,7 +21,8 @@ from gymnasium import spaces
 
 from ...body.tables import load_body, subtree
 from ..world import AgentSetup, Prop
-from .base import GAZE_JOINTS, Gaze, Task, hand_geoms, held_posture, parts_outside
+from .base import (GAZE_JOINTS, Gaze, Task, geoms_touching, hand_geoms, held_posture,
+                   parts_outside)
 from .standup import settle
 
 ARM_DEG = {"right_shoulder_horizontal": 92.0, "right_shoulder_abduction": 44.0,
@@ -151,14 +152,9 @@ class Catch(Task):
 
     def _touching(self, d):
         """Body parts of the infant touching the ball, and whether the right hand does."""
-        n = d.ncon
-        if n == 0:
+        other = geoms_touching(d, self._ball_geom)
+        if not len(other):
             return 0, False
-        c = d.contact
-        g1, g2 = c.geom1[:n], c.geom2[:n]
-        ball = self._ball_geom
-        on = ((g1 == ball) | (g2 == ball)) & (c.dist[:n] <= 0.0)
-        other = np.where(g1 == ball, g2, g1)[on]
         mine = other[self._is_agent[other]]
         parts = len(np.unique(self._world.model.geom_bodyid[mine]))
         return parts, bool(np.any(self._is_hand[mine]))

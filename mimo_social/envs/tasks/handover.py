@@ -33,8 +33,8 @@ import numpy as np
 from ...body.tables import load_body
 from ...partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
 from ..world import AgentSetup, Prop
-from .base import (GAZE_JOINTS, Gaze, Task, check_number, hand_geoms, held_posture,
-                   parts_outside, right_arm_joints)
+from .base import (GAZE_JOINTS, Gaze, Task, check_number, geoms_touching, hand_geoms,
+                   held_posture, parts_outside, right_arm_joints)
 
 RECEIVER, GIVER = 0, 1
 PARKED = (0.2, 1.5, 0.5)             # where the ball is built (the reset moves it to the palm)
@@ -265,14 +265,9 @@ class Handover(Task):
     def _contacts(self, d):
         """Segments of the receiver's right hand touching the ball, and whether the giver's
         right hand touches it."""
-        n = d.ncon
-        if n == 0:
+        other = geoms_touching(d, self._ball_geom)
+        if not len(other):
             return 0, False
-        c = d.contact
-        g1, g2 = c.geom1[:n], c.geom2[:n]
-        ball = self._ball_geom
-        on = ((g1 == ball) | (g2 == ball)) & (c.dist[:n] <= 0.0)
-        other = np.where(g1 == ball, g2, g1)[on]
         whose = self._hand_of[other]
         parts = len(np.unique(self._geom_body[other[whose == RECEIVER]]))
         return parts, bool(np.any(whose == GIVER))
