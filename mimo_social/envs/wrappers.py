@@ -33,7 +33,7 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-__all__ = ["FlattenParallel", "FlatActionWrapper", "FlatObservationWrapper",
+__all__ = ["ParallelWrapper", "FlattenParallel", "FlatActionWrapper", "FlatObservationWrapper",
            "ExpressionActionWrapper", "is_expression_only", "make_sb3_single",
            "flat_action_space", "flat_observation_space"]
 
@@ -172,15 +172,41 @@ def flat_action_space(space: spaces.Space) -> spaces.Space:
 
 
 # -- the PettingZoo wrapper ---------------------------------------------------------------------
-class FlattenParallel(ParallelEnv):
-    """Box observations and Box actions for every agent of a ParallelEnv (see module docstring)."""
+class ParallelWrapper(ParallelEnv):
+    """Base of this package's ParallelEnv wrappers: holds ``env``, and passes ``unwrapped``,
+    ``metadata``, ``render_mode``, ``render``, ``close``, ``state`` and ``state_space`` on to it."""
 
     def __init__(self, env: ParallelEnv):
         if not isinstance(env, ParallelEnv):
-            raise TypeError(f"FlattenParallel wraps a pettingzoo ParallelEnv, got {type(env).__name__}")
+            raise TypeError(f"{type(self).__name__} wraps a pettingzoo ParallelEnv, got "
+                            f"{type(env).__name__}")
         self.env = env
         self.metadata = dict(getattr(env, "metadata", {}))
         self.render_mode = getattr(env, "render_mode", None)
+
+    @property
+    def unwrapped(self):
+        return self.env.unwrapped
+
+    def render(self):
+        return self.env.render()
+
+    def close(self):
+        return self.env.close()
+
+    def state(self):
+        return self.env.state()
+
+    def state_space(self, *args, **kwargs):
+        space = self.env.state_space
+        return space(*args, **kwargs) if callable(space) else space
+
+
+class FlattenParallel(ParallelWrapper):
+    """Box observations and Box actions for every agent of a ParallelEnv (see module docstring)."""
+
+    def __init__(self, env: ParallelEnv):
+        super().__init__(env)
         self.possible_agents = list(env.possible_agents)
         self._obs = {a: _ObsFlattener(env.observation_space(a)) for a in self.possible_agents}
         self._act = {a: _ActionDecoder(env.action_space(a)) for a in self.possible_agents}
@@ -191,10 +217,6 @@ class FlattenParallel(ParallelEnv):
     @property
     def agents(self):
         return self.env.agents
-
-    @property
-    def unwrapped(self):
-        return self.env.unwrapped
 
     def observation_space(self, agent):
         try:
@@ -226,18 +248,6 @@ class FlattenParallel(ParallelEnv):
         obs, rewards, terminations, truncations, infos = self.env.step(decoded)
         return self._flat_obs(obs), rewards, terminations, truncations, infos
 
-    def render(self):
-        return self.env.render()
-
-    def close(self):
-        return self.env.close()
-
-    def state(self):
-        return self.env.state()
-
-    def state_space(self, *args, **kwargs):
-        space = self.env.state_space
-        return space(*args, **kwargs) if callable(space) else space
 
     def __getattr__(self, name: str):
         # only public names, and never before __init__/__setstate__ has set ``env`` (pickling)

@@ -15,16 +15,16 @@ from typing import Any, Mapping
 import numpy as np
 from pettingzoo import ParallelEnv
 
+from ..envs.wrappers import ParallelWrapper
+
 from .base import Partner
 
 __all__ = ["ScriptedPartners"]
 
 
-class ScriptedPartners(ParallelEnv):
+class ScriptedPartners(ParallelWrapper):
     def __init__(self, env: ParallelEnv, partners: Mapping[str, Partner]):
-        if not isinstance(env, ParallelEnv):
-            raise TypeError(f"ScriptedPartners wraps a pettingzoo ParallelEnv, got "
-                            f"{type(env).__name__}")
+        super().__init__(env)
         if not isinstance(partners, Mapping) or not partners:
             raise ValueError("partners must be a non-empty mapping agent -> Partner, got "
                              f"{partners!r}")
@@ -39,20 +39,13 @@ class ScriptedPartners(ParallelEnv):
         learners = [a for a in env.possible_agents if a not in partners]
         if not learners:
             raise ValueError("every agent is scripted: leave at least one learner")
-        self.env = env
         self.partners = dict(partners)
         self.possible_agents = learners
-        self.metadata = dict(getattr(env, "metadata", {}))
-        self.render_mode = getattr(env, "render_mode", None)
         self._partner_obs: dict[str, Any] = {}
 
     @property
     def agents(self):
         return [a for a in self.env.agents if a not in self.partners]
-
-    @property
-    def unwrapped(self):
-        return self.env.unwrapped
 
     def observation_space(self, agent):
         self._check(agent)
@@ -100,15 +93,3 @@ class ScriptedPartners(ParallelEnv):
             infos[a] = dict(infos[a], partner_rewards=partner_rewards)
         return (self._split(obs), self._split(rewards), self._split(terms), self._split(truncs),
                 infos)
-
-    def render(self):
-        return self.env.render()
-
-    def close(self):
-        return self.env.close()
-
-    def state(self):
-        return self.env.state()
-
-    def state_space(self):
-        return self.env.state_space()
