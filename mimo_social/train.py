@@ -101,6 +101,13 @@ class TrainInputError(ValueError):
     """A task, mode or option that ``train`` / ``eval`` / ``compare`` cannot use (says why)."""
 
 
+def _json_default(value):
+    """config.json: a class (e.g. a features extractor in policy_kwargs) by its dotted name."""
+    if isinstance(value, type):
+        return f"{value.__module__}.{value.__qualname__}"
+    raise TypeError(f"not JSON serialisable: {value!r}")
+
+
 def _check_task(task: str) -> str:
     if task in MULTI_TASKS:
         return MULTI_TASKS[task]
@@ -289,7 +296,8 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           checkpoint_every: int | None = None, progress: bool = True,
           env_kwargs: Mapping[str, Any] | None = None,
           algo_kwargs: Mapping[str, Any] | None = None, verbose: int = 0,
-          mode: str | None = None, n_envs: int = 1, n_cpus: int = 0) -> dict:
+          mode: str | None = None, n_envs: int = 1, n_cpus: int = 0,
+          normalize_obs: bool = False) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
     time). See the module docstring for what it writes. ``mode`` (``shared``, ``independent``,
     ``scripted``; default ``shared``), ``n_envs`` and ``n_cpus`` (shared mode: worlds and worker
@@ -319,8 +327,12 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     kwargs = dict(algo_kwargs or {})
     if algo == "sac":
         kwargs.setdefault("buffer_size", min(1_000_000, steps))
+    if normalize_obs:  # running input statistics inside the policy (saved in model.zip)
+        from .obs_norm import RunningNorm
+        kwargs["policy_kwargs"] = {**kwargs.get("policy_kwargs", {}),
+                                   "features_extractor_class": RunningNorm}
     config = {"task": task, "env_id": _check_task(task), "algo": algo, "steps": steps,
-              "seed": seed,
+              "seed": seed, "normalize_obs": bool(normalize_obs),
               "env_kwargs": env_kwargs, "algo_kwargs": kwargs, "eval_every": eval_every,
               "eval_episodes": eval_episodes, "checkpoint_every": checkpoint_every}
     if mode is not None:
@@ -331,7 +343,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
                            progress=progress, env_kwargs=env_kwargs, algo_kwargs=kwargs,
                            n_envs=int(n_envs), n_cpus=int(n_cpus), verbose=verbose,
                            config=config)
-    (out / "config.json").write_text(json.dumps(config, indent=2))
+    (out / "config.json").write_text(json.dumps(config, indent=2, default=_json_default))
 
     venv = DummyVecEnv([lambda: Monitor(make_env(task, **env_kwargs))])
     eval_env = make_env(task, **env_kwargs)
@@ -343,7 +355,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     wall = time.perf_counter() - t0
     model.save(out / "model.zip")
     config.update({"wall_time_s": round(wall, 1), "timesteps_done": int(model.num_timesteps)})
-    (out / "config.json").write_text(json.dumps(config, indent=2))
+    (out / "config.json").write_text(json.dumps(config, indent=2, default=_json_default))
     venv.close()
     eval_env.close()
     last = cb.rows[-1]
@@ -726,6 +738,9 @@ def _common(p):
                    help="JSON keyword arguments for the env, e.g. '{\"max_steps\": 200}'")
     p.add_argument("--algo-kwargs", type=_json_arg, default={},
                    help="JSON keyword arguments for the SB3 algorithm (default: SB3's defaults)")
+    p.add_argument("--normalize-obs", action="store_true",
+                   help="normalise every observation input by running statistics inside the "
+                   "policy (mimo_social.obs_norm.RunningNorm; saved in the model): for eye images")
 
 
 def _train_main(args) -> int:
@@ -734,7 +749,7 @@ def _train_main(args) -> int:
                     eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                     checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
                     env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs, mode=args.mode,
-                    n_envs=args.n_envs, n_cpus=args.n_cpus)
+                    n_envs=args.n_envs, n_cpus=args.n_cpus, normalize_obs=args.normalize_obs)
     except TrainInputError as e:
         print(f"mimo-social train: {e}", file=sys.stderr)
         return 2
@@ -794,7 +809,8 @@ def _compare_run(args, algos):
     return compare(args.task, algos, args.seeds, args.steps, args.out, jobs=args.jobs,
                    plot_only=args.plot_only, mode=args.mode, eval_every=args.eval_every,
                    eval_episodes=args.eval_episodes, checkpoint_every=args.checkpoint_every,
-                   env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs)
+                   env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs,
+                   normalize_obs=args.normalize_obs)
 
 
 def add_parser(subparsers) -> None:

@@ -51,7 +51,7 @@ from typing import Any, Callable, Mapping
 import gymnasium as gym
 import numpy as np
 
-from .train import (MULTI_TASKS, TASKS, EvalOutputs, TrainInputError, _algo_class,
+from .train import (MULTI_TASKS, TASKS, EvalOutputs, TrainInputError, _algo_class, _json_default,
                     plot_learning_curve, write_progress)
 
 __all__ = ["MODES", "DEFAULT_MODE", "task_module", "check_mode", "make_parallel_env",
@@ -577,7 +577,7 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
         config["models"] = {a: f"model_{a}.zip" for a in agents}
     else:
         config["models"] = {a: "model.zip" for a in agents}
-    (out / "config.json").write_text(json.dumps(config, indent=2))
+    (out / "config.json").write_text(json.dumps(config, indent=2, default=_json_default))
     bar = None
     if progress:
         from tqdm import tqdm
@@ -604,7 +604,7 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
     wall = time.perf_counter() - t0
     timesteps = rows[-1]["timesteps"]
     config.update({"wall_time_s": round(wall, 1), "timesteps_done": int(timesteps)})
-    (out / "config.json").write_text(json.dumps(config, indent=2))
+    (out / "config.json").write_text(json.dumps(config, indent=2, default=_json_default))
     models_out = ({a: str(out / f"model_{a}.zip") for a in agents} if mode == "independent"
                   else {a: str(out / "model.zip") for a in agents})
     return {"out": str(out), "model": models_out[agents[0]], "models": models_out,

@@ -371,10 +371,16 @@ def test_a_face_only_learner_trains_and_evaluates_with_a_discrete_expression(tmp
     out = tmp_path / "mirror"
     train_mod.train("mirror", "ppo", 128, 0, out, mode="scripted", eval_every=128,
                     eval_episodes=1, checkpoint_every=0, progress=False,
-                    env_kwargs={"max_steps": 16},
+                    env_kwargs={"max_steps": 16}, normalize_obs=True,
                     algo_kwargs={"n_steps": 64, "batch_size": 32, "n_epochs": 1})
     res = train_mod.evaluate(out, episodes=1)
     assert res["episodes"] == 1
+    # the running input statistics were learnt from the training batches and saved in the model
+    from stable_baselines3 import PPO
+    from mimo_social.obs_norm import RunningNorm
+    norm = PPO.load(str(out / "model.zip"), device="cpu").policy.features_extractor
+    assert isinstance(norm, RunningNorm) and float(norm.count) >= 128
+    assert float(norm.var.max()) > 0 and float(norm.mean.abs().max()) > 0.1
     flat = make_scripted_env("mirror", max_steps=16)
     assert flat.action_space("infant_0").n == 7
 

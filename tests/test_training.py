@@ -260,3 +260,21 @@ def test_a_face_only_agent_learns_a_discrete_expression():
         assert world.expression_of(0) == face
     with pytest.raises(ValueError):
         env.step(7)
+
+
+def test_running_norm_learns_input_statistics_only_while_training():
+    from gymnasium import spaces
+    from mimo_social.obs_norm import RunningNorm
+    norm = RunningNorm(spaces.Box(-np.inf, np.inf, (3,), np.float32))
+    data = np.random.default_rng(0).normal([1, 5, -2], [0.1, 2, 3], (4000, 3)).astype(np.float32)
+    norm.train()
+    for k in range(0, 4000, 100):
+        norm(torch.tensor(data[k:k + 100]))
+    assert np.allclose(norm.mean.numpy(), data.mean(0), atol=1e-4)
+    assert np.allclose(np.sqrt(norm.var.numpy()), data.std(0), rtol=1e-3)
+    out = norm(torch.tensor(data)).numpy()
+    assert np.allclose(out.mean(0), 0, atol=1e-2) and np.allclose(out.std(0), 1, atol=1e-2)
+    norm.eval()                                   # acting / evaluating: statistics stay
+    before = norm.mean.clone()
+    norm(torch.tensor(data[:10] + 100))
+    assert torch.equal(before, norm.mean)
