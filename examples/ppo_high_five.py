@@ -16,7 +16,7 @@ def main() -> None:
     from stable_baselines3 import PPO
 
     from mimo_social.envs import high_five_v0
-    from mimo_social.envs.vector import sb3_vec_env
+    from mimo_social.train.vector import sb3_vec_env
 
     parser = argparse.ArgumentParser()
     parser.add_argument("--steps", type=int, default=20000)
@@ -28,7 +28,7 @@ def main() -> None:
     model.learn(total_timesteps=args.steps, progress_bar=False)
     # evaluate: distance of the right hands at the end of one episode
     env = high_five_v0.parallel_env(expressions=False)
-    from mimo_social.envs.wrappers import FlattenParallel
+    from mimo_social.core.wrappers import FlattenParallel
     flat = FlattenParallel(env)
     obs, _ = flat.reset(seed=123)
     infos = {}

@@ -1,19 +1,19 @@
-"""mimo_social: several MIMo infants in one MuJoCo world.
+"""mimo_social: several MIMo infants (and caregivers) in one MuJoCo world.
 
-PettingZoo envs in :mod:`mimo_social.envs` (``free_play_v0``, ``high_five_v0``, ``mirror_v0``,
-``joint_attention_v0``, ``social_touch_v0``, ``handover_v0`` and the one-agent ``reach_v0``,
-``standup_v0``, ``selfbody_v0``, ``catch_v0``), scripted partners in
-:mod:`mimo_social.partners`. Importing the package chooses a headless OpenGL backend when none is
-set (see :mod:`mimo_social.rendering`) and registers the Gymnasium ids ``mimo_social/Reach-v0``,
-``mimo_social/Standup-v0``, ``mimo_social/SelfBody-v0`` and ``mimo_social/Catch-v0``.
+Importing the package chooses a headless OpenGL backend when none is set
+(:mod:`mimo_social.render.gl`) and registers every Gymnasium id of the catalogue
+(:mod:`mimo_social.envs.catalog`). The envs (PettingZoo module, Gymnasium id, kind):
+
 """
 
-from .rendering import choose_gl_backend as _choose_gl_backend
+from .render.gl import choose_gl_backend as _choose_gl_backend
 
 _choose_gl_backend()
 
-from .envs.registration import register_envs as _register_envs  # noqa: E402
+from .envs.catalog import describe as _describe, register_envs as _register_envs  # noqa: E402
 
 _register_envs()
+if __doc__:  # None under python -OO
+    __doc__ += _describe() + "\n"
 
 __version__ = "0.1.0"

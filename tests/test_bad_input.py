@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import free_play_v0, high_five_v0
-from mimo_social.envs.config import ConfigError
+from mimo_social.core.config import ConfigError
 
 
 @pytest.fixture

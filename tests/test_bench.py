@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from mimo_social import bench
+from mimo_social.bench import suite as bench
 
 TOP_KEYS = {"machine", "settings", "cold_start", "results"}
 ENTRY_KEYS = {"name", "n_agents", "real_s_per_sim_s", "build_s", "components"}

@@ -31,7 +31,7 @@ def test_standing_height_is_77_8_cm():
     # straighten every joint to measure the standing height with the head upright
     d.qpos[a.qpos_adr] = 0.0
     mujoco.mj_kinematics(m, d)
-    from mimo_social.envs.world import _support_below
+    from mimo_social.core.world import _support_below
     top = d.geom_xpos[a.head_geom, 2] + m.geom_size[a.head_geom, 0]
     bottom = _support_below(m, d, a.geom_ids).min()
     assert top - bottom == pytest.approx(0.778, abs=0.004)

@@ -7,8 +7,8 @@ from gymnasium.utils.env_checker import check_env
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import handover_v0
-from mimo_social.envs.single import SingleAgentEnv
-from mimo_social.envs.tasks.handover import OFFER_TARGET
+from mimo_social.core.gym_adapter import SingleAgentEnv
+from mimo_social.tasks.handover import OFFER_TARGET
 from mimo_social.partners import ScriptedPartners, zero_action
 from mimo_social.partners.hand_offer import HandOffer
 

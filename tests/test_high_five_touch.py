@@ -6,9 +6,9 @@ import pytest
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import high_five_v0
-from mimo_social.envs.config import ConfigError
-from mimo_social.envs.tasks.high_five import hand_touch, touch_system
-from mimo_social.envs.tasks.standup import reach_sites
+from mimo_social.core.config import ConfigError
+from mimo_social.tasks.high_five import hand_touch, touch_system
+from mimo_social.tasks.standup import reach_sites
 from mimo_social.partners import Still
 from mimo_social.partners.hand_offer import HandOffer
 

@@ -6,8 +6,8 @@ from gymnasium import spaces
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import mirror_v0
-from mimo_social.envs.single import SingleAgentEnv
-from mimo_social.envs.wrappers import FlattenParallel, make_sb3_single
+from mimo_social.core.gym_adapter import SingleAgentEnv
+from mimo_social.core.wrappers import FlattenParallel, make_sb3_single
 from mimo_social.expressions.faces import EXPRESSIONS
 from mimo_social.partners import Partner
 from mimo_social.partners.expression import ExpressionShow

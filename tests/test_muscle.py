@@ -11,9 +11,9 @@ import mimo_social  # noqa: F401  (headless GL before mujoco renders)
 from mimo_social.body.actuation import MODELS, Muscle
 from mimo_social.body.actuation import muscle as M
 from mimo_social.body.tables import load_body
-from mimo_social.calibration import calibrate_vmax, measure_fmax, static_scene
+from mimo_social.experiments.calibration import calibrate_vmax, measure_fmax, static_scene
 from mimo_social.cli import main as cli_main
-from mimo_social.compliance import run_compliance
+from mimo_social.experiments.compliance import run_compliance
 from mimo_social.envs import free_play_v0
 
 
@@ -296,7 +296,7 @@ def test_mujoco_actuator_carries_the_muscle_torque():
 def test_speed_command_measures_the_issue_figures(capsys):
     """One five-fingered infant, physics only: <= 0.15 real s per simulated s (the issue's
     figure; measured 0.04-0.05 here); the muscle model's own cost per physics step."""
-    from mimo_social.calibration import measure_speed
+    from mimo_social.experiments.calibration import measure_speed
 
     r = measure_speed("five_fingers", seconds=1.0)
     # wall-clock figures depend on the machine's load: the command reports them, the test only

@@ -5,7 +5,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from mimo_social.envs import high_five_v0
-from mimo_social.envs.single import SingleAgentEnv
+from mimo_social.core.gym_adapter import SingleAgentEnv
 from mimo_social.partners import Partner, ScriptedPartners, Still, zero_action
 
 

@@ -1,4 +1,4 @@
-"""Rerun recordings (`mimo_social.replay`) and the `demo` subcommand, checked by reading the .rrd
+"""Rerun recordings (`mimo_social.recording.recorder`) and the `demo` subcommand, checked by reading the .rrd
 files back with Rerun's own reader (`rerun.chunk.RrdReader`)."""
 
 import argparse
@@ -15,10 +15,11 @@ import pytest
 import rerun.blueprint as rrb
 from rerun.chunk import RrdReader
 
-from mimo_social import demo
+from mimo_social.experiments import demo
 from mimo_social.envs import free_play_v0
 from mimo_social.expressions.faces import EXPRESSIONS, face_image
-from mimo_social.replay import HIDDEN_GEOM_GROUP, SKIN_POINT_RADIUS, Recorder, record_episode
+from mimo_social.recording.recorder import (HIDDEN_GEOM_GROUP, SKIN_POINT_RADIUS, Recorder,
+                                            record_episode)
 
 N_STEPS = 50
 CHANGE_STEP = 20          # infant_1 turns happy at this step (1-based env.step count)
@@ -291,9 +292,9 @@ def test_misuse_is_reported(env, tmp_path):
 
 
 def test_single_agent_adapter(tmp_path):
-    from mimo_social.envs.single import make_reach
+    import gymnasium as gym
 
-    genv = make_reach()
+    genv = gym.make("mimo_social/Reach-v0").unwrapped
     path = tmp_path / "single.rrd"
     with Recorder(genv, path) as rec:
         genv.reset(seed=0)
@@ -334,8 +335,8 @@ def test_demo_noise_is_smooth_and_seeded():
 
 
 def test_demo_subcommand_writes_a_readable_recording(tmp_path, capsys):
-    if importlib.util.find_spec("mimo_social.bench") is None:
-        pytest.skip("mimo_social.cli also needs mimo_social.bench, which is not there yet")
+    if importlib.util.find_spec("mimo_social.bench.suite") is None:
+        pytest.skip("mimo_social.cli also needs mimo_social.bench.suite, which is not there yet")
     from mimo_social.cli import main
 
     path = tmp_path / "sub" / "demo.rrd"
@@ -404,7 +405,7 @@ def zero_actions(env, expression=0):
 
 
 def test_png_encoder_round_trips_every_byte():
-    from mimo_social.replay import encode_png
+    from mimo_social.recording.recorder import encode_png
 
     rng = np.random.default_rng(0)
     for shape in ((5, 7, 3), (64, 64, 3), (3, 4)):
@@ -582,7 +583,7 @@ def touch_episode(tmp_path_factory):
 
 
 def test_skin_points_with_force_every_step_in_world_coordinates(touch_episode):
-    from mimo_social.replay import force_colors
+    from mimo_social.recording.recorder import force_colors
 
     data, views = touch_episode["data"], touch_episode["views"]
     for agent, view in views.items():
@@ -610,7 +611,7 @@ def test_skin_points_with_force_every_step_in_world_coordinates(touch_episode):
 
 
 def test_force_colours_go_from_yellow_to_dark_red():
-    from mimo_social.replay import force_colors
+    from mimo_social.recording.recorder import force_colors
 
     colors = force_colors(np.array([0.0, 0.1, 1.0, 100.0]))
     rgb = [[(int(c) >> s) & 0xFF for s in (24, 16, 8, 0)] for c in colors]
@@ -724,7 +725,7 @@ def hip_steps(path) -> list[int]:
 def test_recording_wrapper_records_every_kth_episode_and_pickles(tmp_path):
     import pickle
 
-    from mimo_social.replay import RecordingParallelEnv
+    from mimo_social.recording.recorder import RecordingParallelEnv
 
     env = RecordingParallelEnv(free_play_v0.parallel_env(n_agents=2, max_steps=4),
                                tmp_path / "ep{episode:02d}.rrd", every_k_episodes=2)
@@ -767,8 +768,8 @@ def _high_five_short():
 def test_vector_env_records_every_kth_episode_of_sub_env_0_only(tmp_path, n_cpus):
     pytest.importorskip("stable_baselines3")
     pytest.importorskip("supersuit")
-    from mimo_social.envs.vector import sb3_vec_env
-    from mimo_social.replay import recording_env_fn
+    from mimo_social.train.vector import sb3_vec_env
+    from mimo_social.recording.recorder import recording_env_fn
 
     env_fn = recording_env_fn(_high_five_short, str(tmp_path / "ep{episode:03d}.rrd"),
                               every_k_episodes=2)
@@ -797,7 +798,7 @@ import os, signal, sys
 import numpy as np
 import mimo_social
 from mimo_social.envs import free_play_v0
-from mimo_social.replay import Recorder
+from mimo_social.recording.recorder import Recorder
 
 env = free_play_v0.parallel_env(n_agents=2, max_steps=10**9)
 obs, _ = env.reset(seed=0)

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from mimo_social import cli, replay_cli
+from mimo_social import cli
+from mimo_social.cli import replay as replay_cli
 from mimo_social.envs import free_play_v0, high_five_v0
-from mimo_social.replay import Recorder
+from mimo_social.recording.recorder import Recorder
 
 N_STEPS = 90
 
@@ -183,7 +184,7 @@ def test_missing_or_unreadable_files_are_reported(tmp_path, capsys):
 
 
 def test_subcommand_is_registered():
-    assert "replay_cli" in cli.SUBCOMMAND_MODULES
+    assert replay_cli in cli.SUBCOMMANDS
     args = cli.build_parser().parse_args(["replay", "x.rrd", "--summary"])
     assert (args.file, args.summary, args.func) == ("x.rrd", True, replay_cli.run)
 

@@ -15,8 +15,8 @@ from mimo_social.body.actuation import Muscle, SpringDamper
 from mimo_social.body.builder import build_infant
 from mimo_social.body.tables import load_body
 from mimo_social.envs import free_play_v0
-from mimo_social.envs.config import AgentConfig, ConfigError, PhysicsConfig
-from mimo_social.envs.world import AgentSetup, World, _support_below
+from mimo_social.core.config import AgentConfig, ConfigError, PhysicsConfig
+from mimo_social.core.world import AgentSetup, World, _support_below
 
 MODEL_ARRAYS = ("body_pos", "body_quat", "body_mass", "body_inertia", "body_ipos", "geom_size",
                 "geom_pos", "geom_friction", "jnt_pos", "jnt_range", "jnt_stiffness",

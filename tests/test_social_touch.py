@@ -6,9 +6,9 @@ import pytest
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import social_touch_v0
-from mimo_social.envs.tasks.base import hand_geoms
-from mimo_social.envs.tasks.high_five import touch_system
-from mimo_social.envs.tasks.standup import reach_sites
+from mimo_social.core.task import hand_geoms
+from mimo_social.tasks.high_five import touch_system
+from mimo_social.tasks.standup import reach_sites
 from mimo_social.partners import Still
 
 MITTEN_TARGETS = ("head", "upper_body", "lower_body", "left_upper_arm", "left_lower_arm",

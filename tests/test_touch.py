@@ -16,10 +16,10 @@ import mimo_social  # noqa: F401
 from mimo_social.body.postures import POSTURES
 from mimo_social.body.tables import load_body
 from mimo_social.envs import free_play_v0
-from mimo_social.envs.config import ConfigError
-from mimo_social.envs.parallel import MimoParallelEnv
-from mimo_social.envs.tasks.base import Task, held_posture
-from mimo_social.envs.world import AgentSetup, Prop
+from mimo_social.core.config import ConfigError
+from mimo_social.core.env import MimoParallelEnv
+from mimo_social.core.task import Task, held_posture
+from mimo_social.core.world import AgentSetup, Prop
 from mimo_social.senses import skin as skin_module
 from mimo_social.senses.touch import hand_ball_scene, save_skin_png
 

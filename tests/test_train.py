@@ -10,7 +10,7 @@ import pytest
 import torch
 
 from mimo_social import cli
-from mimo_social.train import compare, evaluate, read_progress, train
+from mimo_social.train.runner import compare, evaluate, read_progress, train
 
 torch.set_num_threads(1)
 

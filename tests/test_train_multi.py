@@ -9,12 +9,13 @@ import numpy as np
 import pytest
 import torch
 
-from mimo_social import cli, train as train_mod
+from mimo_social import cli
+from mimo_social.train import runner as train_mod
 from mimo_social.envs import high_five_v0
-from mimo_social.envs.single import SingleAgentEnv
-from mimo_social.envs.wrappers import make_sb3_single
-from mimo_social.train import TrainInputError, compare, evaluate, read_progress, train
-from mimo_social.train_multi import (Lockstep, LockstepAborted, LockstepError, run_lockstep,
+from mimo_social.core.gym_adapter import SingleAgentEnv
+from mimo_social.core.wrappers import make_sb3_single
+from mimo_social.train.runner import TrainInputError, compare, evaluate, read_progress, train
+from mimo_social.train.multi import (Lockstep, LockstepAborted, LockstepError, run_lockstep,
                                      make_parallel_env, make_scripted_env, task_module)
 
 torch.set_num_threads(1)
@@ -333,7 +334,7 @@ def test_lockstep_learners_with_different_step_budgets_get_a_clear_error(budgets
 @pytest.mark.timeout(90)
 def test_independent_training_with_a_failing_evaluation_raises_instead_of_hanging(
         tmp_path, monkeypatch):
-    from mimo_social import train_multi
+    from mimo_social.train import multi as train_multi
 
     def broken(*args, **kwargs):
         raise RuntimeError("evaluation broke")
@@ -367,7 +368,7 @@ def test_scripted_mode_trains_and_evaluates_on_the_same_observations():
 def test_a_face_only_learner_trains_and_evaluates_with_a_discrete_expression(tmp_path):
     """Mirror with its scripted partner: the learner's only action is its face, a Discrete(7)
     in training and in evaluation alike."""
-    from mimo_social import train as train_mod
+    from mimo_social.train import runner as train_mod
     out = tmp_path / "mirror"
     train_mod.train("mirror", "ppo", 128, 0, out, mode="scripted", eval_every=128,
                     eval_episodes=1, checkpoint_every=0, progress=False,
@@ -377,7 +378,7 @@ def test_a_face_only_learner_trains_and_evaluates_with_a_discrete_expression(tmp
     assert res["episodes"] == 1
     # the running input statistics were learnt from the training batches and saved in the model
     from stable_baselines3 import PPO
-    from mimo_social.obs_norm import RunningNorm
+    from mimo_social.train.obs_norm import RunningNorm
     norm = PPO.load(str(out / "model.zip"), device="cpu").policy.features_extractor
     assert isinstance(norm, RunningNorm) and float(norm.count) >= 128
     assert float(norm.var.max()) > 0 and float(norm.mean.abs().max()) > 0.1

@@ -10,8 +10,8 @@ from pettingzoo.test import parallel_api_test
 from stable_baselines3 import PPO
 
 from mimo_social.envs import high_five_v0, reach_v0
-from mimo_social.envs.vector import sb3_vec_env
-from mimo_social.envs.wrappers import FlattenParallel, make_sb3_single
+from mimo_social.train.vector import sb3_vec_env
+from mimo_social.core.wrappers import FlattenParallel, make_sb3_single
 
 torch.set_num_threads(1)
 
@@ -219,7 +219,7 @@ def test_ppo_with_spawn_workers():
 def test_flat_observations_scale_eye_images_to_unit_range():
     """Learners get eye pixels in [0, 1] (raw 0-255 values saturate an MLP's first layer)."""
     from mimo_social.envs import mirror_v0
-    from mimo_social.envs.single import SingleAgentEnv
+    from mimo_social.core.gym_adapter import SingleAgentEnv
     env = mirror_v0.parallel_env()
     flat = FlattenParallel(env)
     raw, _ = env.reset(seed=0)
@@ -249,7 +249,7 @@ def test_a_face_only_agent_learns_a_discrete_expression():
     """The mirror learner has no motors: its SB3 action is the expression id itself."""
     from gymnasium import spaces
     from mimo_social.envs import mirror_v0
-    from mimo_social.envs.single import SingleAgentEnv
+    from mimo_social.core.gym_adapter import SingleAgentEnv
     single = SingleAgentEnv(mirror_v0.scripted_env())
     env = make_sb3_single(single)
     assert env.action_space == spaces.Discrete(7)
@@ -264,7 +264,7 @@ def test_a_face_only_agent_learns_a_discrete_expression():
 
 def test_running_norm_learns_input_statistics_only_while_training():
     from gymnasium import spaces
-    from mimo_social.obs_norm import RunningNorm
+    from mimo_social.train.obs_norm import RunningNorm
     norm = RunningNorm(spaces.Box(-np.inf, np.inf, (3,), np.float32))
     data = np.random.default_rng(0).normal([1, 5, -2], [0.1, 2, 3], (4000, 3)).astype(np.float32)
     norm.train()

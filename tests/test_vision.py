@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import free_play_v0
-from mimo_social.senses import eye_renderer
-from mimo_social.senses.vision import (anaglyph, eye_images, render_now, save_anaglyph,
-                                       vision_system)
+from mimo_social.render import eye_renderer
+from mimo_social.senses.vision import anaglyph, eye_images, render_now, save_anaglyph, vision_system
 
 S = 64
 
@@ -314,7 +313,7 @@ VEC_SCRIPT = textwrap.dedent("""
     import numpy as np
     import mimo_social
     from mimo_social.envs import free_play_v0
-    from mimo_social.envs.vector import sb3_vec_env
+    from mimo_social.train.vector import sb3_vec_env
 
     if __name__ == "__main__":
         fn = functools.partial(free_play_v0.parallel_env, n_agents=2,

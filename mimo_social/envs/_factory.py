@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pettingzoo.utils.conversions import parallel_to_aec
 
-from .parallel import MimoParallelEnv
+from ..core.env import MimoParallelEnv
 
 TASK_ARGS = ("physics", "per_agent", "render_mode", "max_steps", "render_size")
 

@@ -1,11 +1,11 @@
 """`free_play_v0`: the free play task as a PettingZoo env (see :mod:`.tasks.free_play` for the table).
 
 ``parallel_env(n_agents=..., task_options={...}, physics={...}, per_agent=[...], **agent_settings)``
-returns a :class:`~mimo_social.envs.parallel.MimoParallelEnv`; ``env(...)`` the AEC version.
+returns a :class:`~mimo_social.core.env.MimoParallelEnv`; ``env(...)`` the AEC version.
 """
 
 from ._factory import make_aec, make_parallel
-from .tasks.free_play import FreePlay
+from ..tasks.free_play import FreePlay
 
 __all__ = ["parallel_env", "env", "FreePlay"]
 

@@ -1,14 +1,14 @@
 """`handover_v0`: the handover task as a PettingZoo env (see :mod:`.tasks.handover` for the table).
 
 ``parallel_env(n_agents=2, task_options={...}, physics={...}, per_agent=[...], **agent_settings)``
-returns a :class:`~mimo_social.envs.parallel.MimoParallelEnv`; ``env(...)`` the AEC version;
+returns a :class:`~mimo_social.core.env.MimoParallelEnv`; ``env(...)`` the AEC version;
 ``scripted_env(partner=None, **kwargs)`` a one-learner env: the receiver ``infant_0`` learns and
 the giver ``infant_1`` is a scripted :class:`~mimo_social.partners.hand_offer.HandOffer` (its
 offer target follows the ``offer_target`` task option) unless another partner is given.
 """
 
 from ._factory import make_aec, make_parallel
-from .tasks.handover import OFFER_TARGET, Handover
+from ..tasks.handover import OFFER_TARGET, Handover
 
 __all__ = ["parallel_env", "env", "scripted_env", "Handover"]
 

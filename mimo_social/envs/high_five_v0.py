@@ -1,7 +1,7 @@
 """`high_five_v0`: the high five task as a PettingZoo env (see :mod:`.tasks.high_five` for the table).
 
 ``parallel_env(n_agents=..., task_options={...}, physics={...}, per_agent=[...], **agent_settings)``
-returns a :class:`~mimo_social.envs.parallel.MimoParallelEnv`; ``env(...)`` the AEC version;
+returns a :class:`~mimo_social.core.env.MimoParallelEnv`; ``env(...)`` the AEC version;
 ``scripted_env(partner=None, **kwargs)`` a one-learner env (``infant_0`` learns) whose partner
 ``infant_1`` is driven by a scripted :class:`~mimo_social.partners.Partner` (by default one that
 offers its right hand: :func:`default_partner`).
@@ -13,9 +13,9 @@ another density.
 
 from pettingzoo.utils.conversions import parallel_to_aec
 
-from .parallel import MimoParallelEnv
-from .tasks import high_five as _task
-from .tasks.high_five import HighFive, hand_touch, hands_of
+from ..core.env import MimoParallelEnv
+from ..tasks import high_five as _task
+from ..tasks.high_five import HighFive, hand_touch, hands_of
 
 __doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
 

@@ -1,7 +1,7 @@
 """`joint_attention_v0`: gaze following as a PettingZoo env (see :mod:`.tasks.joint_attention`).
 
 ``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns
-a :class:`~mimo_social.envs.parallel.MimoParallelEnv` with two learners (both see, both get the
+a :class:`~mimo_social.core.env.MimoParallelEnv` with two learners (both see, both get the
 shared reward); ``env(...)`` the AEC version; ``scripted_env(partner=None, **kwargs)`` a
 one-learner env (``infant_0`` learns) whose partner ``infant_1`` is driven by a scripted
 :class:`~mimo_social.partners.Partner`, by default
@@ -10,7 +10,7 @@ one-learner env (``infant_0`` learns) whose partner ``infant_1`` is driven by a 
 """
 
 from ._factory import make_aec, make_parallel
-from .tasks.joint_attention import JointAttention
+from ..tasks.joint_attention import JointAttention
 
 __all__ = ["parallel_env", "env", "scripted_env", "JointAttention"]
 

@@ -1,7 +1,7 @@
 """`mirror_v0`: facial mimicry as a PettingZoo env (see :mod:`.tasks.mirror` for the table).
 
 ``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns
-a :class:`~mimo_social.envs.parallel.MimoParallelEnv` with two learners (both see, both are
+a :class:`~mimo_social.core.env.MimoParallelEnv` with two learners (both see, both are
 rewarded for matching); ``env(...)`` the AEC version; ``scripted_env(partner=None, **kwargs)``
 a one-learner env (``infant_0`` learns) whose partner ``infant_1`` is driven by a scripted
 :class:`~mimo_social.partners.Partner`, by default
@@ -10,7 +10,7 @@ is set: the partner has no eyes and no reward).
 """
 
 from ._factory import make_aec, make_parallel
-from .tasks.mirror import Mirror
+from ..tasks.mirror import Mirror
 
 __all__ = ["parallel_env", "env", "scripted_env", "Mirror"]
 

@@ -1,11 +1,11 @@
 """`reach_v0`: the reach task as a PettingZoo env (see :mod:`.tasks.reach` for the table).
 
 ``parallel_env(n_agents=..., task_options={...}, physics={...}, per_agent=[...], **agent_settings)``
-returns a :class:`~mimo_social.envs.parallel.MimoParallelEnv`; ``env(...)`` the AEC version.
+returns a :class:`~mimo_social.core.env.MimoParallelEnv`; ``env(...)`` the AEC version.
 """
 
 from ._factory import make_aec, make_parallel
-from .tasks.reach import Reach
+from ..tasks.reach import Reach
 
 __all__ = ["parallel_env", "env", "Reach"]
 

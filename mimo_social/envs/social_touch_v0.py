@@ -1,7 +1,7 @@
 """`social_touch_v0`: the social touch task as a PettingZoo env (see :mod:`.tasks.social_touch`).
 
 ``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns a
-:class:`~mimo_social.envs.parallel.MimoParallelEnv` with the toucher ``infant_0`` and the touched
+:class:`~mimo_social.core.env.MimoParallelEnv` with the toucher ``infant_0`` and the touched
 infant ``infant_1`` (both learners); ``env(...)`` the AEC version; ``scripted_env(partner=None,
 **kwargs)`` a one-learner env in which ``infant_0`` learns to touch and ``infant_1`` is driven by
 a scripted :class:`~mimo_social.partners.Partner` (default :class:`~mimo_social.partners.Still`:
@@ -14,10 +14,10 @@ toucher's right hand and the touched infant's target parts keep their skin.
 
 from pettingzoo.utils.conversions import parallel_to_aec
 
-from .parallel import MimoParallelEnv
-from .tasks import social_touch as _task
-from .tasks.high_five import hands_of
-from .tasks.social_touch import DEFAULT_TARGETS, SocialTouch
+from ..core.env import MimoParallelEnv
+from ..tasks import social_touch as _task
+from ..tasks.high_five import hands_of
+from ..tasks.social_touch import DEFAULT_TARGETS, SocialTouch
 
 __doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
 

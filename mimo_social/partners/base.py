@@ -14,7 +14,7 @@ import numpy as np
 from gymnasium import spaces
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..envs.parallel import MimoParallelEnv
+    from ..core.env import MimoParallelEnv
 
 __all__ = ["Partner", "Still", "zero_action"]
 
@@ -35,7 +35,7 @@ class Partner:
     """Base class of scripted partners.
 
     ``reset(env, agent, rng)`` is called after every env reset (``env`` is the
-    :class:`~mimo_social.envs.parallel.MimoParallelEnv`, ``agent`` the partner's name, ``rng``
+    :class:`~mimo_social.core.env.MimoParallelEnv`, ``agent`` the partner's name, ``rng``
     a generator seeded from the reset seed); ``act(env, agent, observation)`` returns the
     agent's action for the next step, in ``env.action_space(agent)``.
     """

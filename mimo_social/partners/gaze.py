@@ -4,7 +4,7 @@ Every ``hold_s`` seconds (a time drawn uniformly from the range) it picks anothe
 random (never the same twice in a row) and turns to it with its own motors: a PD law with
 compensation of gravity, springs and any force the task applies drives its head (swivel, tilt; sideways tilt to 0) and eye
 joints (horizontal, vertical; torsion to 0) from their current angles to the angles that look at
-the target. Those angles come from the same geometry as :class:`~mimo_social.envs.tasks.base.Gaze`
+the target. Those angles come from the same geometry as :class:`~mimo_social.core.task.Gaze`
 (the head turns, swivel then tilt, to face the target from the neck; each eye then turns,
 horizontal then vertical, to look at it from its own centre), computed on a private copy of the
 state: the partner never writes the world's ``qpos``, so its head turn is physical (it takes

@@ -31,7 +31,7 @@ from typing import Mapping
 import mujoco
 import numpy as np
 
-from ..envs.tasks.base import check_number
+from ..core.task import check_number
 from .base import Partner, zero_action
 
 __all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]
@@ -272,7 +272,7 @@ class HandOffer(Partner):
             if self.prop not in w.prop_bodies:
                 raise ValueError(f"HandOffer: prop {self.prop!r} is not in this env; props: "
                                  f"{sorted(w.prop_bodies)}")
-            from ..envs.tasks.base import hand_geoms
+            from ..core.task import hand_geoms
             self._object_geom = int(np.flatnonzero(m.geom_bodyid == w.prop_bodies[self.prop])[0])
             self._others = np.zeros(m.ngeom, bool)
             for j in range(len(w.agents)):

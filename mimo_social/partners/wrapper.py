@@ -1,9 +1,9 @@
 """``ScriptedPartners(env, {"infant_1": ExpressionShow()})``: some agents driven by scripts.
 
-A PettingZoo ParallelEnv around a :class:`~mimo_social.envs.parallel.MimoParallelEnv` whose
+A PettingZoo ParallelEnv around a :class:`~mimo_social.core.env.MimoParallelEnv` whose
 agents are only the learners; every scripted agent's action is filled in by its
 :class:`~mimo_social.partners.base.Partner` each step. With one learner left, the result can be
-wrapped by :class:`~mimo_social.envs.single.SingleAgentEnv` for Gymnasium / SB3. Each learner's
+wrapped by :class:`~mimo_social.core.gym_adapter.SingleAgentEnv` for Gymnasium / SB3. Each learner's
 info gets ``partner_rewards`` (the scripted agents' rewards of the step), so a cooperative task
 can be judged from both sides.
 """
@@ -15,7 +15,7 @@ from typing import Any, Mapping
 import numpy as np
 from pettingzoo import ParallelEnv
 
-from ..envs.wrappers import ParallelWrapper
+from ..core.wrappers import ParallelWrapper
 
 from .base import Partner
 

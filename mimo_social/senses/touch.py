@@ -1,6 +1,6 @@
 """Touch (paper Sec. V-C): a full-body skin of force sensors on every infant, infant-to-infant too.
 
-Turn it on with ``touch=True`` or a mapping of :class:`~mimo_social.envs.config.TouchConfig`
+Turn it on with ``touch=True`` or a mapping of :class:`~mimo_social.core.config.TouchConfig`
 settings (``density``, ``response``, ``frame``, ``normal_only``, ``exclude``, ``cache``), for all
 agents or per agent (``per_agent=[...]``).
 
@@ -61,7 +61,7 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from ..envs.config import ConfigError, TouchConfig
+from ..core.config import ConfigError, TouchConfig
 from .skin import GRID_CELL, Skin, build_skin
 
 __all__ = ["build_touch", "TouchSystem", "AgentTouch", "save_skin_png", "hand_ball_scene",
@@ -568,10 +568,10 @@ def hand_ball_scene(steps: int = 100, touch: dict | bool = True, ball_radius: fl
     """
     from ..body.postures import POSTURES
     from ..body.tables import load_body
-    from ..envs.parallel import MimoParallelEnv
-    from ..envs.tasks.base import held_posture
-    from ..envs.tasks.free_play import FreePlay
-    from ..envs.world import AgentSetup, Prop
+    from ..core.env import MimoParallelEnv
+    from ..core.task import held_posture
+    from ..tasks.free_play import FreePlay
+    from ..core.world import AgentSetup, Prop
 
     class HoldBall(FreePlay):
         def setup(self, i, config):

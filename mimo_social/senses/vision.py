@@ -40,7 +40,7 @@ from typing import Sequence
 import numpy as np
 from gymnasium import spaces
 
-from .eye_renderer import Tile, TileRenderer
+from ..render.eye_renderer import Tile, TileRenderer
 
 __all__ = ["VisionSystem", "VisionSense", "build_vision", "vision_system", "eye_images",
            "render_now", "anaglyph", "save_anaglyph", "write_png", "EYES"]
@@ -260,7 +260,7 @@ BENCH_VARIANTS = {
 
 def _bench_states(n_agents: int, n_steps: int, seed: int = 0):
     """A world and ``n_steps`` of its qpos under gentle smooth random actions (standing)."""
-    from ..bench import smooth_random_actions
+    from ..bench.suite import smooth_random_actions
     from ..envs import free_play_v0
 
     env = free_play_v0.parallel_env(n_agents=n_agents)
@@ -284,7 +284,7 @@ def bench_images(sizes=(64, 256), agents=(1, 2), rounds: int = 5, n_states: int 
 
     import mujoco
 
-    from .eye_renderer import TileRenderer, shared_gl_context
+    from ..render.eye_renderer import TileRenderer, shared_gl_context
 
     out = []
     for n in agents:
@@ -388,7 +388,7 @@ def bench_env(configs=None, sim_seconds: float = 5.0, seed: int = 0) -> list[dic
     ``env.timing`` and the wall clock), the configurations taking turns of 100 steps."""
     import time
 
-    from ..bench import smooth_random_actions
+    from ..bench.suite import smooth_random_actions
     from ..envs import free_play_v0
 
     configs = configs or {

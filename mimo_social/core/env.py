@@ -1,0 +1,330 @@
+"""The PettingZoo ParallelEnv: N infants in one world, built from a task object.
+
+Actions per agent: a ``Box`` of the agent's motor controls (spring-damper: one value in [-1, 1]
+per motor; muscles: two values in [0, 1] per motor), or, when expressions are on, a
+``Dict({"motors": Box, "expression": Discrete(7)})``. Motor values outside the Box are
+**clipped** (learners' Gaussian policies overshoot); NaN/inf, a wrong shape, an unknown agent or
+an expression id out of range raise ``ValueError`` naming the agent, the field and what is
+allowed. A simulation that goes unstable ends the episode for every agent with the reason in
+``infos[agent]["instability"]``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+from typing import Any, Mapping, Sequence
+
+import mujoco
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+
+from ..body.actuation import MODELS as ACTUATION_MODELS
+from ..expressions.faces import EXPRESSIONS
+from ..render.gl import make_renderer
+from ..senses import Proprioception, Vestibular
+from .config import ConfigError, parse_physics, resolve_agents
+from .task import Task
+from .world import World
+
+__all__ = ["MimoParallelEnv", "TIMING_KEYS"]
+
+TIMING_KEYS = ("actuation", "physics", "proprioception", "vestibular", "touch", "vision", "task",
+               "other")
+
+
+class MimoParallelEnv(ParallelEnv):
+    metadata = {"name": "mimo_social", "render_modes": ["rgb_array"], "is_parallelizable": True}
+
+    def __init__(self, task: Task, physics: Mapping[str, Any] | None = None,
+                 per_agent: Sequence[Mapping[str, Any]] | None = None,
+                 render_mode: str | None = None, max_steps: int | None = None,
+                 render_size: tuple[int, int] = (480, 640), **agent_settings):
+        if render_mode not in (None, "rgb_array"):
+            raise ConfigError(f"render_mode={render_mode!r}; allowed: None, 'rgb_array'")
+        self.task = task
+        self.render_mode = render_mode
+        self.render_size = tuple(render_size)
+        self.max_steps = int(max_steps if max_steps is not None else task.default_max_steps)
+        if self.max_steps < 1:
+            raise ConfigError(f"max_steps={max_steps}; allowed: a positive integer")
+        n = task.n_agents
+        defaults = [task.agent_defaults(i) for i in range(n)]
+        self.agent_configs = resolve_agents(n, agent_settings, per_agent, defaults)
+        self.physics = parse_physics(physics, task.physics_overrides)
+        self.frame_skip = self.physics.frame_skip
+        self.dt = self.physics.timestep * self.frame_skip
+        self.metadata = dict(self.metadata, render_fps=int(round(1.0 / self.dt)))
+        task.configs = tuple(self.agent_configs)
+        setups = [task.setup(i, cfg) for i, cfg in enumerate(self.agent_configs)]
+        self.world = World(setups, task.props(), self.physics)
+        self.possible_agents = list(self.world.names)
+        self.agents = list(self.possible_agents)
+        self._index = {name: i for i, name in enumerate(self.possible_agents)}
+        self._bind()
+        self._rng = np.random.default_rng()
+        self._renderer = None
+        self.timing = dict.fromkeys(TIMING_KEYS, 0.0)
+        self._steps = 0
+
+    def _bind(self):
+        """Actuation and senses of every agent, and the observation and action spaces.
+
+        A sense is an object with ``name`` (its timing key), ``spaces`` (observation key ->
+        space) and ``observe(model, data, out)``. A shared system (one per world, e.g. the
+        touch skin reading the contacts once for everyone) has ``name``, ``reset(model, data)``
+        and ``update(model, data)``, run once per step before the senses read.
+        """
+        w = self.world
+        self.actuation, self.senses, self.shared = [], [], []
+        self._obs_spaces, self._act_spaces = {}, {}
+        self._needs_substep = False
+        for i, (name, cfg, a) in enumerate(zip(self.possible_agents, self.agent_configs, w.agents)):
+            tables = w.tables[i]
+            by_name = {j.name: j for j in tables.joints}
+            act = ACTUATION_MODELS[cfg.actuation]([by_name[n] for n in a.actuated_names],
+                                                  a.actuator_ids)
+            self._needs_substep |= act.needs_substep
+            self.actuation.append(act)
+            senses = []
+            if cfg.proprioception:
+                senses.append(Proprioception(cfg.proprioception, a, act))
+            if cfg.vestibular:
+                senses.append(Vestibular(cfg.vestibular, a))
+            self.senses.append(senses)
+        # Senses that share one per-world system: the skin reads the contacts once for every
+        # agent; the eyes share one renderer per process.
+        for key, module, builder in (("touch", "touch", "build_touch"),
+                                     ("vision", "vision", "build_vision")):
+            configs = [getattr(c, key) for c in self.agent_configs]
+            if any(configs):
+                mod = importlib.import_module(f"mimo_social.senses.{module}")
+                system, per_agent = getattr(mod, builder)(w, configs)
+                self.shared.append(system)
+                for i, sense in enumerate(per_agent):
+                    if sense is not None:
+                        self.senses[i].append(sense)
+        for i, name in enumerate(self.possible_agents):
+            obs = {}
+            for sense in self.senses[i]:
+                obs.update(sense.spaces)
+            obs.update(self.task.task_spaces(self, i))
+            if not obs:
+                raise ConfigError(f"{name}: every sense is off; turn on at least one of "
+                                  "proprioception, vestibular, touch, vision")
+            self._obs_spaces[name] = spaces.Dict(obs)
+            act = self.actuation[i]
+            motors = spaces.Box(act.control_low, act.control_high, dtype=np.float32)
+            self._act_spaces[name] = (spaces.Dict({"motors": motors,
+                                                   "expression": spaces.Discrete(len(EXPRESSIONS))})
+                                      if self.agent_configs[i].expressions else motors)
+        self._expression = np.zeros(len(self.possible_agents), dtype=np.int64)
+        self._controls = [np.zeros(act.n_controls) for act in self.actuation]
+
+    # -- PettingZoo API --------------------------------------------------------------------------
+    def observation_space(self, agent):
+        return self._obs_spaces[self._check_agent(agent)]
+
+    def action_space(self, agent):
+        return self._act_spaces[self._check_agent(agent)]
+
+    def _check_agent(self, agent):
+        if agent not in self._index:
+            raise KeyError(f"unknown agent {agent!r}; agents of this env: {self.possible_agents}")
+        return agent
+
+    def reset(self, seed: int | None = None, options: dict | None = None):
+        if seed is not None:
+            self._rng = np.random.default_rng(seed)
+        w = self.world
+        w.reset()
+        for act in self.actuation:
+            act.reset(w.model, w.data)
+        self._expression[:] = 0
+        for c in self._controls:
+            c[:] = 0.0
+        self.task.reset(self, self._rng)
+        mujoco.mj_forward(w.model, w.data)
+        for system in self.shared:
+            system.reset(w.model, w.data)
+        self._update_shared()
+        self.agents = list(self.possible_agents)
+        self._steps = 0
+        obs = {a: self._observe(i) for i, a in enumerate(self.agents)}
+        infos = {a: self._info(i) for i, a in enumerate(self.agents)}
+        return obs, infos
+
+    def step(self, actions: Mapping[str, Any]):
+        t0 = time.perf_counter()
+        timing = self.timing
+        if not self.agents:
+            raise RuntimeError("step() called after the episode ended; call reset() first")
+        self._apply_actions(actions)
+        t1 = time.perf_counter()
+        timing["actuation"] += t1 - t0
+        self.task.before_physics(self)
+        t2 = time.perf_counter()
+        timing["task"] += t2 - t1
+        w = self.world
+        if self._needs_substep:
+            m, d = w.model, w.data
+            acts = self.actuation
+
+            def substep():
+                for act in acts:
+                    act.substep(m, d)
+            reason = w.step(self.frame_skip, substep)
+        else:
+            reason = w.step(self.frame_skip)
+        t3 = time.perf_counter()
+        timing["physics"] += t3 - t2
+        self._steps += 1
+        self._update_shared()
+        obs = {a: self._observe(self._index[a]) for a in self.agents}
+        t4 = time.perf_counter()
+        rewards = self.task.rewards(self)
+        terminated, task_infos = self.task.terminations(self)
+        t5 = time.perf_counter()
+        timing["task"] += t5 - t4
+        truncated = self._steps >= self.max_steps
+        rew, term, trunc, infos = {}, {}, {}, {}
+        for a in self.agents:
+            i = self._index[a]
+            rew[a] = float(rewards[i])
+            term[a] = bool(terminated[i]) or reason is not None
+            trunc[a] = truncated and not term[a]
+            infos[a] = self._info(i)
+            infos[a].update(task_infos[i])
+            if reason is not None:
+                infos[a]["instability"] = reason
+        self.agents = [a for a in self.agents if not (term[a] or trunc[a])]
+        timing["other"] += time.perf_counter() - t5
+        return obs, rew, term, trunc, infos
+
+    def _apply_actions(self, actions):
+        if not isinstance(actions, Mapping):
+            raise ValueError(f"actions must be a dict agent -> action, got {type(actions).__name__}")
+        unknown = [a for a in actions if a not in self._index]
+        if unknown:
+            raise ValueError(f"actions for unknown agent(s) {unknown}; agents: {self.possible_agents}")
+        missing = [a for a in self.agents if a not in actions]
+        if missing:
+            raise ValueError(f"no action for live agent(s) {missing}; every live agent of "
+                             f"{self.agents} needs one")
+        w = self.world
+        for a in self.agents:
+            i = self._index[a]
+            act = self.actuation[i]
+            action = actions[a]
+            if self.agent_configs[i].expressions:
+                if not isinstance(action, Mapping) or set(action) != {"motors", "expression"}:
+                    raise ValueError(f"{a}: action must be a dict with keys 'motors' and "
+                                     f"'expression' (expressions are on), got {action!r:.200}")
+                motors, expression = action["motors"], action["expression"]
+                e = np.asarray(expression)
+                if e.shape not in ((), (1,)) or e.dtype.kind not in "iu" \
+                        or not 0 <= int(e.reshape(())) < len(EXPRESSIONS):
+                    raise ValueError(
+                        f"{a}: expression={expression!r} not allowed; an integer 0..{len(EXPRESSIONS) - 1}: "
+                        + ", ".join(f"{k}={n}" for k, n in enumerate(EXPRESSIONS)))
+                self._expression[i] = int(e.reshape(()))
+                w.set_expression(i, self._expression[i])
+            else:
+                motors = action
+            u = np.asarray(motors, dtype=np.float64)
+            if u.shape != (act.n_controls,):
+                raise ValueError(f"{a}: motor action has shape {u.shape}; expected "
+                                 f"({act.n_controls},) for motors {act.control_names}")
+            if not np.isfinite(u).all():
+                bad = [act.control_names[k] for k in np.flatnonzero(~np.isfinite(u))]
+                raise ValueError(f"{a}: motor action has NaN/inf for {bad}; values must be finite, "
+                                 f"in [{act.control_low.min():g}, {act.control_high.max():g}]")
+            np.clip(u, act.control_low, act.control_high, out=u)
+            self._controls[i] = u
+            act.apply(w.model, w.data, u)
+
+    def _observe(self, i: int) -> dict:
+        m, d = self.world.model, self.world.data
+        out = {}
+        timing = self.timing
+        t = time.perf_counter()
+        for sense in self.senses[i]:
+            sense.observe(m, d, out)
+            t2 = time.perf_counter()
+            timing[sense.name] += t2 - t
+            t = t2
+        out.update(self.task.observe(self, i))
+        timing["task"] += time.perf_counter() - t
+        return out
+
+    def _update_shared(self):
+        m, d = self.world.model, self.world.data
+        for system in self.shared:
+            t = time.perf_counter()
+            system.update(m, d)
+            self.timing[system.name] += time.perf_counter() - t
+
+    def _info(self, i: int) -> dict:
+        act = self.actuation[i]
+        u = self._controls[i]
+        info = {"expression": EXPRESSIONS[self._expression[i]], "step": self._steps,
+                "time": float(self.world.data.time),
+                "cost": act.cost(u), "weighted_cost": act.weighted_cost(u)}
+        for sense in self.senses[i]:
+            if hasattr(sense, "info"):
+                info.update(sense.info())
+        return info
+
+    def state(self) -> np.ndarray:
+        d = self.world.data
+        return np.concatenate([d.qpos, d.qvel]).astype(np.float32)
+
+    def state_space(self):
+        n = self.world.model.nq + self.world.model.nv
+        return spaces.Box(-np.inf, np.inf, (n,), np.float32)
+
+    # -- rendering -------------------------------------------------------------------------------
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        return self.render_rgb()
+
+    def render_rgb(self, camera: mujoco.MjvCamera | None = None) -> np.ndarray:
+        """An RGB image of the scene from a camera that shows every agent (renderer made lazily)."""
+        w = self.world
+        if self._renderer is None:
+            h, wd = self.render_size
+            self._renderer = make_renderer(w.model, h, wd)
+        if camera is None:
+            camera = self.scene_camera()
+        self._renderer.update_scene(w.data, camera)
+        return self._renderer.render()
+
+    def scene_camera(self) -> mujoco.MjvCamera:
+        d = self.world.data
+        roots = d.xpos[[a.root_body for a in self.world.agents]]
+        cam = mujoco.MjvCamera()
+        centre = roots.mean(axis=0)
+        spread = float(np.max(np.linalg.norm(roots[:, :2] - centre[:2], axis=1))) if len(roots) > 1 else 0.0
+        # frame the tallest head too (a caregiver-sized body is twice an infant's height)
+        top = float(np.max(d.site_xpos[[a.head_site for a in self.world.agents], 2]))
+        cam.lookat[:] = (centre[0], centre[1], max(0.3, 0.45 * top))
+        cam.distance = max(1.4 + 2.0 * spread, 2.2 * top)
+        cam.azimuth = 60.0
+        cam.elevation = -20.0
+        return cam
+
+    def close(self):
+        for system in self.shared:
+            if hasattr(system, "close"):
+                system.close()
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    # -- pickling (renderers never travel) -------------------------------------------------------
+    def __getstate__(self):
+        state = self.__dict__.copy()
+        state["_renderer"] = None
+        return state

@@ -1,0 +1,421 @@
+"""Compose N infants and a scene into one MuJoCo model, with integer index tables per agent.
+
+Each infant is built by :func:`mimo_social.body.builder.build_infant` with unprefixed names and
+attached with ``MjSpec.attach`` under the prefix ``infant_<i>/``. After compiling, every name an
+agent needs is resolved to integer ids and address arrays (:class:`AgentIndex`); no string
+lookups or MuJoCo accessor views are kept, so a world pickles (it rebuilds its model from its
+recipe when unpickled).
+
+Agents may differ in body: hands, actuation, senses, and size and strength (``scale``,
+``strength`` of :class:`~mimo_social.core.config.AgentConfig`). Each infant is built from its
+own scaled tables (:attr:`World.tables`) and lowered onto the floor from its own geometry.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import mujoco
+import numpy as np
+
+from ..body.builder import axis_angle_quat, build_infant, quat_mul
+from ..body.postures import POSTURES
+from ..expressions.switch import FaceTextures
+from .config import AgentConfig, PhysicsConfig
+
+__all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE"]
+
+CLOTHES_PALETTE = (
+    (0.35, 0.55, 0.85, 1.0), (0.90, 0.45, 0.40, 1.0), (0.45, 0.75, 0.45, 1.0),
+    (0.85, 0.70, 0.30, 1.0), (0.65, 0.45, 0.80, 1.0), (0.30, 0.75, 0.75, 1.0),
+    (0.85, 0.50, 0.70, 1.0), (0.55, 0.55, 0.55, 1.0),
+)
+
+
+@dataclass(frozen=True)
+class AgentSetup:
+    """How the task wants one agent built and placed."""
+
+    config: AgentConfig
+    position: tuple[float, float] = (0.0, 0.0)
+    facing: tuple[float, float] = (1.0, 0.0)
+    frozen: dict = field(default_factory=dict)       # joint -> angle (rad), held still
+    base: str = "free"                               # "free" or "fixed"
+    actuated: tuple[str, ...] | None = None          # motor joints in the action; None: all
+    gaze_joints: tuple[str, ...] = ()                # joints the task points at a target
+
+
+@dataclass(frozen=True)
+class Prop:
+    """A simple object in the scene (free to move unless ``fixed``)."""
+
+    name: str
+    shape: str = "sphere"            # sphere | box | capsule | cylinder
+    size: tuple[float, ...] = (0.025,)
+    pos: tuple[float, float, float] = (0.0, 0.0, 0.5)
+    mass: float = 0.1
+    rgba: tuple[float, float, float, float] = (0.9, 0.2, 0.2, 1.0)
+    fixed: bool = False
+    # bodies held to this prop by a weld equality, with their agent prefix
+    # ("infant_0/right_hand"); each is held at its pose relative to the prop in the world's
+    # initial pose, and :meth:`World.hold_welds` re-anchors them to the current one
+    welds: tuple[str, ...] = ()
+
+
+@dataclass
+class AgentIndex:
+    """Integer index tables of one agent in the compiled world."""
+
+    name: str
+    joint_names: list[str]          # unprefixed hinge joints, model order
+    qpos_adr: np.ndarray
+    dof_adr: np.ndarray
+    joint_range: np.ndarray         # (n, 2) rad
+    actuated_names: list[str]       # joints of the motors in the action, action order
+    actuator_ids: np.ndarray
+    actuated_joint_idx: np.ndarray  # index into joint_names of each actuated joint
+    gaze_idx: np.ndarray            # index into joint_names of joints the task sets
+    body_ids: np.ndarray
+    geom_ids: np.ndarray
+    root_body: int
+    free_qpos: int                  # -1 for a fixed base
+    free_dof: int
+    head_geom: int
+    head_material: int
+    head_site: int
+    palm_sites: np.ndarray          # right, left
+    fingertip_sites: np.ndarray     # right, left
+    eye_cameras: np.ndarray         # right, left
+    gyro_adr: int
+    accel_adr: int
+    initial_qpos: np.ndarray = None  # this agent's part of qpos at reset (full-length mask below)
+
+
+def _support_below(model, data, geom_ids: np.ndarray) -> np.ndarray:
+    """Lowest world z of each geom (exact for the primitive shapes the body uses)."""
+    z = data.geom_xpos[geom_ids, 2]
+    R = data.geom_xmat[geom_ids].reshape(-1, 3, 3)
+    size = model.geom_size[geom_ids]
+    t = model.geom_type[geom_ids]
+    rz = R[:, 2, :]  # the world-z row: components of world z in the geom's frame
+    low = np.empty(len(geom_ids))
+    G = mujoco.mjtGeom
+    sph = t == G.mjGEOM_SPHERE
+    low[sph] = z[sph] - size[sph, 0]
+    cap = t == G.mjGEOM_CAPSULE
+    low[cap] = z[cap] - np.abs(rz[cap, 2]) * size[cap, 1] - size[cap, 0]
+    cyl = t == G.mjGEOM_CYLINDER
+    low[cyl] = (z[cyl] - np.abs(rz[cyl, 2]) * size[cyl, 1]
+                - size[cyl, 0] * np.sqrt(np.clip(1 - rz[cyl, 2] ** 2, 0, 1)))
+    box = t == G.mjGEOM_BOX
+    low[box] = z[box] - np.sum(np.abs(rz[box]) * size[box], axis=1)
+    ell = t == G.mjGEOM_ELLIPSOID
+    low[ell] = z[ell] - np.sqrt(np.sum((rz[ell] * size[ell]) ** 2, axis=1))
+    return low
+
+
+def _yaw_quat(position, facing) -> np.ndarray:
+    d = np.asarray(facing, float) - np.asarray(position, float)
+    yaw = float(np.arctan2(d[1], d[0])) if np.linalg.norm(d) > 1e-9 else 0.0
+    return axis_angle_quat((0, 0, 1), yaw)
+
+
+class World:
+    """N infants, a floor, lights and props, compiled into one model."""
+
+    def __init__(self, agents: Sequence[AgentSetup], props: Sequence[Prop] = (),
+                 physics: PhysicsConfig = PhysicsConfig(), floor: bool = True):
+        if not 1 <= len(agents) <= 8:
+            raise ValueError(f"a world holds 1 to 8 infants, got {len(agents)}")
+        self._recipe = (tuple(agents), tuple(props), physics, floor)
+        self.agent_setups = tuple(agents)
+        self.props = tuple(props)
+        self.physics = physics
+        self.names = [f"infant_{i}" for i in range(len(agents))]
+        self._build()
+
+    # -- pickling: rebuild from the recipe (MuJoCo objects are not kept in the pickle) --------
+    _STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # everything mj_step reads, warm start included
+
+    def __getstate__(self):
+        m, d = self.model, self.data
+        full = np.empty(mujoco.mj_stateSize(m, self._STATE))
+        mujoco.mj_getState(m, d, full, self._STATE)
+        return {"recipe": self._recipe, "state": full, "mat_texid": m.mat_texid.copy(),
+                "eq_data": m.eq_data.copy(), "bad_count": self._bad_count}
+
+    def __setstate__(self, state):
+        self.__init__(*state["recipe"])
+        mujoco.mj_setState(self.model, self.data, state["state"], self._STATE)
+        self.model.mat_texid[:] = state["mat_texid"]
+        if "eq_data" in state:
+            self.model.eq_data[:] = state["eq_data"]
+        self._bad_count = state["bad_count"]
+        mujoco.mj_forward(self.model, self.data)
+
+    # -- building ------------------------------------------------------------------------------
+    def _build(self):
+        agents, props, physics, floor = self._recipe
+        spec = mujoco.MjSpec()
+        spec.modelname = "mimo_social"
+        spec.compiler.degree = False
+        self._set_options(spec, physics)
+        self.faces = FaceTextures()
+        self.faces.add_to(spec)
+        if floor:
+            self._add_floor(spec)
+        self._add_lights(spec)
+        builds = []
+        for i, setup in enumerate(agents):
+            cfg = setup.config
+            rgba = cfg.clothes_rgba or CLOTHES_PALETTE[i % len(CLOTHES_PALETTE)]
+            build = build_infant(cfg.hands, setup.frozen, setup.base, rgba,
+                                 scale=cfg.scale, strength=cfg.strength)
+            unknown = sorted(set(setup.actuated or ()) - set(build.actuated))
+            if unknown:
+                raise ValueError(f"{self.names[i]}: cannot actuate {unknown}: not motor joints "
+                                 f"of this body (frozen or unknown)")
+            pose_q, root_quat, height = self._rest_pose(build, cfg.posture, setup)
+            frame = spec.worldbody.add_frame(
+                pos=[setup.position[0], setup.position[1], height], quat=root_quat)
+            prefix = f"{self.names[i]}/"
+            spec.attach(build.spec, prefix=prefix, frame=frame)
+            mat = spec.add_material(name=f"{prefix}face")
+            self.faces.bind_material(mat)
+            spec.geom(f"{prefix}head").material = f"{prefix}face"
+            builds.append((build, pose_q))
+        for p in props:
+            self._add_prop(spec, p)
+        self.spec = spec
+        self.model = spec.compile()
+        self.data = mujoco.MjData(self.model)
+        self._index(builds)
+        self._initial_qpos = self.model.qpos0.copy()
+        for a, (build, pose_q) in zip(self.agents, builds):
+            for k, name in enumerate(a.joint_names):
+                self._initial_qpos[a.qpos_adr[k]] = pose_q.get(name, self._initial_qpos[a.qpos_adr[k]])
+        self.reset()
+        self.hold_welds()
+
+    @staticmethod
+    def _set_options(spec, physics: PhysicsConfig):
+        opt = spec.option
+        opt.timestep = physics.timestep
+        opt.gravity = physics.gravity
+        opt.iterations = physics.iterations
+        opt.tolerance = physics.tolerance
+        opt.solver = {"newton": mujoco.mjtSolver.mjSOL_NEWTON, "cg": mujoco.mjtSolver.mjSOL_CG,
+                      "pgs": mujoco.mjtSolver.mjSOL_PGS}[physics.solver]
+        opt.cone = {"pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL,
+                    "elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC}[physics.cone]
+        opt.jacobian = {"dense": mujoco.mjtJacobian.mjJAC_DENSE,
+                        "sparse": mujoco.mjtJacobian.mjJAC_SPARSE,
+                        "auto": mujoco.mjtJacobian.mjJAC_AUTO}[physics.jacobian]
+        spec.visual.global_.offwidth = 640
+        spec.visual.global_.offheight = 480
+        spec.visual.quality.shadowsize = 0
+
+    @staticmethod
+    def _add_floor(spec):
+        tex = spec.add_texture(name="floor_checker", type=mujoco.mjtTexture.mjTEXTURE_2D,
+                               builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER, width=256, height=256,
+                               rgb1=[0.82, 0.78, 0.70], rgb2=[0.74, 0.70, 0.62])
+        mat = spec.add_material(name="floor", texrepeat=[8, 8], reflectance=0.0)
+        mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
+        spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE,
+                                size=[10, 10, 0.1], material="floor", condim=3)
+
+    @staticmethod
+    def _add_lights(spec):
+        for pos, direction in (((0, -2, 3), (0, 0.5, -1)), ((2, 2, 3), (-0.5, -0.5, -1))):
+            spec.worldbody.add_light(pos=pos, dir=direction, diffuse=[0.55, 0.55, 0.55],
+                                     castshadow=False, type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
+        spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
+        spec.visual.headlight.diffuse = [0.25, 0.25, 0.25]
+
+    @staticmethod
+    def _add_prop(spec, p: Prop):
+        shapes = {"sphere": mujoco.mjtGeom.mjGEOM_SPHERE, "box": mujoco.mjtGeom.mjGEOM_BOX,
+                  "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
+                  "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER}
+        if p.shape not in shapes:
+            raise ValueError(f"prop {p.name}: shape {p.shape!r}; allowed: {list(shapes)}")
+        body = spec.worldbody.add_body(name=p.name, pos=p.pos)
+        if not p.fixed:
+            body.add_freejoint(name=f"{p.name}_free")
+        size = np.zeros(3)
+        size[: len(p.size)] = p.size
+        body.add_geom(name=p.name, type=shapes[p.shape], size=size, mass=p.mass, rgba=p.rgba,
+                      condim=3)
+        for other in p.welds:
+            if spec.body(other) is None:
+                raise ValueError(f"prop {p.name}: cannot weld unknown body {other!r}")
+            eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_WELD, objtype=mujoco.mjtObj.mjOBJ_BODY,
+                                   name=f"{p.name}__{other}", name1=other, name2=p.name)
+            data = np.array(eq.data)
+            data[:3] = 0.0  # the anchor: the prop's origin
+            eq.data = data
+
+    @staticmethod
+    def _rest_pose(build, posture: str, setup: AgentSetup):
+        """Joint angles of the posture, the root orientation, and the hip height on the floor."""
+        spec = build.spec.copy()
+        hip = spec.body("hip")
+        if hip.first_joint() is None or hip.first_joint().type != mujoco.mjtJoint.mjJNT_FREE:
+            hip.add_freejoint(name="root")  # only to orient this measuring copy
+        model = spec.compile()
+        data = mujoco.MjData(model)
+        by_name = {j.name: j for j in build.tables.joints}
+        wanted = POSTURES[posture]["joints"]
+        pose = {}
+        for name in build.joints:
+            j = by_name[name]
+            lo, hi = np.deg2rad(j.range_deg)
+            pose[name] = float(np.clip(np.deg2rad(wanted.get(name, j.springref_deg)), lo, hi))
+        for name in build.joints:  # coupled trunk joints follow their driver
+            j = by_name[name]
+            if j.coupled_to in pose:
+                lo, hi = np.deg2rad(j.range_deg)
+                pose[name] = float(np.clip(pose[j.coupled_to] * j.coupling, lo, hi))
+        for name in build.locked:
+            pose[name] = build.frozen[name]
+        pitch = axis_angle_quat((0, 1, 0), np.deg2rad(POSTURES[posture]["pitch_deg"]))
+        root_quat = quat_mul(_yaw_quat(setup.position, setup.facing), pitch)
+        data.qpos[model.joint("root").qposadr[0] + 3:][:4] = root_quat
+        for name, angle in pose.items():
+            data.qpos[model.joint(name).qposadr[0]] = angle
+        mujoco.mj_kinematics(model, data)
+        low = float(_support_below(model, data, np.arange(model.ngeom)).min())
+        return pose, root_quat, -low + 0.002
+
+    def _index(self, builds):
+        m = self.model
+        self.agents: list[AgentIndex] = []
+        body_agent = np.full(m.nbody, -1, dtype=np.intp)
+        for i, (build, _) in enumerate(builds):
+            p = f"{self.names[i]}/"
+            jids = np.array([m.joint(p + n).id for n in build.joints], dtype=np.intp)
+            actuated = [n for n in build.actuated
+                        if self.agent_setups[i].actuated is None
+                        or n in self.agent_setups[i].actuated]
+            act_names = {j: a for j, a in zip(build.actuated, build.actuators)}
+            act_ids = np.array([m.actuator(p + act_names[n]).id for n in actuated], dtype=np.intp)
+            root = m.body(p + "hip").id
+            bodies = np.array([b for b in range(m.nbody)
+                               if m.body(b).name.startswith(p)], dtype=np.intp)
+            body_agent[bodies] = i
+            geoms = np.flatnonzero(np.isin(m.geom_bodyid, bodies)).astype(np.intp)
+            free = m.body_jntadr[root]
+            has_free = free >= 0 and m.jnt_type[free] == mujoco.mjtJoint.mjJNT_FREE
+            gaze = self.agent_setups[i].gaze_joints
+            missing = sorted(set(gaze) - set(build.joints))
+            if missing:
+                raise ValueError(f"{self.names[i]}: gaze joints {missing} are not in the model")
+            self.agents.append(AgentIndex(
+                name=self.names[i],
+                joint_names=list(build.joints),
+                qpos_adr=m.jnt_qposadr[jids].astype(np.intp),
+                dof_adr=m.jnt_dofadr[jids].astype(np.intp),
+                joint_range=m.jnt_range[jids].copy(),
+                actuated_names=actuated,
+                actuator_ids=act_ids,
+                actuated_joint_idx=np.array([build.joints.index(n) for n in actuated],
+                                            dtype=np.intp),
+                gaze_idx=np.array([build.joints.index(n) for n in gaze], dtype=np.intp),
+                body_ids=bodies, geom_ids=geoms, root_body=root,
+                free_qpos=int(m.jnt_qposadr[free]) if has_free else -1,
+                free_dof=int(m.jnt_dofadr[free]) if has_free else -1,
+                head_geom=m.geom(p + "head").id,
+                head_material=m.material(p + "face").id,
+                head_site=m.site(p + "head_centre").id,
+                palm_sites=np.array([m.site(p + f"{s}_palm_centre").id for s in ("right", "left")]),
+                fingertip_sites=np.array([m.site(p + f"{s}_fingertips").id
+                                          for s in ("right", "left")]),
+                eye_cameras=np.array([m.camera(p + f"{s}_eye").id for s in ("right", "left")]),
+                gyro_adr=int(m.sensor_adr[m.sensor(p + "vestibular_gyro").id]),
+                accel_adr=int(m.sensor_adr[m.sensor(p + "vestibular_accel").id]),
+            ))
+        self.body_agent = body_agent
+        self.geom_agent = body_agent[m.geom_bodyid]
+        self.prop_bodies = {p.name: m.body(p.name).id for p in self.props}
+        self.prop_qpos = {p.name: int(m.jnt_qposadr[m.body_jntadr[m.body(p.name).id]])
+                          for p in self.props if not p.fixed}
+        self.prop_dof = {p.name: int(m.jnt_dofadr[m.body_jntadr[m.body(p.name).id]])
+                         for p in self.props if not p.fixed}
+        # each agent's (scaled) body tables: what its actuation and skin are built from
+        self.tables = [build.tables for build, _ in builds]
+        self.welds = np.array([(m.equality(f"{p.name}__{o}").id, m.body(o).id, m.body(p.name).id)
+                               for p in self.props for o in p.welds], dtype=np.intp).reshape(-1, 3)
+
+    # -- state ---------------------------------------------------------------------------------
+    def place_prop(self, name: str, position, quat=(1.0, 0.0, 0.0, 0.0)) -> None:
+        """Put free prop ``name`` at a world position and orientation, at rest (kinematics
+        updated, so positions read right away are the new ones)."""
+        if name not in self.prop_qpos:
+            raise KeyError(f"no free prop {name!r}; free props: {sorted(self.prop_qpos)}")
+        q, v = self.prop_qpos[name], self.prop_dof[name]
+        self.data.qpos[q:q + 3] = position
+        self.data.qpos[q + 3:q + 7] = quat
+        self.data.qvel[v:v + 6] = 0.0
+        mujoco.mj_kinematics(self.model, self.data)
+
+    def reset(self, qpos: np.ndarray | None = None):
+        mujoco.mj_resetData(self.model, self.data)
+        self.data.qpos[:] = self._initial_qpos if qpos is None else qpos
+        for a in self.agents:
+            self.faces.show(self.model, a.head_material, 0)
+        mujoco.mj_forward(self.model, self.data)
+        self._bad_count = 0
+
+    def hold_welds(self) -> None:
+        """Anchor every prop weld (:attr:`Prop.welds`) at the bodies' current relative pose
+        (``data`` kinematics must be up to date): ``eq_data`` holds the welded body's pose in the
+        prop's frame as MuJoCo stores it (position of the anchor in the body's frame, then the
+        relative orientation ``q_body^-1 q_prop``)."""
+        m, d = self.model, self.data
+        for eq, b1, b2 in self.welds:
+            anchor = m.eq_data[eq, :3]
+            R1 = d.xmat[b1].reshape(3, 3)
+            m.eq_data[eq, 3:6] = R1.T @ (d.xpos[b2] + d.xmat[b2].reshape(3, 3) @ anchor - d.xpos[b1])
+            q1 = d.xquat[b1] * np.array([1.0, -1.0, -1.0, -1.0])
+            mujoco.mju_mulQuat(m.eq_data[eq, 6:10], q1, d.xquat[b2])
+
+    @property
+    def initial_qpos(self) -> np.ndarray:
+        return self._initial_qpos.copy()
+
+    def step(self, n: int, before_substep=None) -> str | None:
+        """Advance ``n`` physics steps; return a reason string if the simulation went unstable."""
+        m, d = self.model, self.data
+        for _ in range(n):
+            if before_substep is not None:
+                before_substep()
+            mujoco.mj_step(m, d)
+        # mj_step leaves positions of the state before its last integration; bring body, geom,
+        # site and camera poses up to date so tasks and senses read the state they are given.
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_camlight(m, d)
+        return self.instability()
+
+    _BAD = np.array([mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                     mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADCTRL], int)
+
+    def instability(self) -> str | None:
+        """A reason string when the last steps diverged. MuJoCo resets the data when it meets a
+        NaN/inf or huge value; its warning counters tell that this happened."""
+        d = self.data
+        counts = d.warning.number[self._BAD]
+        total = int(counts.sum())
+        if total > self._bad_count:
+            self._bad_count = total
+            which = [mujoco.mjtWarning(w).name for w, c in zip(self._BAD, counts) if c]
+            return (f"MuJoCo found NaN, inf or huge values ({', '.join(which)}) and reset the "
+                    f"simulation: it went unstable")
+        return None
+
+    def set_expression(self, agent: int, expression: int) -> None:
+        self.faces.show(self.model, self.agents[agent].head_material, expression)
+
+    def expression_of(self, agent: int) -> int:
+        return self.faces.shown(self.model, self.agents[agent].head_material)

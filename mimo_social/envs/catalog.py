@@ -1,0 +1,124 @@
+"""The one list of envs.
+
+Every env of the package is one :class:`EnvEntry` of :data:`CATALOG`: its task name (what
+``mimo-social train --task`` takes), its versioned PettingZoo module (``parallel_env``, ``env``
+and, for social tasks, ``scripted_env``) and its Gymnasium id. Registration, training, the
+benchmark, the package docstring, the docs and the tests read this list; a new task is its task
+file in :mod:`mimo_social.tasks`, its ``<task>_v0`` module here and one line below.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from types import ModuleType
+
+from ..core.gym_adapter import SingleAgentEnv
+from . import (catch_v0, free_play_v0, handover_v0, high_five_v0, joint_attention_v0, mirror_v0,
+               reach_v0, selfbody_v0, social_touch_v0, standup_v0)
+
+__all__ = ["EnvEntry", "CATALOG", "KINDS", "entry", "names", "make_gym", "register_envs"]
+
+#: what an entry is: a sandbox without a goal, a one-agent task of the paper, or a social task
+#: (two learners, or one learner and a scripted partner)
+KINDS = ("sandbox", "one-agent", "social")
+
+
+@dataclass(frozen=True)
+class EnvEntry:
+    """One env: ``name`` (the task name), ``module`` (its ``<task>_v0`` module), ``gym_id`` (the
+    Gymnasium id: the env itself for one agent, the scripted form for a social task), ``kind``
+    (one of :data:`KINDS`) and a one-line ``summary``."""
+
+    name: str
+    module: ModuleType
+    gym_id: str
+    kind: str
+    summary: str
+    gym_defaults: tuple = ()   # keyword arguments the Gymnasium id passes by default
+
+    @property
+    def module_name(self) -> str:
+        """``reach_v0`` ..."""
+        return self.module.__name__.rsplit(".", 1)[1]
+
+    @property
+    def social(self) -> bool:
+        return self.kind == "social"
+
+    def parallel_env(self, **kwargs):
+        """The PettingZoo ParallelEnv with every agent learning."""
+        return self.module.parallel_env(**kwargs)
+
+    def scripted_env(self, **kwargs):
+        """One learner (``infant_0``) and a scripted partner (social tasks); else the env."""
+        if self.social:
+            return self.module.scripted_env(**kwargs)
+        return self.module.parallel_env(**kwargs)
+
+    def gym_env(self, **kwargs) -> SingleAgentEnv:
+        """The one-learner env as a Gymnasium env (what ``gym.make(gym_id)`` returns)."""
+        return SingleAgentEnv(self.scripted_env(**{**dict(self.gym_defaults), **kwargs}))
+
+
+CATALOG: tuple[EnvEntry, ...] = (
+    EnvEntry("free_play", free_play_v0, "mimo_social/FreePlay-v0", "sandbox",
+             "infants (1-8) on the floor, optional props, no goal", (("n_agents", 1),)),
+    EnvEntry("reach", reach_v0, "mimo_social/Reach-v0", "one-agent",
+             "reach a ball in front of the body with the right hand"),
+    EnvEntry("standup", standup_v0, "mimo_social/Standup-v0", "one-agent",
+             "stand up from a crouch holding a crib rail"),
+    EnvEntry("selfbody", selfbody_v0, "mimo_social/SelfBody-v0", "one-agent",
+             "touch a named part of one's own body"),
+    EnvEntry("catch", catch_v0, "mimo_social/Catch-v0", "one-agent",
+             "catch a falling ball and hold it"),
+    EnvEntry("high_five", high_five_v0, "mimo_social/HighFive-v0", "social",
+             "two infants meet with their right hands"),
+    EnvEntry("mirror", mirror_v0, "mimo_social/Mirror-v0", "social",
+             "show the partner's facial expression, seen through the eyes"),
+    EnvEntry("joint_attention", joint_attention_v0, "mimo_social/JointAttention-v0", "social",
+             "follow the partner's gaze to one of four toys"),
+    EnvEntry("social_touch", social_touch_v0, "mimo_social/SocialTouch-v0", "social",
+             "touch a named part of the partner's body"),
+    EnvEntry("handover", handover_v0, "mimo_social/Handover-v0", "social",
+             "take a ball from the partner's hand"),
+)
+
+_BY_NAME = {e.name: e for e in CATALOG}
+_BY_ID = {e.gym_id: e for e in CATALOG}
+
+
+def names(kind: str | None = None) -> tuple[str, ...]:
+    """Task names, all or of one kind."""
+    if kind is not None and kind not in KINDS:
+        raise ValueError(f"kind={kind!r}; allowed: {list(KINDS)}")
+    return tuple(e.name for e in CATALOG if kind is None or e.kind == kind)
+
+
+def entry(name: str) -> EnvEntry:
+    """The entry of a task name, else a ValueError naming every allowed one."""
+    try:
+        return _BY_NAME[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"task {name!r} not allowed; allowed: {', '.join(_BY_NAME)}") from None
+
+
+def make_gym(gym_id: str, **kwargs) -> SingleAgentEnv:
+    """Entry point of every Gymnasium id of the package."""
+    return _BY_ID[gym_id].gym_env(**kwargs)
+
+
+def register_envs() -> None:
+    """Register every Gymnasium id (idempotent)."""
+    import gymnasium as gym
+
+    for e in CATALOG:
+        if e.gym_id not in gym.registry:
+            gym.register(id=e.gym_id, entry_point="mimo_social.envs.catalog:make_gym",
+                         kwargs={"gym_id": e.gym_id}, disable_env_checker=False)
+
+
+def describe() -> str:
+    """The catalogue as text (the package docstring lists it)."""
+    width = max(len(e.module_name) for e in CATALOG)
+    return "\n".join(f"  {e.module_name:<{width}}  {e.gym_id:<30} {e.kind:<9} {e.summary}"
+                     for e in CATALOG)

@@ -1,0 +1,184 @@
+"""Catch (paper Sec. VI-A): a ball falls onto the infant's open right hand; grasp it and hold it.
+
+| | |
+|---|---|
+| agents | 1 (`infant_0`), five-fingered hands, muscle actuation |
+| body | standing, hip fixed; the right arm held stretched forward (shoulder 92, 44, -99 deg, elbow -30 deg), palm up; the thumb held at its rest angles; everything else held except the right wrist and fingers; head and eyes fixate the ball (set each control step) |
+| scene | a ball: radius U(0.5, 2.5) cm, mass U(0.05, 0.5) kg, dropped from 9 cm (+-8 cm) above the palm surface, +-1 cm sideways |
+| reset | the wrist turned palm up (rotation -65 deg); 50 physics steps without gravity and without the ball settle the hand; then the ball is placed, at rest |
+| action | 40 muscle controls in [0, 1]: a negative and a positive muscle for each of the right wrist's 3 axes and the 17 finger joints other than the thumb's (with `actuation="spring_damper"`: 20 motors in [-1, 1]) |
+| observation | `proprioception`, `touch` (the right arm's and hand's skin only, at the published spacing; the normal force only, 1 float a point), `ball_size` (radius, m) |
+| reward | `-100` when the ball falls more than 10 cm below the palm centre or goes more than 0.5 m from it; `+100` once the hand has touched the ball for 1 s without a break; otherwise `N_c - c_w(a)`: the number of the infant's body parts touching the ball minus the weighted muscle cost (paper eq. for muscles; `cost_weight` scales it) |
+| termination | on success (held 1 s) or failure (dropped); truncation at 800 steps |
+| infos | `is_success`, `dropped`, `parts_touching` (N_c), `held_steps`, `ball_radius`, `ball_mass` |
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from gymnasium import spaces
+
+from ..body.tables import load_body, subtree
+from ..core.world import AgentSetup, Prop
+from ..core.task import (GAZE_JOINTS, Gaze, Task, geoms_touching, hand_geoms, held_posture,
+                         parts_outside)
+from .standup import settle
+
+ARM_DEG = {"right_shoulder_horizontal": 92.0, "right_shoulder_abduction": 44.0,
+           "right_shoulder_rotation": -99.0, "right_elbow": -30.0}
+WRIST = ("right_wrist_rotation", "right_wrist_flexion", "right_wrist_ulnar")
+WRIST_START_DEG = -65.0   # wrist rotation that turns the palm up with the arm above
+PARKED = (0.0, 1.5, 0.5)  # where the ball waits while the hand settles
+
+
+def catch_joints(tables) -> tuple[str, ...]:
+    """The right wrist's 3 joints and the right fingers' joints except the thumb's."""
+    hand = set(subtree(tables, "right_hand")) - {"right_hand"}
+    fingers = [j.name for j in tables.joints if j.body in hand and "thumb" not in j.name]
+    return WRIST + tuple(fingers)
+
+
+def touch_exclude(tables) -> tuple[str, ...]:
+    """Every body part with skin outside the right arm (upper arm to fingertips)."""
+    return parts_outside(tables, ("right_upper_arm",))
+
+
+class Catch(Task):
+    name = "catch"
+    n_agents_range = (1, 1)
+    default_n_agents = 1
+    default_max_steps = 800
+
+    def option_defaults(self) -> dict:
+        return {"radius": (0.005, 0.025), "mass": (0.05, 0.5), "drop_height": 0.09,
+                "position_noise": (0.01, 0.01, 0.08), "hold_time": 1.0, "drop_margin": 0.1,
+                "max_distance": 0.5, "success_reward": 100.0, "failure_reward": -100.0,
+                "cost_weight": 1.0, "settle_steps": 50}
+
+    def agent_defaults(self, i):
+        tables = load_body("five_fingers")
+        return {"hands": "five_fingers", "actuation": "muscle", "posture": "standing",
+                "vestibular": False, "expressions": False,
+                "touch": {"normal_only": True, "exclude": touch_exclude(tables)}}
+
+    def setup(self, i, config):
+        if config.hands != "five_fingers":
+            raise ValueError(f"catch: hands={config.hands!r} not allowed; the task needs "
+                             "hands='five_fingers' (it moves the fingers one by one)")
+        tables = load_body(config.hands)
+        joints = catch_joints(tables)
+        frozen = held_posture(tables, keep=joints + GAZE_JOINTS, angles=ARM_DEG)
+        return AgentSetup(config, position=(0.0, 0.0), facing=(1.0, 0.0), frozen=frozen,
+                          base="fixed", actuated=joints, gaze_joints=GAZE_JOINTS)
+
+    def props(self):
+        hi = float(self.options["radius"][1])
+        return [Prop("ball", "sphere", (hi,), PARKED, float(self.options["mass"][1]),
+                     (0.95, 0.55, 0.15, 1.0))]
+
+    def task_spaces(self, env, i):
+        return {"ball_size": spaces.Box(0.0, 1.0, (1,), np.float32)}
+
+    def _bind(self, env):
+        w = env.world
+        m = w.model
+        a = w.agents[0]
+        self._world = w
+        self._ball_body = w.prop_bodies["ball"]
+        self._ball_geom = int(np.flatnonzero(m.geom_bodyid == self._ball_body)[0])
+        self._ball_q = w.prop_qpos["ball"]
+        self._ball_v = w.prop_dof["ball"]
+        self._is_hand = np.zeros(m.ngeom, bool)
+        self._is_hand[hand_geoms(w, 0, 0)] = True
+        self._is_agent = np.zeros(m.ngeom, bool)
+        self._is_agent[a.geom_ids] = True
+        self._palm = int(a.palm_sites[0])
+        self._gaze = Gaze(w, 0)
+        idx = {n: k for k, n in enumerate(a.joint_names)}
+        self._wrist_q = int(a.qpos_adr[idx["right_wrist_rotation"]])
+        self._wrist_start = float(np.clip(np.deg2rad(WRIST_START_DEG),
+                                          *a.joint_range[idx["right_wrist_rotation"]]))
+        # the hand's half thickness: the palm box's smallest half size
+        hand_body = int(m.site_bodyid[self._palm])
+        boxes = [g for g in np.flatnonzero(m.geom_bodyid == hand_body)
+                 if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX]
+        self._half_thickness = float(min(m.geom_size[g].min() for g in boxes)) if boxes else 0.01
+
+    def set_ball(self, env, radius: float, mass: float) -> None:
+        """Give the ball a radius (m) and a mass (kg): the model's size, bounding sphere and box,
+        mass and inertia change in place (no recompiling)."""
+        m = env.world.model
+        g, b = self._ball_geom, self._ball_body
+        m.geom_size[g, 0] = radius
+        m.geom_rbound[g] = radius
+        m.geom_aabb[g, 3:] = radius
+        m.body_mass[b] = mass
+        m.body_inertia[b] = 0.4 * mass * radius * radius
+        self._radius, self._mass = float(radius), float(mass)
+
+    def place_ball(self, env, position) -> None:
+        """Put the ball at a world position, at rest."""
+        env.world.place_prop("ball", position)
+
+    def reset(self, env, rng):
+        if getattr(self, "_world", None) is not env.world:
+            self._bind(env)
+        w = env.world
+        m, d = w.model, w.data
+        o = self.options
+        d.qpos[self._wrist_q] = self._wrist_start
+        self.place_ball(env, PARKED)
+        settle(env, int(o["settle_steps"]), gravity=False)
+        r = rng.uniform(*o["radius"])
+        self.set_ball(env, r, rng.uniform(*o["mass"]))
+        palm = d.site_xpos[self._palm].copy()
+        noise = rng.uniform(-1.0, 1.0, 3) * np.asarray(o["position_noise"], float)
+        height = r + self._half_thickness + float(o["drop_height"])
+        self.place_ball(env, palm + np.array([0.0, 0.0, height]) + noise)
+        self._held = 0
+        self._hold_steps = max(1, int(round(float(o["hold_time"]) / env.dt)))
+        self._success = self._dropped = False
+        self._n_touch = 0
+        self._size = np.array([self._radius], np.float32)
+        self.before_physics(env)
+
+    def before_physics(self, env):
+        w = env.world
+        self._gaze(w.model, w.data, "body", self._ball_body)
+
+    def observe(self, env, i):
+        return {"ball_size": self._size.copy()}
+
+    def _touching(self, d):
+        """Body parts of the infant touching the ball, and whether the right hand does."""
+        other = geoms_touching(d, self._ball_geom)
+        if not len(other):
+            return 0, False
+        mine = other[self._is_agent[other]]
+        parts = len(np.unique(self._world.model.geom_bodyid[mine]))
+        return parts, bool(np.any(self._is_hand[mine]))
+
+    def rewards(self, env):
+        w = env.world
+        d = w.data
+        o = self.options
+        self._n_touch, in_hand = self._touching(d)
+        self._held = self._held + 1 if in_hand else 0
+        ball = d.xpos[self._ball_body]
+        palm = d.site_xpos[self._palm]
+        self._dropped = bool(ball[2] < palm[2] - float(o["drop_margin"])
+                             or np.linalg.norm(ball - palm) > float(o["max_distance"]))
+        self._success = not self._dropped and self._held >= self._hold_steps
+        if self._dropped:
+            return np.array([float(o["failure_reward"])])
+        if self._success:
+            return np.array([float(o["success_reward"])])
+        cost = env.actuation[0].weighted_cost(env._controls[0])
+        return np.array([self._n_touch - float(o["cost_weight"]) * cost])
+
+    def terminations(self, env):
+        return (np.array([self._success or self._dropped]),
+                [{"is_success": self._success, "dropped": self._dropped,
+                  "parts_touching": self._n_touch, "held_steps": self._held,
+                  "ball_radius": self._radius, "ball_mass": self._mass}])

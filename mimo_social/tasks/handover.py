@@ -1,0 +1,300 @@
+"""Handover: one infant holds out a ball in its right hand, the other takes it.
+
+| | |
+|---|---|
+| agents | 2: `infant_0` the receiver, `infant_1` the giver (scripted :class:`~mimo_social.partners.HandOffer` in `scripted_env`, or a learner); standing face to face, `distance` (0.34 m) apart |
+| body | five-fingered hands (`hands="five_fingers"` is required), spring-damper motors by default (`actuation="muscle"`, for all or per agent, works too); standing, hip fixed in the world; trunk, legs, left arm held; each agent's right arm (shoulder 3, elbow, wrist 3, 22 finger joints) actuated; the receiver's head and eyes fixate the ball, the giver's fixate the receiver's right palm (set by the task every control step) |
+| scene | a ball (radius `ball_radius` 3 cm, mass `ball_mass` 30 g) |
+| reset | the giver's arm is posed in its offer posture (:func:`~mimo_social.partners.hand_offer.offer_posture` for `offer_target` = 18 cm ahead of its right shoulder, 10 cm toward its midline, 8 cm lower; palm up, leaning slightly toward thumb and fingers), the ball laid in its palm, its four fingers curled kinematically until they touch the ball; then for `settle_time` (0.3 s) the giver's own motors hold the arm and the fingers grip gently (the :class:`HandOffer` controller): the episode starts with a physical grasp at rest, no weld. The receiver's right arm starts at a random offset (+-`arm_noise` 10 deg per joint of shoulder, elbow, wrist) from its hanging posture |
+| action | per agent: the right-arm motors, 29 (spring-damper, in [-1, 1]) or 58 (muscles, in [0, 1]); plus the expression when `expressions=True` |
+| observation | `proprioception` (the head and eye angles tell where the ball / the receiver's hand is), `touch` (the skin of both arms and hands, normal force, 1 float a point) |
+| reward (both) | `-distance(receiver's right fingertips, ball)` every step; `+success_reward` (10) on success; `failure_reward` (-1) when the ball drops, and (`charge_remaining`, on) minus that step's distance times the steps left in the episode: the per-step shaping is negative, so without this charge ending the episode by knocking the ball down would beat holding still (measured without the charge: two random agents drop it within 0.35 s and score -10, a random receiver with the scripted giver scores -145 over the full episode) |
+| success | the ball touches at least `min_parts` (2) segments of the receiver's right hand (palm, finger segments), no longer touches the giver's hand and is above `drop_height`, continuously for `hold_time` (0.3 s) |
+| termination | both agents, on success or when the ball falls below `drop_height` (0.25 m: well below the hands, near the floor); truncation at `max_steps` (600, 6 s) |
+| infos | `is_success`, `holder` (`"giver"`: the ball touches the giver's hand; `"receiver"`: the receiver's hand in >= `min_parts` segments and not the giver's; `"none"` otherwise), `dropped`, `receiver_parts`, `held_steps`, `distance` |
+
+Rationale: from about 12 months infants give objects to others and take what is offered, and
+give-and-take games with caregivers fill much of the second year; an exchange needs each
+partner to read the other's hand (where it is, whether it grips or lets go) through sight and
+touch. Here the receiver learns the taking half (reach to the offered ball, close its fingers
+around it, hold it as the giver lets go) from proprioception of its gaze and touch alone; the
+scripted giver lets go only when it feels the other's hand on the ball, as a cooperative adult
+would. Both are rewarded: the exchange is a joint success.
+
+A learning giver starts with the same grasp but holds it only if it acts: with zero actions its
+arm sinks under gravity and the ball falls (a failure) within half a second.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from ..body.tables import load_body
+from ..partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
+from ..core.world import AgentSetup, Prop
+from ..core.task import (GAZE_JOINTS, Gaze, Task, check_number, geoms_touching, hand_geoms,
+                         held_posture, parts_outside, right_arm_joints)
+
+RECEIVER, GIVER = 0, 1
+PARKED = (0.2, 1.5, 0.5)             # where the ball is built (the reset moves it to the palm)
+OFFER_TARGET = (0.18, 0.10, -0.08)   # the giver's palm: m from its right shoulder (fwd, left, up)
+BALL_TOWARD_FINGERS = 0.01           # m from the palm centre toward the fingers: the ball's rest
+
+
+def arms_only_touch(tables) -> dict:
+    """Touch settings: skin on both arms and hands only, the normal force only."""
+    return {"normal_only": True,
+            "exclude": parts_outside(tables, ("right_upper_arm", "left_upper_arm"))}
+
+
+def _check_number(name, value, lo, hi):
+    return check_number("handover: task option", name, value, lo, hi)
+
+
+class Handover(Task):
+    name = "handover"
+    n_agents_range = (2, 2)
+    default_n_agents = 2
+    default_max_steps = 600
+
+    def option_defaults(self) -> dict:
+        return {"distance": 0.34, "ball_radius": 0.03, "ball_mass": 0.03, "hold_time": 0.3,
+                "min_parts": 2, "drop_height": 0.25, "success_reward": 10.0,
+                "failure_reward": -1.0, "settle_time": 0.3, "arm_noise": 10.0,
+                "offer_target": OFFER_TARGET, "end_on_success": True,
+                "charge_remaining": True}
+
+    LIMITS = {"distance": (0.3, 0.8), "ball_radius": (0.015, 0.045), "ball_mass": (0.005, 0.3),
+              "hold_time": (0.0, 5.0), "min_parts": (1, 10), "drop_height": (0.0, 0.5),
+              "success_reward": (-1e6, 1e6), "failure_reward": (-1e6, 1e6),
+              "settle_time": (0.0, 2.0), "arm_noise": (0.0, 45.0)}
+
+    def __init__(self, n_agents: int, **options):
+        super().__init__(n_agents, **options)
+        o = self.options
+        for k, (lo, hi) in self.LIMITS.items():
+            o[k] = _check_number(k, o[k], lo, hi)
+        if o["min_parts"] != int(o["min_parts"]):
+            raise ValueError(f"handover: task option min_parts={o['min_parts']!r}; allowed: an "
+                             "integer 1 to 10")
+        o["min_parts"] = int(o["min_parts"])
+        for key in ("end_on_success", "charge_remaining"):
+            if not isinstance(o[key], bool):
+                raise ValueError(f"handover: task option {key}={o[key]!r}; allowed: True or False")
+        t = o["offer_target"]
+        if t is not None:
+            arr = np.asarray(t, dtype=float) if not isinstance(t, str) else np.zeros(0)
+            if arr.shape != (3,) or not np.isfinite(arr).all() or np.linalg.norm(arr) > 0.5:
+                raise ValueError(f"handover: task option offer_target={t!r}; allowed: None or "
+                                 "(forward, left, up) in metres from the giver's right "
+                                 "shoulder, within 0.5 m")
+            o["offer_target"] = tuple(float(x) for x in arr)
+
+    # -- building ------------------------------------------------------------------------------
+    def agent_defaults(self, i):
+        return {"hands": "five_fingers", "posture": "standing", "vestibular": False,
+                "expressions": False, "touch": arms_only_touch(load_body("five_fingers"))}
+
+    def setup(self, i, config):
+        if config.hands != "five_fingers":
+            raise ValueError(f"handover: infant_{i}: hands={config.hands!r} not allowed; the task "
+                             "needs hands='five_fingers' (the ball is held between the fingers)")
+        if config.posture != "standing":
+            raise ValueError(f"handover: infant_{i}: posture={config.posture!r} not allowed; "
+                             "the task places both infants standing (hip fixed)")
+        dist = float(self.options["distance"])
+        pos = (0.0, 0.0) if i == RECEIVER else (dist, 0.0)
+        facing = (dist, 0.0) if i == RECEIVER else (0.0, 0.0)
+        tables = load_body(config.hands)
+        arm = right_arm_joints(tables)
+        frozen = held_posture(tables, keep=arm + GAZE_JOINTS,
+                              angles={"right_knee": -5, "left_knee": -5})
+        return AgentSetup(config, position=config.position or pos,
+                          facing=config.facing or facing, frozen=frozen, base="fixed",
+                          actuated=arm, gaze_joints=GAZE_JOINTS)
+
+    def props(self):
+        o = self.options
+        return [Prop("ball", "sphere", (o["ball_radius"],), PARKED, o["ball_mass"],
+                     (0.95, 0.55, 0.15, 1.0))]
+
+    # -- index tables (once per world) ---------------------------------------------------------
+    def _bind(self, env):
+        w = env.world
+        m = w.model
+        self._world = w
+        self._ball_body = w.prop_bodies["ball"]
+        self._ball_geom = int(np.flatnonzero(m.geom_bodyid == self._ball_body)[0])
+        self._ball_q = w.prop_qpos["ball"]
+        self._ball_v = w.prop_dof["ball"]
+        self._hand_of = np.full(m.ngeom, -1, np.intp)   # geom -> 0 receiver / 1 giver right hand
+        for i in (RECEIVER, GIVER):
+            self._hand_of[hand_geoms(w, i, 0)] = i
+        self._geom_body = m.geom_bodyid.astype(np.intp)
+        self._gaze = [Gaze(w, i) for i in (RECEIVER, GIVER)]
+        r = w.agents[RECEIVER]
+        self._tip = int(r.fingertip_sites[0])
+        self._receiver_palm = int(r.palm_sites[0])
+        self._offer = HandOffer(target=self.options["offer_target"], release=None)
+        self._giver_palm = int(w.agents[GIVER].palm_sites[0])
+        self._fingers = [self._finger_tables(w, i) for i in (RECEIVER, GIVER)]
+        self._hand_body = [int(m.site_bodyid[w.agents[i].palm_sites[0]]) for i in (0, 1)]
+        boxes = [k for k in np.flatnonzero(m.geom_bodyid == self._hand_body[GIVER])
+                 if m.geom_type[k] == mujoco.mjtGeom.mjGEOM_BOX]
+        self._half_thickness = float(min(m.geom_size[k].min() for k in boxes)) if boxes else 0.006
+
+    @staticmethod
+    def _finger_tables(w, i):
+        """Per finger of agent i's right hand (not the thumb): qpos addresses of mcp, pip, dip,
+        their upper limits, and the finger's geoms."""
+        m = w.model
+        a = w.agents[i]
+        out = []
+        for finger in ("index", "middle", "ring", "little"):
+            ks = [k for k, n in enumerate(a.joint_names)
+                  if n.startswith(f"right_{finger}_") and n.split("_")[-1] in ("mcp", "pip", "dip")]
+            bodies = [m.body(f"{a.name}/right_{finger}_{part}").id
+                      for part in ("proximal", "middle", "distal")]
+            geoms = np.flatnonzero(np.isin(m.geom_bodyid, bodies))
+            out.append((a.qpos_adr[ks], a.joint_range[ks, 1], geoms))
+        return out
+
+    # -- running -------------------------------------------------------------------------------
+    def place_ball(self, env, position) -> None:
+        """Put the ball at a world position, at rest."""
+        env.world.place_prop("ball", position)
+
+    def ball_in_palm(self, env, i: int = GIVER) -> np.ndarray:
+        """Where the ball rests on agent i's right palm: on the palm's normal, touching it."""
+        w = env.world
+        d = w.data
+        R = d.xmat[self._hand_body[i]].reshape(3, 3)
+        normal = -R[:, 1]  # the right palm faces the hand's -y
+        r = float(self.options["ball_radius"])
+        return (d.site_xpos[w.agents[i].palm_sites[0]]
+                + (self._half_thickness + r + 0.001) * normal + BALL_TOWARD_FINGERS * R[:, 2])
+
+    def put_ball_in_hand(self, env, i: int, target=None) -> None:
+        """Pose agent i's right arm in the offer posture (palm up; ``target`` as for
+        :func:`~mimo_social.partners.hand_offer.offer_posture`), lay the ball in its palm and
+        curl its fingers onto it (used at reset for the giver; tests use it for the receiver)."""
+        w = env.world
+        a = w.agents[i]
+        posture = offer_posture(w, i, None, target)
+        d = w.data
+        for k in a.actuated_joint_idx:
+            n = a.joint_names[k]
+            angle = posture.get(n, np.deg2rad(OPEN_FINGERS_DEG.get(n, 0.0)))
+            d.qpos[a.qpos_adr[k]] = np.clip(angle, *a.joint_range[k])
+        mujoco.mj_kinematics(w.model, d)
+        self.place_ball(env, self.ball_in_palm(env, i))
+        self._close_fingers(env, i)
+
+    def reset(self, env, rng):
+        if getattr(self, "_world", None) is not env.world:
+            self._bind(env)
+        w = env.world
+        m, d = w.model, w.data
+        o = self.options
+        r = w.agents[RECEIVER]
+        # the receiver's arm: the hanging posture, shifted at random
+        k = r.actuated_joint_idx[:7]
+        noise = np.deg2rad(float(o["arm_noise"])) * rng.uniform(-1.0, 1.0, len(k))
+        d.qpos[r.qpos_adr[k]] = np.clip(d.qpos[r.qpos_adr[k]] + noise, r.joint_range[k, 0],
+                                        r.joint_range[k, 1])
+        mujoco.mj_kinematics(m, d)
+        # the giver: arm in the offer posture, the ball in its palm, fingers curled onto it
+        self.put_ball_in_hand(env, GIVER, o["offer_target"])
+        self._settle(env)
+        self._held = 0
+        self._hold_steps = max(1, int(round(float(o["hold_time"]) / env.dt)))
+        self._success = self._dropped = False
+        self._holder = "giver"
+        self._parts = 0
+        self._distance = 0.0
+        self.before_physics(env)
+
+    def _close_fingers(self, env, i: int):
+        """Curl each of agent i's four fingers (mcp, pip, dip together, from straight toward
+        their upper limits) until it is within 1 mm of the ball: the grasp starts in contact,
+        without the impact of fingers closing dynamically."""
+        m, d = env.world.model, env.world.data
+        ball = self._ball_geom
+        for qadr, top, geoms in self._fingers[i]:
+            last = np.zeros(len(qadr))
+            for alpha in np.linspace(0.0, 1.0, 41):
+                d.qpos[qadr] = alpha * top
+                mujoco.mj_kinematics(m, d)
+                if min(mujoco.mj_geomDistance(m, d, ball, int(g), 0.01, None)
+                       for g in geoms) < 0.001:
+                    break
+                last = alpha * top
+            d.qpos[qadr] = last
+        mujoco.mj_kinematics(m, d)
+
+    def _settle(self, env):
+        """The giver's own motors hold the offer posture and close the fingers on the ball for
+        ``settle_time`` (the receiver is still); time restarts at 0."""
+        w = env.world
+        m, d = w.model, w.data
+        n = int(round(float(self.options["settle_time"]) / env.dt))
+        offer = self._offer
+        giver = env.possible_agents[GIVER]
+        offer.reset(env, giver, np.random.default_rng(0))
+        act = env.actuation[GIVER]
+        subs = [a for a in env.actuation if a.needs_substep]
+        for _ in range(n):
+            u = offer.act(env, giver, None)
+            act.apply(m, d, np.asarray(u["motors"] if isinstance(u, dict) else u, float))
+            for _ in range(env.frame_skip):
+                for a in subs:
+                    a.substep(m, d)
+                mujoco.mj_step(m, d)
+        act.reset(m, d)
+        env._controls[GIVER][:] = 0.0
+        d.time = 0.0
+        mujoco.mj_forward(m, d)
+
+    def before_physics(self, env):
+        w = env.world
+        m, d = w.model, w.data
+        self._gaze[RECEIVER](m, d, "body", self._ball_body)
+        self._gaze[GIVER](m, d, "site", self._receiver_palm)
+
+    def _contacts(self, d):
+        """Segments of the receiver's right hand touching the ball, and whether the giver's
+        right hand touches it."""
+        other = geoms_touching(d, self._ball_geom)
+        if not len(other):
+            return 0, False
+        whose = self._hand_of[other]
+        parts = len(np.unique(self._geom_body[other[whose == RECEIVER]]))
+        return parts, bool(np.any(whose == GIVER))
+
+    def rewards(self, env):
+        d = env.world.data
+        o = self.options
+        self._parts, giver_holds = self._contacts(d)
+        ball = d.xpos[self._ball_body]
+        self._dropped = bool(ball[2] < o["drop_height"])
+        receiver_holds = self._parts >= o["min_parts"] and not giver_holds
+        self._holder = "giver" if giver_holds else "receiver" if receiver_holds else "none"
+        self._held = self._held + 1 if receiver_holds and not self._dropped else 0
+        self._success = self._held >= self._hold_steps
+        self._distance = float(np.linalg.norm(d.site_xpos[self._tip] - ball))
+        r = -self._distance
+        if self._success:
+            r += o["success_reward"]
+        if self._dropped:
+            r += o["failure_reward"]
+            if o["charge_remaining"]:  # the rest of the episode at this distance: drops never pay
+                r -= self._distance * max(0, env.max_steps - env._steps)
+        return np.array([r, r])
+
+    def terminations(self, env):
+        done = self._dropped or (self._success and self.options["end_on_success"])
+        info = {"is_success": self._success, "holder": self._holder, "dropped": self._dropped,
+                "receiver_parts": self._parts, "held_steps": self._held,
+                "distance": self._distance}
+        return np.array([done, done]), [dict(info), dict(info)]

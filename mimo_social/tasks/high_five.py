@@ -1,0 +1,263 @@
+"""High five: two standing infants, face to face, bring their right hands together and feel it.
+
+| | |
+|---|---|
+| agents | 2 (`infant_0`, `infant_1`), `distance` (0.35 m) apart hip to hip, facing each other |
+| reset | each right arm starts in its own random posture: every joint at its standing-pose angle plus U(-1/2, 1/2) x `start_spread` (0.3) x its range (seeded by `reset(seed=...)`) |
+| body | hip fixed in the world; trunk, legs, left arm held; head and eyes fixate the partner's right hand (set by the task each control step) |
+| action | the right-arm motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five fingers: 29), plus the expression when expressions are on |
+| observation | `proprioception` (head and eye angles tell where the partner's hand is), `vestibular`, `touch`: the skin of the right hand only by default (hand and fingers, a tenth of the published point density, normal force only: 232 floats for the mitten hand); `touch=True` or a mapping gives more skin |
+| reward (both) | `-distance(right palms)` (m) per step, `+touch_bonus` (100) on a step of success |
+| success (`is_success`) | both right hands feel the partner: each agent's right-hand skin (hand or fingers) senses a force whose source is the other agent, and the two right hands are in contact with each other. The partner's forearm, body or left hand on one's hand does not count (the partner's right hand feels nothing), nor do crossed arms (each right hand on the other's arm) |
+| termination | both, on success (if `end_on_touch`, default); truncation at `max_steps` (500 steps, 5 s) |
+| infos | `is_success`, `hands_touching` (the same, kept for older code), `hand_feels_partner` (this agent's right-hand skin senses the other agent, on any of its parts), `hand_distance` (m), and the skin's `touch` (who touches which part) |
+| options | `touch_bonus` (100.0), `end_on_touch` (True), `distance` (0.35 m, 0.25 to 0.6) |
+| scripted partner | `high_five_v0.scripted_env()`: `infant_1` is `HandOffer(grip=False, release=None)` (holds its right hand out, fingers open) |
+
+A high five is felt, not only seen: the task reads success from the same skin that the agents
+observe (:mod:`mimo_social.senses.touch`), so what ends the episode is exactly what both
+infants perceive. The skin must cover the right hand (`touch=False`, or an `exclude` that
+names a right-hand part, raises an error).
+
+Why: touch is the earliest channel of social contact. Infants feel and seek touch from their
+caregivers long before they reach for objects, and in the second year touch-based games (pat-a-
+cake, give-and-take, clapping hands together) are among the first joint actions with a partner:
+each partner's move is answered by a felt contact, a contingency infants are highly sensitive
+to. Reading success from both skins makes the reward a shared, perceived event rather than a
+geometric fact, the basis of the touch-based turn taking studied with two learning infants.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+import mujoco
+import numpy as np
+
+from ..body.tables import HAND_VERSIONS, load_body, subtree
+from ..core.config import ConfigError
+from ..core.world import AgentSetup
+from ..core.task import (GAZE_JOINTS, ContactProbe, Gaze, Task, face_to_face, hand_geoms,
+                         held_posture, right_arm_joints)
+
+# 0.35 m: the right hands meet with the arms forward, half stretched; at 0.45 m (the first
+# version's distance) only the outstretched fingers meet, and PPO takes many times longer
+DISTANCE = 0.35
+DISTANCE_RANGE = (0.25, 0.6)
+# a tenth of the published point density: the right hand's skin is 232 points (25 on the palm
+# part, 207 on the fingers) for the mitten body, 1 float each (normal force)
+HAND_TOUCH_DENSITY = 0.1
+
+
+# -- skin helpers (shared with the social touch task) ------------------------------------------
+def skin_parts(tables) -> tuple[str, ...]:
+    """Every body part that has geoms, in table order (the parts a skin may cover)."""
+    parts: list[str] = []
+    for g in tables.geoms:
+        if g.body not in parts:
+            parts.append(g.body)
+    return tuple(parts)
+
+
+def right_hand_parts(tables) -> tuple[str, ...]:
+    """The right hand's body parts: ``right_hand`` and every part below it (the mitten's
+    fingers, or the five fingers' segments)."""
+    return tuple(subtree(tables, "right_hand"))
+
+
+def touch_only_on(tables, parts: Sequence[str], density: float = HAND_TOUCH_DENSITY,
+                  normal_only: bool = True) -> dict:
+    """A ``touch`` setting whose skin covers only ``parts`` (every other part is excluded)."""
+    keep = set(parts)
+    return {"density": float(density), "normal_only": bool(normal_only),
+            "exclude": tuple(p for p in skin_parts(tables) if p not in keep)}
+
+
+def hand_touch(hands: str = "mitten", density: float = HAND_TOUCH_DENSITY,
+               normal_only: bool = True) -> dict:
+    """The default ``touch`` setting of high five: the right hand's skin only.
+
+    ``touch=hand_touch(density=1.0, normal_only=False)`` gives the right hand at the published
+    density with 3 floats a point."""
+    if hands not in HAND_VERSIONS:
+        raise ConfigError(f"hands={hands!r} not allowed; allowed: {list(HAND_VERSIONS)}")
+    tables = load_body(hands)
+    return touch_only_on(tables, right_hand_parts(tables), density, normal_only)
+
+
+def hands_of(n_agents: int, settings: Mapping[str, Any]) -> list[str]:
+    """Each agent's hand version as the env will resolve it from its keyword arguments
+    (``hands=...`` for all, ``per_agent=[{"hands": ...}, ...]``). Malformed values fall back to
+    ``"mitten"``: the env itself then raises the error that says what is allowed."""
+    common = settings.get("hands", "mitten")
+    out = [common if common in HAND_VERSIONS else "mitten"] * n_agents
+    per_agent = settings.get("per_agent")
+    if isinstance(per_agent, Sequence) and not isinstance(per_agent, (str, Mapping)) \
+            and len(per_agent) == n_agents:
+        for i, s in enumerate(per_agent):
+            if isinstance(s, Mapping) and s.get("hands") in HAND_VERSIONS:
+                out[i] = s["hands"]
+    return out
+
+
+def require_skin(task: str, agent: str, config, parts: Sequence[str], what: str) -> None:
+    """Raise a :class:`ConfigError` unless ``config.touch`` covers every part of ``parts``."""
+    if config.touch is None:
+        raise ConfigError(f"{task}: {agent} has touch=False, but the task senses {what} through "
+                          f"the skin; turn touch on (the default covers {list(parts)}, "
+                          "touch=True the whole body)")
+    missing = [p for p in parts if p in config.touch.exclude]
+    if missing:
+        raise ConfigError(f"{task}: {agent}'s touch excludes {missing}, but the task senses "
+                          f"{what} through the skin there; remove them from touch 'exclude'")
+
+
+def check_number(task: str, key: str, value, lo: float | None = None,
+                 hi: float | None = None) -> float:
+    """A finite real task option within [lo, hi], or a ConfigError saying what is allowed."""
+    where = "any finite number" if lo is None else f"a number from {lo} to {hi}"
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not np.isfinite(value) or (lo is not None and not lo <= value <= hi):
+        raise ConfigError(f"{task}: task option {key}={value!r} not allowed; {where}")
+    return float(value)
+
+
+def check_bool(task: str, key: str, value) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise ConfigError(f"{task}: task option {key}={value!r} not allowed; True or False")
+    return bool(value)
+
+
+class SkinSource:
+    """Does one body region of agent ``i`` (e.g. its right hand) feel agent ``j`` on its skin?
+
+    A contact probe between the region's geoms and all of ``j``'s geoms gates the question (one
+    pair of gathers a step); only when they are in contact is the skin's record of who touches
+    which part (:meth:`~mimo_social.senses.touch.TouchSystem.touched_by`) read, for the few
+    parts of the region.
+    """
+
+    def __init__(self, world, touch, i: int, region_geoms, parts: Sequence[str], j: int):
+        self.touch = touch
+        self.i = i
+        self.parts = tuple(parts)
+        self.source = world.names[j]
+        self.probe = ContactProbe(world.model.ngeom, region_geoms, world.agents[j].geom_ids)
+
+    def __call__(self, data) -> bool:
+        if not self.probe(data):
+            return False
+        felt = self.touch.touched_by(self.i)
+        return any(self.source in felt[p]["agents"] for p in self.parts if p in felt)
+
+
+def touch_system(env):
+    """The env's shared :class:`~mimo_social.senses.touch.TouchSystem` (None without touch)."""
+    for s in env.shared:
+        if getattr(s, "name", None) == "touch" and hasattr(s, "touched_by"):
+            return s
+    return None
+
+
+# -- the task ----------------------------------------------------------------------------------
+START_TRIES = 50   # random start postures tried until the hands touch nothing
+
+
+class HighFive(Task):
+    name = "high_five"
+    n_agents_range = (2, 2)
+    default_n_agents = 2
+    default_max_steps = 500
+
+    def __init__(self, n_agents: int, **options):
+        super().__init__(n_agents, **options)
+        o = self.options
+        o["touch_bonus"] = check_number(self.name, "touch_bonus", o["touch_bonus"])
+        o["end_on_touch"] = check_bool(self.name, "end_on_touch", o["end_on_touch"])
+        o["distance"] = check_number(self.name, "distance", o["distance"], *DISTANCE_RANGE)
+        o["start_spread"] = check_number(self.name, "start_spread", o["start_spread"], 0.0, 1.0)
+        # the hand version of each agent, for the default skin; set by ``high_five_v0``
+        self.agent_hands: list[str] = ["mitten"] * self.n_agents
+
+    def option_defaults(self) -> dict:
+        return {"touch_bonus": 100.0, "end_on_touch": True, "distance": DISTANCE,
+                "start_spread": 0.3}
+
+    def agent_defaults(self, i):
+        return {"posture": "standing", "touch": hand_touch(self.agent_hands[i])}
+
+    def setup(self, i, config):
+        dist = float(self.options["distance"])
+        pos, facing = face_to_face(i, dist)
+        tables = load_body(config.hands)
+        require_skin(self.name, f"infant_{i}", config, right_hand_parts(tables),
+                     "the high five (the right hands meeting)")
+        arm = right_arm_joints(tables)
+        frozen = held_posture(tables, keep=arm + GAZE_JOINTS,
+                              angles={"right_knee": -5, "left_knee": -5})
+        return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
+                          frozen=frozen, base="fixed", actuated=arm,
+                          gaze_joints=GAZE_JOINTS)
+
+    def _bind(self, env):
+        w = env.world
+        self._world = w
+        self._gaze = [Gaze(w, i) for i in range(2)]
+        self._palms = np.array([w.agents[i].palm_sites[0] for i in range(2)], dtype=np.intp)
+        hands = [hand_geoms(w, i) for i in range(2)]
+        self._hands_meet = ContactProbe(w.model.ngeom, hands[0], hands[1])
+        touch = touch_system(env)
+        self._feels = [SkinSource(w, touch, i, hands[i], right_hand_parts(w.tables[i]), 1 - i)
+                       for i in range(2)]
+        self._hand_mask = np.zeros(w.model.ngeom, bool)
+        self._hand_mask[np.concatenate(hands)] = True
+        # each arm's joints: qpos/dof addresses, the standing pose's angles (rad) and ranges
+        self._arms = []
+        rest = w.initial_qpos
+        for a in w.agents:
+            k = a.actuated_joint_idx
+            lo, hi = a.joint_range[k, 0], a.joint_range[k, 1]
+            self._arms.append((a.qpos_adr[k], a.dof_adr[k], rest[a.qpos_adr[k]].copy(), lo, hi))
+
+    def reset(self, env, rng):
+        if getattr(self, "_world", None) is not env.world:
+            self._bind(env)
+        m, d = env.world.model, env.world.data
+        spread = self.options["start_spread"]
+        for _ in range(START_TRIES):  # each arm in its own random posture, the hands touching nothing
+            for q, v, mid, lo, hi in self._arms:
+                u = rng.uniform(-0.5, 0.5, len(q))
+                d.qpos[q] = np.clip(mid + u * spread * (hi - lo), lo, hi)
+                d.qvel[v] = 0.0
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_collision(m, d)
+            n = d.ncon
+            g1, g2 = d.contact.geom1[:n], d.contact.geom2[:n]
+            if not np.any((self._hand_mask[g1] | self._hand_mask[g2]) & (d.contact.dist[:n] < 0)):
+                break
+        self._touching = False
+        self._felt = [False, False]
+        self._distance = float("nan")
+        self.before_physics(env)
+
+    def before_physics(self, env):
+        m, d = env.world.model, env.world.data
+        for i in range(2):
+            self._gaze[i](m, d, "site", self._palms[1 - i])
+
+    def rewards(self, env):
+        d = env.world.data
+        p = d.site_xpos[self._palms]
+        dist = float(np.linalg.norm(p[0] - p[1]))
+        self._felt = [bool(f(d)) for f in self._feels]
+        self._touching = self._felt[0] and self._felt[1] and self._hands_meet(d)
+        r = -dist + (self.options["touch_bonus"] if self._touching else 0.0)
+        self._distance = dist
+        return np.array([r, r])
+
+    def terminations(self, env):
+        done = self._touching and self.options["end_on_touch"]
+        infos = [{"is_success": self._touching, "hands_touching": self._touching,
+                  "hand_feels_partner": self._felt[i], "hand_distance": self._distance}
+                 for i in range(2)]
+        return np.array([done, done]), infos

@@ -1,0 +1,196 @@
+"""Self-body knowledge (paper Sec. VI-A): a cross-legged infant touches a named part of its own
+body with its right hand.
+
+| | |
+|---|---|
+| agents | 1 (`infant_0`), mitten hands, spring-damper motors |
+| body | hip fixed, sitting cross-legged (legs crossed in front, shins towards the midline), trunk bent forward; everything but the right arm held (trunk, head, eyes, legs, left arm: they cannot move, but their skin feels) |
+| reset | the right arm starts held out to the side, touching nothing; a target part is drawn uniformly from `targets` (task option `target` fixes it) |
+| physics | one physics step (5 ms) per control step (`frame_skip=1`), as published |
+| action | the right-arm motors: 8 in [-1, 1] (shoulder 3, elbow, wrist 3, fingers) |
+| observation | `proprioception`, `touch` (the whole skin; by default at a quarter of the published point density and the normal force only, 1 float a point), `target`: one-hot over `targets` (15 parts for the mitten body) |
+| reward | `+500` when the right hand (hand or fingers) touches the target part; else `-distance(contact, target part's centre of mass)` (m, the contact nearest the target) when the right hand touches another part of the body; else `-1` |
+| termination | when the target is touched; truncation at 500 steps |
+| infos | `target` (part name), `is_success`, `touched` (parts the right hand touches), `distance` (m; None when the hand touches no part) |
+
+`targets` by default: every body part except the right arm's own (upper arm, lower arm, hand,
+fingers), the eyes and the left toes, which lie out of the right hand's reach in this pose (none of
+20,000 random right-arm postures touches them): hip, lower and upper trunk, head, the left arm's
+four parts, the right leg's four parts and the left leg's thigh, shin and foot (15 for the mitten
+body). The trunk is bent forward as far as it goes and the left hand rests on the lap so that the
+rest is within reach; the hip is fixed where the body's lowest point touches the floor.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from gymnasium import spaces
+
+from ..body.tables import load_body
+from ..core.world import AgentSetup
+from ..core.task import Task, hand_geoms, held_posture, right_arm_joints
+
+CROSS_LEGGED_DEG = {
+    "right_hip_flexion": -120.0, "left_hip_flexion": -120.0,
+    "right_hip_abduction": -51.0, "left_hip_abduction": -51.0,
+    "right_hip_rotation": 40.0, "left_hip_rotation": 40.0,
+    "right_knee": -130.0, "left_knee": -130.0,
+    "right_ankle_flexion": 20.0, "left_ankle_flexion": 20.0,
+    # the left hand rests on the lap, within the right hand's reach
+    "left_shoulder_horizontal": 52.0, "left_shoulder_abduction": 41.0,
+    "left_shoulder_rotation": 0.0, "left_elbow": -64.0,
+    "lower_trunk_bend": 30.0,
+}
+# the right arm at the start: raised to the side, elbow bent a little, touching nothing
+ARM_START_DEG = {"right_shoulder_abduction": 45.0, "right_shoulder_horizontal": 20.0,
+                 "right_elbow": -30.0}
+EXCLUDED_SUFFIXES = ("_eye",)
+# out of the right hand's reach in this pose (none of 20,000 random right-arm postures touches it)
+UNREACHABLE = ("left_toes",)
+
+
+def default_targets(tables) -> tuple[str, ...]:
+    """Every body part with geoms except the right arm's own parts and the eyes."""
+    from ..body.tables import subtree
+    arm = set(subtree(tables, "right_upper_arm"))
+    with_geoms = []
+    for g in tables.geoms:
+        if g.body not in with_geoms:
+            with_geoms.append(g.body)
+    return tuple(b for b in with_geoms if b not in arm and b not in UNREACHABLE
+                 and not b.endswith(EXCLUDED_SUFFIXES))
+
+
+class SelfBody(Task):
+    name = "selfbody"
+    n_agents_range = (1, 1)
+    default_n_agents = 1
+    default_max_steps = 500
+    physics_overrides = {"frame_skip": 1}
+
+    def option_defaults(self) -> dict:
+        return {"targets": None, "target": None, "success_reward": 500.0, "miss_reward": -1.0}
+
+    def agent_defaults(self, i):
+        return {"posture": "sitting", "vestibular": False, "expressions": False,
+                "touch": {"density": 0.25, "normal_only": True}}
+
+    def setup(self, i, config):
+        tables = load_body(config.hands)
+        arm = right_arm_joints(tables)
+        frozen = held_posture(tables, keep=arm, angles=CROSS_LEGGED_DEG)
+        targets = self.options["targets"]
+        targets = tuple(targets) if targets is not None else default_targets(tables)
+        parts = {g.body for g in tables.geoms}
+        unknown = [t for t in targets if t not in parts]
+        if unknown or not targets:
+            raise ValueError(f"selfbody: targets {unknown or list(targets)} not allowed; body parts "
+                             f"of the {config.hands} body: {sorted(parts)}")
+        fixed = self.options["target"]
+        if fixed is not None and fixed not in targets:
+            raise ValueError(f"selfbody: target={fixed!r} not allowed; one of {list(targets)}")
+        self.targets = targets
+        return AgentSetup(config, position=(0.0, 0.0), facing=(1.0, 0.0), frozen=frozen,
+                          base="fixed", actuated=arm)
+
+    def task_spaces(self, env, i):
+        return {"target": spaces.Box(0.0, 1.0, (len(self.targets),), np.float32)}
+
+    def _bind(self, env):
+        w = env.world
+        m = w.model
+        a = w.agents[0]
+        self._world = w
+        hand = hand_geoms(w, 0, 0)
+        self._is_hand = np.zeros(m.ngeom, bool)
+        self._is_hand[hand] = True
+        # every geom of this infant outside the right hand -> its body id; others -> -1
+        self._part_body = np.full(m.ngeom, -1, dtype=np.intp)
+        own = a.geom_ids[~self._is_hand[a.geom_ids]]
+        self._part_body[own] = m.geom_bodyid[own]
+        self._target_bodies = np.array([m.body(f"{a.name}/{t}").id for t in self.targets],
+                                       dtype=np.intp)
+        idx = {n: k for k, n in enumerate(a.joint_names)}
+        ks = [idx[n] for n in ARM_START_DEG if n in idx]
+        self._arm_qpos = a.qpos_adr[ks]
+        self._arm_start = np.clip(np.deg2rad([ARM_START_DEG[a.joint_names[k]] for k in ks]),
+                                  a.joint_range[ks, 0], a.joint_range[ks, 1])
+        self._names = {int(b): m.body(int(b)).name[len(a.name) + 1:]
+                       for b in np.unique(self._part_body[own])}
+
+    def reset(self, env, rng):
+        if getattr(self, "_world", None) is not env.world:
+            self._bind(env)
+        d = env.world.data
+        d.qpos[self._arm_qpos] = self._arm_start
+        fixed = self.options["target"]
+        self._target = (self.targets.index(fixed) if fixed is not None
+                        else int(rng.integers(len(self.targets))))
+        self._onehot = np.zeros(len(self.targets), np.float32)
+        self._onehot[self._target] = 1.0
+        self._success = False
+        self._touched: list[str] = []
+        self._distance = None
+
+    def observe(self, env, i):
+        return {"target": self._onehot.copy()}
+
+    @property
+    def target(self) -> str:
+        """The current episode's target part."""
+        return self.targets[self._target]
+
+    def _contacts(self, d):
+        """Bodies the right hand touches, and the contact positions."""
+        n = d.ncon
+        if n == 0:
+            return np.empty(0, np.intp), np.empty((0, 3))
+        c = d.contact
+        g1, g2 = c.geom1[:n], c.geom2[:n]
+        h1, h2 = self._is_hand[g1], self._is_hand[g2]
+        other = np.where(h1, g2, g1)
+        body = self._part_body[other]
+        keep = (h1 ^ h2) & (body >= 0) & (c.dist[:n] <= 0.0)
+        return body[keep], c.pos[:n][keep]
+
+    def rewards(self, env):
+        d = env.world.data
+        bodies, pos = self._contacts(d)
+        target = self._target_bodies[self._target]
+        self._touched = sorted({self._names[int(b)] for b in bodies})
+        self._success = bool(np.any(bodies == target))
+        if self._success:
+            self._distance = 0.0
+            return np.array([float(self.options["success_reward"])])
+        if len(bodies):
+            self._distance = float(np.min(np.linalg.norm(pos - d.xipos[target], axis=1)))
+            return np.array([-self._distance])
+        self._distance = None
+        return np.array([float(self.options["miss_reward"])])
+
+    def terminations(self, env):
+        return (np.array([self._success]),
+                [{"target": self.target, "is_success": self._success,
+                  "touched": list(self._touched), "distance": self._distance}])
+
+    # -- for tests and demos ----------------------------------------------------------------------
+    def place_hand_on(self, env, part: str, iters: int = 200) -> float:
+        """Move the right arm (joint angles, no physics) until the palm centre lies on ``part``'s
+        surface nearest to it; returns the remaining distance (m) between the hand and the part
+        (negative: penetrating). Used by tests; a policy has to learn this."""
+        from .standup import reach_sites
+        w = env.world
+        m, d = w.model, w.data
+        a = w.agents[0]
+        k = a.actuated_joint_idx
+        body = m.body(f"{a.name}/{part}").id
+        geoms = np.flatnonzero(m.geom_bodyid == body)
+        target = d.xipos[body].copy()
+        reach_sites(m, d, a.qpos_adr[k], a.dof_adr[k], a.joint_range[k, 0], a.joint_range[k, 1],
+                    a.palm_sites[0], target, iters)
+        mujoco.mj_forward(m, d)
+        hand = np.flatnonzero(self._is_hand)
+        fromto = np.zeros(6)
+        return float(min(mujoco.mj_geomDistance(m, d, int(h), int(g), 0.05, fromto)
+                         for h in hand for g in geoms))

@@ -1,0 +1,246 @@
+"""Social touch: a sitting infant touches a named part of its partner's body, who feels it.
+
+| | |
+|---|---|
+| agents | 2: the toucher `infant_0` and the touched infant `infant_1`, sitting cross-legged face to face, `distance` (0.28 m) apart hip to hip, within arm's reach |
+| body | hips fixed on the floor, legs crossed; the toucher: everything but the right arm held, the trunk bent forward towards the partner (lower trunk 20 deg, the upper trunk coupled), the left arm hanging at its side; the touched infant: everything but both arms held, leaning back a little (6 deg); heads upright; the eyes are set by the task each control step: the toucher's fixate the target part, the touched infant's the toucher's right hand |
+| reset | the toucher's right arm starts out to its side, touching nothing; the touched infant's hands rest on its legs; the target part is drawn uniformly from `targets` (task option `target` fixes it) |
+| action | `infant_0`: the right arm's motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five fingers: 29) in [-1, 1]; `infant_1`: both arms' motors (16; 58), zero in the scripted env (`Still` partner); expressions off by default (`expressions=True` adds them) |
+| observation | both: `proprioception` (the toucher's eye angles tell where the target is), `touch` (normal force only, 1 float a point): the toucher's skin covers its right arm (upper arm to fingertips, a tenth of the published point density: 242 floats), the touched infant's its whole body (a quarter of the density: 1400); the toucher also gets `target`, one-hot over `targets` (9 for the mitten body) |
+| reward (both) | `-distance(toucher's right fingertips, target part's centre of mass)` (m) per step, `+success_reward` (100) on success |
+| success (`is_success`) | the toucher's right hand (hand or fingers) touches the target part and the touched infant's skin feels it there, with the toucher as the source |
+| termination | both, on success (if `end_on_touch`, default); touching another part does not end the episode; truncation at `max_steps` (500 steps, 5 s) |
+| infos (both) | `target_part`, `is_success`, `touched_parts` (the partner's parts the toucher's right hand touches this step), `target_felt` (the touched infant's skin feels the toucher on the target part), `fingertip_distance` (m), and each agent's own skin record `touch` |
+| options | `targets` (None: :data:`DEFAULT_TARGETS`, those of them in the partner's body), `target` (None), `success_reward` (100.0), `end_on_touch` (True), `distance` (0.28 m, 0.25 to 0.4) |
+
+Targets by default are the partner's parts within the toucher's reach in this pose: head, upper
+and lower trunk, the partner's left arm (upper arm, lower arm, hand and the mitten's fingers: it
+is on the toucher's right) and left thigh and shin. The partner's right arm, hip, feet and the
+far leg are out of reach (next to no random posture of the toucher's right arm touches them);
+the eyes are never targets. With another `distance`, give `targets` reachable there. Only two
+infants: a third raises an error (a dyad: one toucher, one touched).
+
+Why the toucher's trunk is held: a free trunk with zero command sags forward under gravity
+until the heads meet; held bent forward it gives the arm the reach, and the action stays the
+arm's alone.
+
+Why: being touched and touching others are, with gaze, the first channels of social exchange.
+Caregivers' touch regulates and engages infants from birth, and in the second year infants
+point to and touch named body parts of themselves and of others ("where is your nose?"), a
+game that builds a body map shared between self and partner. Here the touch is a contingent
+event felt on both sides: the toucher is rewarded when the partner feels the touch on the named
+part, and the partner's skin reports who touched where, the signal for touch-based turn taking
+when both infants learn.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from gymnasium import spaces
+
+from ..body.tables import load_body, subtree
+from ..core.config import ConfigError
+from ..core.world import AgentSetup
+from ..core.task import EYE_GAZE_JOINTS, Gaze, Task, hand_geoms, held_posture, right_arm_joints
+from .high_five import (check_bool, check_number, require_skin, right_hand_parts, skin_parts,
+                        touch_only_on, touch_system)
+from .selfbody import CROSS_LEGGED_DEG
+
+TOUCHER, TOUCHED = 0, 1
+DISTANCE = 0.28
+DISTANCE_RANGE = (0.25, 0.4)   # closer, the crossed feet meet; farther, little is in reach
+# cross-legged (the legs of the self-body pose)
+SITTING_DEG = {k: v for k, v in CROSS_LEGGED_DEG.items()
+               if "hip" in k or "knee" in k or "ankle" in k}
+# the touched infant leans back a little, so that the leaning toucher's head stays clear of it
+RECLINE_DEG = -6.0
+# the toucher's lower trunk bend (the upper trunk follows, coupled): towards the partner
+LEAN_DEG = 20.0
+# the toucher's left arm hangs at its side, out of the way
+SIDE_ARM_DEG = {"left_shoulder_abduction": 15.0, "left_elbow": -10.0}
+# the toucher's right arm at the start: out to its side, elbow a little bent, touching nothing
+ARM_START_DEG = {"right_shoulder_abduction": 45.0, "right_shoulder_horizontal": 0.0,
+                 "right_elbow": -30.0}
+# the partner's parts that the toucher's right hand reaches at the default distance: each was
+# touched by at least 20 of 4,000 uniformly random postures of the toucher's right arm; the hip
+# (5) and the eyes (5) were touched by next to none, every other part by none
+DEFAULT_TARGETS = ("head", "upper_body", "lower_body",
+                   "left_upper_arm", "left_lower_arm", "left_hand", "left_fingers",
+                   "left_upper_leg", "left_lower_leg")
+
+
+def arms_joints(tables) -> tuple[str, ...]:
+    from ..body.tables import arm_joints
+    return arm_joints(tables, "right") + arm_joints(tables, "left")
+
+
+class SocialTouch(Task):
+    name = "social_touch"
+    n_agents_range = (2, 2)
+    default_n_agents = 2
+    default_max_steps = 500
+
+    def __init__(self, n_agents: int = 2, **options):
+        if isinstance(n_agents, (int, np.integer)) and not isinstance(n_agents, bool) \
+                and n_agents != 2:
+            raise ConfigError(f"social_touch: n_agents={n_agents!r} not allowed; allowed: 2 to 2 "
+                              "(a dyad: the toucher infant_0 and the touched infant_1)")
+        super().__init__(n_agents, **options)
+        o = self.options
+        o["success_reward"] = check_number(self.name, "success_reward", o["success_reward"])
+        o["end_on_touch"] = check_bool(self.name, "end_on_touch", o["end_on_touch"])
+        o["distance"] = check_number(self.name, "distance", o["distance"], *DISTANCE_RANGE)
+        t = o["targets"]
+        if t is not None:
+            if isinstance(t, str) or not all(isinstance(x, str) for x in t) or not len(t) \
+                    or len(set(t)) != len(t):
+                raise ConfigError(f"social_touch: targets={t!r} not allowed; None or a non-empty "
+                                  "list of distinct body part names of the partner")
+            o["targets"] = tuple(t)
+        if o["target"] is not None and not isinstance(o["target"], str):
+            raise ConfigError(f"social_touch: target={o['target']!r} not allowed; None or a body "
+                              "part name from targets")
+        self.agent_hands: list[str] = ["mitten"] * self.n_agents
+        self.targets: tuple[str, ...] = ()
+
+    def option_defaults(self) -> dict:
+        return {"targets": None, "target": None, "success_reward": 100.0, "end_on_touch": True,
+                "distance": DISTANCE}
+
+    def agent_defaults(self, i):
+        common = {"posture": "sitting", "vestibular": False, "expressions": False}
+        if i == TOUCHER:
+            tables = load_body(self.agent_hands[i])
+            return dict(common, touch=touch_only_on(tables, subtree(tables, "right_upper_arm")))
+        return dict(common, touch={"density": 0.25, "normal_only": True})
+
+    # -- building ------------------------------------------------------------------------------
+    def _resolve_targets(self, tables) -> tuple[str, ...]:
+        parts = skin_parts(tables)
+        given = self.options["targets"]
+        if given is None:
+            targets = tuple(p for p in DEFAULT_TARGETS if p in parts)
+        else:
+            bad = [p for p in given if p not in parts]
+            if bad:
+                raise ConfigError(f"social_touch: targets {bad} are not body parts of the "
+                                  f"partner ({tables.hands} body); body parts: {list(parts)}")
+            targets = tuple(given)
+        fixed = self.options["target"]
+        if fixed is not None and fixed not in targets:
+            raise ConfigError(f"social_touch: target={fixed!r} not allowed; one of "
+                              f"{list(targets)}")
+        return targets
+
+    def setup(self, i, config):
+        dist = float(self.options["distance"])
+        pos = (0.0, 0.0) if i == TOUCHER else (dist, 0.0)
+        facing = (dist, 0.0) if i == TOUCHER else (0.0, 0.0)
+        tables = load_body(config.hands)
+        if i == TOUCHER:
+            actuated = right_arm_joints(tables)
+            angles = {**SITTING_DEG, **SIDE_ARM_DEG, "lower_trunk_bend": LEAN_DEG}
+            require_skin(self.name, "infant_0", config, right_hand_parts(tables),
+                         "the touch it gives")
+        else:
+            self.targets = self._resolve_targets(tables)
+            actuated = arms_joints(tables)
+            angles = {**SITTING_DEG, "lower_trunk_bend": RECLINE_DEG}
+            require_skin(self.name, "infant_1", config, self.targets,
+                         "the touch it receives on every target part")
+        frozen = held_posture(tables, keep=actuated + EYE_GAZE_JOINTS, angles=angles)
+        return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
+                          frozen=frozen, base="fixed", actuated=actuated,
+                          gaze_joints=EYE_GAZE_JOINTS)
+
+    def task_spaces(self, env, i):
+        if i == TOUCHER:
+            return {"target": spaces.Box(0.0, 1.0, (len(self.targets),), np.float32)}
+        return {}
+
+    def _bind(self, env):
+        w = env.world
+        m = w.model
+        self._world = w
+        toucher, touched = w.agents[TOUCHER], w.agents[TOUCHED]
+        self._touch = touch_system(env)
+        self._gaze = [Gaze(w, TOUCHER), Gaze(w, TOUCHED)]
+        self._is_hand = np.zeros(m.ngeom, bool)
+        self._is_hand[hand_geoms(w, TOUCHER, 0)] = True
+        # every geom of the touched infant -> its body id; every other geom -> -1
+        self._partner_body = np.full(m.ngeom, -1, dtype=np.intp)
+        self._partner_body[touched.geom_ids] = m.geom_bodyid[touched.geom_ids]
+        prefix = len(touched.name) + 1
+        self._part_name = {int(b): m.body(int(b)).name[prefix:]
+                           for b in np.unique(m.geom_bodyid[touched.geom_ids])}
+        self._target_bodies = np.array([m.body(f"{touched.name}/{t}").id for t in self.targets],
+                                       dtype=np.intp)
+        self._fingertip = int(toucher.fingertip_sites[0])
+        self._palm = int(toucher.palm_sites[0])
+        idx = {n: k for k, n in enumerate(toucher.joint_names)}
+        ks = [idx[n] for n in ARM_START_DEG if n in idx]
+        self._arm_qpos = toucher.qpos_adr[ks]
+        self._arm_start = np.clip(np.deg2rad([ARM_START_DEG[toucher.joint_names[k]] for k in ks]),
+                                  toucher.joint_range[ks, 0], toucher.joint_range[ks, 1])
+        self._source = toucher.name
+
+    def reset(self, env, rng):
+        if getattr(self, "_world", None) is not env.world:
+            self._bind(env)
+        env.world.data.qpos[self._arm_qpos] = self._arm_start
+        fixed = self.options["target"]
+        self._target = (self.targets.index(fixed) if fixed is not None
+                        else int(rng.integers(len(self.targets))))
+        self._onehot = np.zeros(len(self.targets), np.float32)
+        self._onehot[self._target] = 1.0
+        self._success = self._felt = False
+        self._touched: list[str] = []
+        self._distance = float("nan")
+        self.before_physics(env)
+
+    @property
+    def target(self) -> str:
+        """The current episode's target part (of the touched infant's body)."""
+        return self.targets[self._target]
+
+    def before_physics(self, env):
+        m, d = env.world.model, env.world.data
+        self._gaze[TOUCHER](m, d, "body", self._target_bodies[self._target])
+        self._gaze[TOUCHED](m, d, "site", self._palm)
+
+    def observe(self, env, i):
+        return {"target": self._onehot.copy()} if i == TOUCHER else {}
+
+    def _hand_contacts(self, d) -> np.ndarray:
+        """Body ids of the touched infant's parts in contact with the toucher's right hand."""
+        n = d.ncon
+        if n == 0:
+            return np.empty(0, np.intp)
+        c = d.contact
+        g1, g2 = c.geom1[:n], c.geom2[:n]
+        h1, h2 = self._is_hand[g1], self._is_hand[g2]
+        body = self._partner_body[np.where(h1, g2, g1)]
+        keep = (h1 ^ h2) & (body >= 0) & (c.dist[:n] <= 0.0)
+        return body[keep]
+
+    def rewards(self, env):
+        d = env.world.data
+        target = self._target_bodies[self._target]
+        bodies = self._hand_contacts(d)
+        self._touched = sorted({self._part_name[int(b)] for b in bodies}) if len(bodies) else []
+        self._felt = False
+        if np.any(bodies == target):
+            felt = self._touch.touched_by(TOUCHED).get(self.target)
+            self._felt = bool(felt is not None and self._source in felt["agents"])
+        self._success = self._felt
+        self._distance = float(np.linalg.norm(d.site_xpos[self._fingertip] - d.xipos[target]))
+        r = -self._distance + (self.options["success_reward"] if self._success else 0.0)
+        return np.array([r, r])
+
+    def terminations(self, env):
+        done = self._success and self.options["end_on_touch"]
+        info = {"target_part": self.target, "is_success": self._success,
+                "touched_parts": self._touched, "target_felt": self._felt,
+                "fingertip_distance": self._distance}
+        return np.array([done, done]), [dict(info, touched_parts=list(self._touched))
+                                         for _ in range(2)]
