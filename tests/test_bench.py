@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from mimo_social.bench import suite as bench
+from mimo_social.core import random_actions
 
 TOP_KEYS = {"machine", "settings", "cold_start", "results"}
 ENTRY_KEYS = {"name", "n_agents", "real_s_per_sim_s", "build_s", "components"}
@@ -61,8 +62,8 @@ def test_markdown_and_targets(report):
 
 
 def test_actions_are_smooth_seeded_and_bounded():
-    a, ea = bench.smooth_random_actions(500, 44, 3)
-    b, eb = bench.smooth_random_actions(500, 44, 3)
+    a, ea = random_actions.smooth_random_actions(500, 44, 3)
+    b, eb = random_actions.smooth_random_actions(500, 44, 3)
     np.testing.assert_array_equal(a, b)
     np.testing.assert_array_equal(ea, eb)
     assert a.dtype == np.float32 and a.shape == (500, 44)
@@ -153,7 +154,7 @@ def test_muscle_actions_fill_their_bounds():
         env = free_play_v0.parallel_env(n_agents=1, actuation="muscle")
     except ValueError as e:  # the muscle model not in yet
         pytest.skip(str(e))
-    block = bench._action_block(env, 200, 0)
+    block = random_actions.random_action_block(env, 200, 0)
     motors = np.stack([a["infant_0"]["motors"] for a in block])
     box = env.action_space("infant_0")["motors"]
     assert (motors >= box.low).all() and (motors <= box.high).all()
@@ -161,8 +162,8 @@ def test_muscle_actions_fill_their_bounds():
     env.close()
     # spring-damper bounds [-1, 1] leave the actions unchanged
     x = np.linspace(-1, 1, 9, dtype=np.float32)[:, None]
-    np.testing.assert_array_equal(bench.to_bounds(x, -np.ones(1), np.ones(1)), x)
-    np.testing.assert_allclose(bench.to_bounds(x, np.zeros(1), np.ones(1)), (x + 1) / 2)
+    np.testing.assert_array_equal(random_actions.to_bounds(x, -np.ones(1), np.ones(1)), x)
+    np.testing.assert_allclose(random_actions.to_bounds(x, np.zeros(1), np.ones(1)), (x + 1) / 2)
 
 
 def test_configuration_that_cannot_be_built_is_skipped(monkeypatch):

@@ -169,7 +169,7 @@ def test_the_receiver_feels_the_ball_and_its_gaze_follows_it():
 
 @pytest.mark.parametrize("kwargs, pattern", [
     ({"task_options": {"ball_colour": "red"}}, r"unknown task option.*allowed"),
-    ({"task_options": {"ball_radius": 0.1}}, r"ball_radius=0.1.*\[0.015, 0.045\]"),
+    ({"task_options": {"ball_radius": 0.1}}, r"ball_radius=0.1.*from 0.015 to 0.045"),
     ({"task_options": {"min_parts": 2.5}}, r"min_parts=2.5.*integer"),
     ({"task_options": {"hold_time": "long"}}, r"hold_time='long'"),
     ({"task_options": {"offer_target": (0, 0)}}, r"offer_target=.*forward, left, up"),

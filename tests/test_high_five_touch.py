@@ -7,7 +7,7 @@ from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import high_five_v0
 from mimo_social.core.config import ConfigError
-from mimo_social.tasks.high_five import hand_touch, touch_system
+from mimo_social.tasks.high_five import hand_touch
 from mimo_social.tasks.standup import reach_sites
 from mimo_social.partners import Still
 from mimo_social.partners.hand_offer import HandOffer
@@ -48,7 +48,7 @@ def test_api_and_seed():
 def test_the_default_skin_covers_the_right_hand_only():
     env = high_five_v0.parallel_env(expressions=False)
     obs, _ = env.reset(seed=0)
-    touch = touch_system(env)
+    touch = env.system("touch")
     for a in env.possible_agents:
         layout = touch.layout(a)
         assert set(layout) == HAND
@@ -57,7 +57,7 @@ def test_the_default_skin_covers_the_right_hand_only():
         assert not obs[a]["touch"].any()                       # nothing touches at the start
     # the user can turn on more skin
     whole = high_five_v0.parallel_env(expressions=False, touch=True)
-    assert {"hip", "head", "right_hand"} <= set(touch_system(whole).layout("infant_1"))
+    assert {"hip", "head", "right_hand"} <= set(whole.system("touch").layout("infant_1"))
 
 
 def test_hands_together_are_felt_by_both_skins_and_give_the_bonus():
@@ -68,7 +68,7 @@ def test_hands_together_are_felt_by_both_skins_and_give_the_bonus():
     assert not term["infant_0"] and not info["infant_0"]["is_success"]
     _hands_together(env)
     obs, r, term, trunc, info = env.step(_zero(env))
-    touch = touch_system(env)
+    touch = env.system("touch")
     for me, other in (("infant_0", "infant_1"), ("infant_1", "infant_0")):
         assert info[me]["is_success"] and info[me]["hands_touching"]
         assert info[me]["hand_feels_partner"]
@@ -133,7 +133,7 @@ def test_five_fingered_hands_get_their_own_hand_skin():
     env = high_five_v0.parallel_env(expressions=False, per_agent=[{}, {"hands": "five_fingers"}],
                                     max_steps=5, task_options={"distance": CLOSE, "start_spread": 0.0})
     obs, _ = env.reset(seed=0)
-    touch = touch_system(env)
+    touch = env.system("touch")
     assert set(touch.layout("infant_0")) == HAND
     parts1 = set(touch.layout("infant_1"))
     assert "right_hand" in parts1 and "right_index_distal" in parts1 and len(parts1) == 17
@@ -183,7 +183,7 @@ def test_scripted_env_offers_a_hand():
     ({"touch": False}, r"infant_0 has touch=False.*turn touch on"),
     ({"per_agent": [{}, {"touch": {"exclude": ["right_fingers"]}}]},
      r"infant_1's touch excludes \['right_fingers'\]"),
-    ({"task_options": {"distance": 0.1}}, r"distance=0.1 not allowed; a number from 0.25 to 0.6"),
+    ({"task_options": {"distance": 0.1}}, r"distance=0.1 not allowed; allowed: a number from 0.25 to 0.6"),
     ({"task_options": {"distance": "far"}}, r"distance='far' not allowed"),
     ({"task_options": {"end_on_touch": "yes"}}, r"end_on_touch='yes'.*True or False"),
     ({"task_options": {"touch_bonus": float("nan")}}, r"touch_bonus=nan.*finite"),

@@ -576,7 +576,7 @@ def touch_episode(tmp_path_factory):
         for _ in range(30):
             obs, rewards, *_ = env.step(zero)
             rec.log_step(zero, rewards, obs)
-    system = next(s for s in env.shared if s.name == "touch")
+    system = env.system("touch")
     views = {a: system.view(a) for a in env.possible_agents}
     yield {"env": env, "data": read_rrd(path), "views": views}
     env.close()

@@ -166,7 +166,7 @@ def test_touch_has_the_same_points_at_every_scale_and_feels_the_weight():
         env = free_play_v0.parallel_env(n_agents=1, scale=s, posture="lying", expressions=False,
                                         touch={"normal_only": True, "frame": "world"})
         obs, _ = env.reset(seed=0)
-        skin = next(x for x in env.shared if x.name == "touch").skins[0]
+        skin = env.system("touch").skins[0]
         counts.append(skin.counts())
         z = zero_actions(env)
         for _ in range(150):
@@ -186,7 +186,7 @@ def test_touch_points_do_not_depend_on_rounding_at_any_scale(scale):
     counts = []
     for s in (1.0, scale):
         env = free_play_v0.parallel_env(n_agents=1, hands="five_fingers", scale=s, touch=True)
-        skin = next(x for x in env.shared if x.name == "touch").skins[0]
+        skin = env.system("touch").skins[0]
         counts.append(skin.counts())
         spacing = skin.part_spacing[skin.point_part]
         nearest = skin.nbr_dist[:, 1]                  # distance to each point's neighbour
@@ -302,7 +302,7 @@ def test_mixed_bodies_build_and_step():
     assert obs["infant_0"]["eye_left"].shape == (24, 32, 3)
     assert obs["infant_1"]["eye_right"].shape == (16, 16, 3)
     assert "eye_left" not in obs["infant_2"] and "touch" not in obs["infant_0"]
-    assert obs["infant_1"]["touch"].size == 3 * env.shared[0].skins[1].n_points
+    assert obs["infant_1"]["touch"].size == 3 * env.system("touch").skins[1].n_points
     assert inter_agent_contacts(env) == 0
     knee = env.world.agents[2].actuated_names.index("right_knee")
     assert env.actuation[2].torque_pos[knee] == pytest.approx(10.0 * 2.2 ** 4 * 0.6)

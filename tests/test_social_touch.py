@@ -7,7 +7,6 @@ from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import social_touch_v0
 from mimo_social.core.task import hand_geoms
-from mimo_social.tasks.high_five import touch_system
 from mimo_social.tasks.standup import reach_sites
 from mimo_social.partners import Still
 
@@ -46,7 +45,7 @@ def test_spaces_and_skins():
     assert set(s1) == {"proprioception", "touch"}
     assert env.action_space("infant_0").shape == (8,)              # the right arm
     assert env.action_space("infant_1").shape == (16,)             # both arms
-    touch = touch_system(env)
+    touch = env.system("touch")
     assert set(touch.layout("infant_0")) == {"right_upper_arm", "right_lower_arm", "right_hand",
                                              "right_fingers"}
     assert set(MITTEN_TARGETS) < set(touch.layout("infant_1"))    # the whole body
@@ -117,7 +116,7 @@ def test_touching_the_target_rewards_both_and_the_partner_feels_it(target):
         assert r[a] == pytest.approx(100.0 - info[a]["fingertip_distance"])
     # the touched infant's skin: force on that part, and the toucher named as its source
     assert "infant_0" in info["infant_1"]["touch"][target]["agents"]
-    lo, hi = touch_system(env).layout("infant_1")[target]
+    lo, hi = env.system("touch").layout("infant_1")[target]
     assert obs["infant_1"]["touch"][lo:hi].sum() > 0.0
     # the toucher feels it too, on its right hand
     assert {"right_hand", "right_fingers"} & set(info["infant_0"]["touch"])
@@ -189,7 +188,7 @@ def test_five_fingered_partner_gets_its_own_targets():
     ({"task_options": {"targets": ["head", "tail"]}}, r"targets \['tail'\] are not body parts"),
     ({"task_options": {"targets": "head"}}, r"targets='head' not allowed"),
     ({"task_options": {"target": "right_toes"}}, r"target='right_toes' not allowed; one of"),
-    ({"task_options": {"distance": 0.1}}, r"distance=0.1 not allowed; a number from 0.25 to 0.4"),
+    ({"task_options": {"distance": 0.1}}, r"distance=0.1 not allowed; allowed: a number from 0.25 to 0.4"),
     ({"task_options": {"success_reward": "lots"}}, r"success_reward='lots' not allowed"),
     ({"task_options": {"end_on_touch": 1}}, r"end_on_touch=1.*True or False"),
     ({"task_options": {"colour": "red"}}, r"unknown task option.*'target'"),

@@ -20,7 +20,7 @@ The configurations (:data:`CONFIGS`; the default set is every one but ``jacobian
   Jacobian (free play without props or recording; only with ``--only``).
 
 Every configuration runs the same smooth random actions (low-pass filtered uniform noise per
-motor, seeded, see :func:`smooth_random_actions`, mapped onto each agent's action-space bounds),
+motor, seeded, see :func:`mimo_social.core.random_actions.smooth_random_actions`, mapped onto each agent's action-space bounds),
 generated in a block *before* the timed loop, so their cost is never counted. Resets between
 episodes are not counted either (their time is taken out of the total and their sense readings
 out of the components).
@@ -64,8 +64,10 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ..core.random_actions import agent_seeds, random_action_block
+
 __all__ = [
-    "CONFIGS", "DEFAULT_CONFIGS", "COMPONENTS", "BenchConfig", "smooth_random_actions",
+    "CONFIGS", "DEFAULT_CONFIGS", "COMPONENTS", "BenchConfig",
     "run_benchmarks", "fresh_build", "skin_cache_builds", "machine_info", "markdown_report",
     "plot_report", "target_checks", "mimo_comparison", "add_parser", "run",
 ]
@@ -213,79 +215,6 @@ CONFIGS: dict[str, BenchConfig] = {c.name: c for c in (
 DEFAULT_CONFIGS = [name for name, c in CONFIGS.items() if c.default]
 
 
-# -- actions ---------------------------------------------------------------------------------
-def smooth_random_actions(n_steps: int, n_motors: int, seed, dt: float = 0.01,
-                          tau: float = 0.1, n_expressions: int = 7,
-                          expression_period: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """Low-pass filtered uniform noise per motor and a slowly switching expression id.
-
-    Uniform noise ``w ~ U(-1, 1)`` through two cascaded first-order low-pass filters
-    ``x[k+1] = a x[k] + (1 - a) in[k]``, ``a = exp(-dt / tau)`` (so the motors move smoothly,
-    like a slow policy, not like white noise), rescaled to the spread of ``U(-1, 1)`` and clipped
-    to [-1, 1]. The filters run ``10 tau`` first so the block starts in their steady state. The
-    expression changes on average every ``expression_period`` seconds. Returns ``(motors
-    (n_steps, n_motors) float32, expressions (n_steps,) int64)``; the same ``seed`` gives the
-    same actions.
-    """
-    rng = np.random.default_rng(seed)
-    a = float(np.exp(-dt / tau))
-    # steady-state std of the cascade's output, relative to its input's
-    gain = np.sqrt((1.0 + a) ** 3 / ((1.0 - a) * (1.0 + a * a)))
-    burn = int(np.ceil(10 * tau / dt))
-    noise = rng.uniform(-1.0, 1.0, (burn + n_steps, n_motors))
-    x1 = np.zeros(n_motors)
-    x2 = np.zeros(n_motors)
-    motors = np.empty((n_steps, n_motors))
-    for k in range(burn + n_steps):
-        x1 = a * x1 + (1.0 - a) * noise[k]
-        x2 = a * x2 + (1.0 - a) * x1
-        if k >= burn:
-            motors[k - burn] = x2
-    motors = np.clip(motors * gain, -1.0, 1.0).astype(np.float32)
-    switch = rng.random(n_steps) < dt / expression_period
-    switch[0] = True
-    draws = rng.integers(0, n_expressions, n_steps)
-    expressions = draws[np.maximum.accumulate(np.where(switch, np.arange(n_steps), 0))]
-    return motors, expressions.astype(np.int64)
-
-
-def _agent_seeds(seed: int, n_agents: int):
-    return np.random.SeedSequence(seed).spawn(n_agents)
-
-
-def to_bounds(motors: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
-    """Map actions in [-1, 1] linearly onto [low, high] per column (unchanged when the bounds
-    are already [-1, 1], e.g. spring-damper; [0, 1] for muscles)."""
-    low = np.asarray(low, np.float32)
-    high = np.asarray(high, np.float32)
-    if np.all(low == -1.0) and np.all(high == 1.0):
-        return motors
-    out = low + (motors + np.float32(1.0)) * np.float32(0.5) * (high - low)
-    return np.clip(out, low, high).astype(np.float32)
-
-
-def _action_block(env, n_steps: int, seed: int) -> list[dict]:
-    """Every action dict of the run, built before timing (agent i always gets stream i)."""
-    from gymnasium import spaces
-
-    per_agent = []
-    for name, s in zip(env.possible_agents, _agent_seeds(seed, len(env.possible_agents))):
-        space = env.action_space(name)
-        with_expr = isinstance(space, spaces.Dict)
-        box = space["motors"] if with_expr else space
-        n_expr = space["expression"].n if with_expr else 7
-        motors, expr = smooth_random_actions(n_steps, box.shape[0], s, env.dt,
-                                             n_expressions=n_expr)
-        motors = to_bounds(motors, box.low, box.high)
-        per_agent.append((name, with_expr, motors, expr))
-    block = []
-    for k in range(n_steps):
-        block.append({name: ({"motors": motors[k], "expression": int(expr[k])} if with_expr
-                             else motors[k])
-                      for name, with_expr, motors, expr in per_agent})
-    return block
-
-
 # -- timing ----------------------------------------------------------------------------------
 def _zero_timing(env):
     for key in env.timing:
@@ -314,7 +243,7 @@ class _EnvRunner:
         self.build_s = time.perf_counter() - t
         try:
             self.n_steps = max(1, int(round(sim_seconds / env.dt)))
-            self.block = _action_block(env, self.n_steps, seed)
+            self.block = random_action_block(env, self.n_steps, seed)
             self.k = 0
             self.real = self.cpu = self.recording = 0.0
             self.episodes, self.unstable, self.reasons, self.ncon = 1, 0, [], []
@@ -691,7 +620,7 @@ env = cfg.make_env()
 t2 = time.perf_counter()
 env.reset(seed=0)
 t3 = time.perf_counter()
-skin = sorted({sk.from_cache or "built" for s in env.shared if s.name == "touch"
+skin = sorted({sk.from_cache or "built" for s in [env.systems.get("touch")] if s is not None
                for sk in s.skins if sk is not None})
 print("JSON" + json.dumps({"import_s": t1 - t0, "build_s": t2 - t1, "first_reset_s": t3 - t2,
                           "skin": skin}))

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, fields
 from typing import Any, Mapping, Sequence
 
 from ..body.tables import HAND_VERSIONS, SCALE_RANGE, STRENGTH_RANGE
+from ..util.checks import ConfigError
 
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "AgentConfig", "PhysicsConfig",
@@ -24,10 +25,6 @@ ACTUATION_MODELS = ("spring_damper", "muscle")
 POSTURES = ("standing", "sitting", "lying")
 PROPRIOCEPTION_COMPONENTS = ("qpos", "qvel", "torque", "limits", "actuation")
 VESTIBULAR_COMPONENTS = ("gyro", "accel")
-
-
-class ConfigError(ValueError):
-    """A configuration key or value that is not allowed."""
 
 
 def _from_mapping(cls, what: str, value: Mapping[str, Any]):

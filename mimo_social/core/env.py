@@ -66,7 +66,7 @@ class MimoParallelEnv(ParallelEnv):
         self._rng = np.random.default_rng()
         self._renderer = None
         self.timing = dict.fromkeys(TIMING_KEYS, 0.0)
-        self._steps = 0
+        self.steps = 0
 
     def _bind(self):
         """Actuation and senses of every agent, and the observation and action spaces.
@@ -77,7 +77,8 @@ class MimoParallelEnv(ParallelEnv):
         and ``update(model, data)``, run once per step before the senses read.
         """
         w = self.world
-        self.actuation, self.senses, self.shared = [], [], []
+        self.actuation, self.senses = [], []
+        self.systems = {}
         self._obs_spaces, self._act_spaces = {}, {}
         self._needs_substep = False
         for i, (name, cfg, a) in enumerate(zip(self.possible_agents, self.agent_configs, w.agents)):
@@ -101,7 +102,7 @@ class MimoParallelEnv(ParallelEnv):
             if any(configs):
                 mod = importlib.import_module(f"mimo_social.senses.{module}")
                 system, per_agent = getattr(mod, builder)(w, configs)
-                self.shared.append(system)
+                self.systems[key] = system
                 for i, sense in enumerate(per_agent):
                     if sense is not None:
                         self.senses[i].append(sense)
@@ -120,7 +121,16 @@ class MimoParallelEnv(ParallelEnv):
                                                    "expression": spaces.Discrete(len(EXPRESSIONS))})
                                       if self.agent_configs[i].expressions else motors)
         self._expression = np.zeros(len(self.possible_agents), dtype=np.int64)
-        self._controls = [np.zeros(act.n_controls) for act in self.actuation]
+        self.controls = [np.zeros(act.n_controls) for act in self.actuation]
+
+    def system(self, name: str):
+        """The shared system of a sense (``"touch"``: the skin of every agent, ``"vision"``: the
+        eyes of every agent), else a ValueError saying how to turn it on."""
+        try:
+            return self.systems[name]
+        except KeyError:
+            raise ValueError(f"this env has no {name} system (no agent has {name} on); make it "
+                             f"with {name}=True; systems here: {sorted(self.systems)}") from None
 
     # -- PettingZoo API --------------------------------------------------------------------------
     def observation_space(self, agent):
@@ -142,15 +152,15 @@ class MimoParallelEnv(ParallelEnv):
         for act in self.actuation:
             act.reset(w.model, w.data)
         self._expression[:] = 0
-        for c in self._controls:
+        for c in self.controls:
             c[:] = 0.0
         self.task.reset(self, self._rng)
         mujoco.mj_forward(w.model, w.data)
-        for system in self.shared:
+        for system in self.systems.values():
             system.reset(w.model, w.data)
         self._update_shared()
         self.agents = list(self.possible_agents)
-        self._steps = 0
+        self.steps = 0
         obs = {a: self._observe(i) for i, a in enumerate(self.agents)}
         infos = {a: self._info(i) for i, a in enumerate(self.agents)}
         return obs, infos
@@ -179,7 +189,7 @@ class MimoParallelEnv(ParallelEnv):
             reason = w.step(self.frame_skip)
         t3 = time.perf_counter()
         timing["physics"] += t3 - t2
-        self._steps += 1
+        self.steps += 1
         self._update_shared()
         obs = {a: self._observe(self._index[a]) for a in self.agents}
         t4 = time.perf_counter()
@@ -187,7 +197,7 @@ class MimoParallelEnv(ParallelEnv):
         terminated, task_infos = self.task.terminations(self)
         t5 = time.perf_counter()
         timing["task"] += t5 - t4
-        truncated = self._steps >= self.max_steps
+        truncated = self.steps >= self.max_steps
         rew, term, trunc, infos = {}, {}, {}, {}
         for a in self.agents:
             i = self._index[a]
@@ -241,7 +251,7 @@ class MimoParallelEnv(ParallelEnv):
                 raise ValueError(f"{a}: motor action has NaN/inf for {bad}; values must be finite, "
                                  f"in [{act.control_low.min():g}, {act.control_high.max():g}]")
             np.clip(u, act.control_low, act.control_high, out=u)
-            self._controls[i] = u
+            self.controls[i] = u
             act.apply(w.model, w.data, u)
 
     def _observe(self, i: int) -> dict:
@@ -260,15 +270,15 @@ class MimoParallelEnv(ParallelEnv):
 
     def _update_shared(self):
         m, d = self.world.model, self.world.data
-        for system in self.shared:
+        for system in self.systems.values():
             t = time.perf_counter()
             system.update(m, d)
             self.timing[system.name] += time.perf_counter() - t
 
     def _info(self, i: int) -> dict:
         act = self.actuation[i]
-        u = self._controls[i]
-        info = {"expression": EXPRESSIONS[self._expression[i]], "step": self._steps,
+        u = self.controls[i]
+        info = {"expression": EXPRESSIONS[self._expression[i]], "step": self.steps,
                 "time": float(self.world.data.time),
                 "cost": act.cost(u), "weighted_cost": act.weighted_cost(u)}
         for sense in self.senses[i]:
@@ -316,7 +326,7 @@ class MimoParallelEnv(ParallelEnv):
         return cam
 
     def close(self):
-        for system in self.shared:
+        for system in self.systems.values():
             if hasattr(system, "close"):
                 system.close()
         if self._renderer is not None:

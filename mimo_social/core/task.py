@@ -144,15 +144,6 @@ def held_posture(tables, keep: tuple[str, ...], angles: Mapping[str, float] | No
     return out
 
 
-def check_number(owner: str, name: str, value, lo: float, hi: float) -> float:
-    """``value`` as a float if it is a finite number in [lo, hi], else a ValueError naming the
-    owner (task or partner), the setting and the allowed range."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(value) or not lo <= value <= hi:
-        raise ValueError(f"{owner}: {name}={value!r}; allowed: a number in [{lo}, {hi}]")
-    return float(value)
-
-
 def parts_outside(tables, roots: tuple[str, ...]) -> tuple[str, ...]:
     """Every body part with geoms that is not in the subtree of one of ``roots``: the touch
     ``exclude`` list that leaves skin on those subtrees only."""

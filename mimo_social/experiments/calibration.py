@@ -285,7 +285,7 @@ def measure_speed(hands: str = "mitten", seconds: float = 20.0, seed: int = 0,
     """
     import time
 
-    from ..bench.suite import smooth_random_actions
+    from ..core.random_actions import smooth_random_actions
     from ..envs import free_play_v0
 
     out = {"hands": hands, "seconds": seconds}

@@ -31,7 +31,7 @@ from typing import Mapping
 import mujoco
 import numpy as np
 
-from ..core.task import check_number
+from ..util.checks import check_number
 from .base import Partner, zero_action
 
 __all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]

@@ -586,11 +586,8 @@ class Recorder:
 
     def _find_senses(self, eyes: bool, skin: bool, contacts: bool) -> None:
         """The env's shared touch and vision systems (if on) and the index arrays to read them."""
-        shared = list(getattr(self.env, "shared", ()))
-        touch = next((s for s in shared if getattr(s, "name", None) == "touch"
-                      and hasattr(s, "force_normal") and hasattr(s, "skins")), None)
-        vision = next((s for s in shared if getattr(s, "name", None) == "vision"
-                       and hasattr(s, "images")), None)
+        touch = self.env.systems.get("touch")
+        vision = self.env.systems.get("vision")
         self._touch = touch if skin else None
         self._touch_agents: list[int] = []
         if self._touch is not None:
@@ -1480,7 +1477,7 @@ def bench_recording(configs: Mapping[str, dict] | None = None, sim_seconds: floa
     """
     import tempfile
 
-    from ..bench.suite import smooth_random_actions
+    from ..core.random_actions import smooth_random_actions
     from ..envs import free_play_v0
 
     configs = BENCH_CONFIGS if configs is None else configs

@@ -61,7 +61,8 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from ..core.config import ConfigError, TouchConfig
+from ..core.config import TouchConfig
+from ..util.checks import ConfigError
 from .skin import GRID_CELL, Skin, build_skin
 
 __all__ = ["build_touch", "TouchSystem", "AgentTouch", "save_skin_png", "hand_ball_scene",
@@ -468,13 +469,6 @@ def build_touch(world, configs: Sequence[TouchConfig | None]):
 
 
 # -- pictures --------------------------------------------------------------------------------
-def _touch_system(env) -> TouchSystem:
-    for s in getattr(env, "shared", []):
-        if getattr(s, "name", None) == "touch" and hasattr(s, "view"):  # run as __main__ too
-            return s
-    raise ValueError("this env has no touch skin; make it with touch=True")
-
-
 def save_skin_png(env, agent, path, parts: Sequence[str] | None = None,
                   elev: float | None = None, azim: float | None = None,
                   title: str | None = None, spheres: Sequence[tuple] = ()) -> str:
@@ -491,7 +485,7 @@ def save_skin_png(env, agent, path, parts: Sequence[str] | None = None,
     import matplotlib.pyplot as plt
     from matplotlib.ticker import MaxNLocator
 
-    system = _touch_system(env)
+    system = getattr(env, "unwrapped", env).system("touch")
     view = system.view(agent)
     if parts is not None:
         unknown = sorted(set(parts) - set(view))
@@ -613,7 +607,7 @@ def save_hand_ball_png(path, steps: int = 100) -> str:
     """The paper's Fig. 5b: the skin of a hand holding a ball, coloured by force, as a PNG."""
     env = hand_ball_scene(steps)
     parts = ["right_lower_arm", "right_hand", "right_fingers"]
-    view = _touch_system(env).view(0)
+    view = getattr(env, "unwrapped", env).system("touch").view(0)
     total = sum(view[k]["normal_force"].sum() for k in parts)
     w = env.world
     ball = w.data.xpos[w.prop_bodies["ball"]]

@@ -157,12 +157,7 @@ def build_vision(world, configs: Sequence):
 # -- helpers -------------------------------------------------------------------------------------
 def vision_system(env) -> VisionSystem:
     """The :class:`VisionSystem` of an env of this package (wrappers are looked through)."""
-    base = getattr(env, "unwrapped", env)
-    for system in getattr(base, "shared", ()):
-        if isinstance(system, VisionSystem):
-            return system
-    raise ValueError("this env has no vision: make it with vision=True or "
-                     "vision={'width': ..., 'height': ...}")
+    return getattr(env, "unwrapped", env).system("vision")
 
 
 def _agent_index(env, agent) -> int:
@@ -260,7 +255,7 @@ BENCH_VARIANTS = {
 
 def _bench_states(n_agents: int, n_steps: int, seed: int = 0):
     """A world and ``n_steps`` of its qpos under gentle smooth random actions (standing)."""
-    from ..bench.suite import smooth_random_actions
+    from ..core.random_actions import smooth_random_actions
     from ..envs import free_play_v0
 
     env = free_play_v0.parallel_env(n_agents=n_agents)
@@ -388,7 +383,7 @@ def bench_env(configs=None, sim_seconds: float = 5.0, seed: int = 0) -> list[dic
     ``env.timing`` and the wall clock), the configurations taking turns of 100 steps."""
     import time
 
-    from ..bench.suite import smooth_random_actions
+    from ..core.random_actions import smooth_random_actions
     from ..envs import free_play_v0
 
     configs = configs or {

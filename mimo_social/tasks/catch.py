@@ -174,7 +174,7 @@ class Catch(Task):
             return np.array([float(o["failure_reward"])])
         if self._success:
             return np.array([float(o["success_reward"])])
-        cost = env.actuation[0].weighted_cost(env._controls[0])
+        cost = env.actuation[0].weighted_cost(env.controls[0])
         return np.array([self._n_touch - float(o["cost_weight"]) * cost])
 
     def terminations(self, env):

@@ -33,7 +33,8 @@ import numpy as np
 from ..body.tables import load_body
 from ..partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
 from ..core.world import AgentSetup, Prop
-from ..core.task import (GAZE_JOINTS, Gaze, Task, check_number, geoms_touching, hand_geoms,
+from ..util.checks import check_number
+from ..core.task import (GAZE_JOINTS, Gaze, Task, geoms_touching, hand_geoms,
                          held_posture, parts_outside, right_arm_joints)
 
 RECEIVER, GIVER = 0, 1
@@ -49,7 +50,7 @@ def arms_only_touch(tables) -> dict:
 
 
 def _check_number(name, value, lo, hi):
-    return check_number("handover: task option", name, value, lo, hi)
+    return check_number("handover", f"task option {name}", value, lo, hi)
 
 
 class Handover(Task):
@@ -252,7 +253,7 @@ class Handover(Task):
                     a.substep(m, d)
                 mujoco.mj_step(m, d)
         act.reset(m, d)
-        env._controls[GIVER][:] = 0.0
+        env.controls[GIVER][:] = 0.0
         d.time = 0.0
         mujoco.mj_forward(m, d)
 
@@ -289,7 +290,7 @@ class Handover(Task):
         if self._dropped:
             r += o["failure_reward"]
             if o["charge_remaining"]:  # the rest of the episode at this distance: drops never pay
-                r -= self._distance * max(0, env.max_steps - env._steps)
+                r -= self._distance * max(0, env.max_steps - env.steps)
         return np.array([r, r])
 
     def terminations(self, env):

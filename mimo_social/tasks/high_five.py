@@ -35,7 +35,7 @@ import mujoco
 import numpy as np
 
 from ..body.tables import HAND_VERSIONS, load_body, subtree
-from ..core.config import ConfigError
+from ..util.checks import ConfigError, check_bool, check_number
 from ..core.world import AgentSetup
 from ..core.task import (GAZE_JOINTS, ContactProbe, Gaze, Task, face_to_face, hand_geoms,
                          held_posture, right_arm_joints)
@@ -112,22 +112,6 @@ def require_skin(task: str, agent: str, config, parts: Sequence[str], what: str)
                           f"{what} through the skin there; remove them from touch 'exclude'")
 
 
-def check_number(task: str, key: str, value, lo: float | None = None,
-                 hi: float | None = None) -> float:
-    """A finite real task option within [lo, hi], or a ConfigError saying what is allowed."""
-    where = "any finite number" if lo is None else f"a number from {lo} to {hi}"
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not np.isfinite(value) or (lo is not None and not lo <= value <= hi):
-        raise ConfigError(f"{task}: task option {key}={value!r} not allowed; {where}")
-    return float(value)
-
-
-def check_bool(task: str, key: str, value) -> bool:
-    if not isinstance(value, (bool, np.bool_)):
-        raise ConfigError(f"{task}: task option {key}={value!r} not allowed; True or False")
-    return bool(value)
-
-
 class SkinSource:
     """Does one body region of agent ``i`` (e.g. its right hand) feel agent ``j`` on its skin?
 
@@ -149,14 +133,6 @@ class SkinSource:
             return False
         felt = self.touch.touched_by(self.i)
         return any(self.source in felt[p]["agents"] for p in self.parts if p in felt)
-
-
-def touch_system(env):
-    """The env's shared :class:`~mimo_social.senses.touch.TouchSystem` (None without touch)."""
-    for s in env.shared:
-        if getattr(s, "name", None) == "touch" and hasattr(s, "touched_by"):
-            return s
-    return None
 
 
 # -- the task ----------------------------------------------------------------------------------
@@ -206,7 +182,7 @@ class HighFive(Task):
         self._palms = np.array([w.agents[i].palm_sites[0] for i in range(2)], dtype=np.intp)
         hands = [hand_geoms(w, i) for i in range(2)]
         self._hands_meet = ContactProbe(w.model.ngeom, hands[0], hands[1])
-        touch = touch_system(env)
+        touch = env.systems.get("touch")
         self._feels = [SkinSource(w, touch, i, hands[i], right_hand_parts(w.tables[i]), 1 - i)
                        for i in range(2)]
         self._hand_mask = np.zeros(w.model.ngeom, bool)

@@ -37,7 +37,8 @@ import numpy as np
 from ..body.postures import POSTURES
 from ..body.tables import load_body
 from ..core.world import AgentSetup, Prop
-from ..core.task import GAZE_JOINTS, Task, check_number, face_to_face, held_posture
+from ..core.task import GAZE_JOINTS, Task, face_to_face, held_posture
+from ..util.checks import check_number
 
 DISTANCE = 0.7
 EYE_SIZE = 96

@@ -39,11 +39,11 @@ import numpy as np
 from gymnasium import spaces
 
 from ..body.tables import load_body, subtree
-from ..core.config import ConfigError
+from ..util.checks import ConfigError, check_bool, check_number
 from ..core.world import AgentSetup
 from ..core.task import EYE_GAZE_JOINTS, Gaze, Task, hand_geoms, held_posture, right_arm_joints
-from .high_five import (check_bool, check_number, require_skin, right_hand_parts, skin_parts,
-                        touch_only_on, touch_system)
+from .high_five import (require_skin, right_hand_parts, skin_parts,
+                        touch_only_on)
 from .selfbody import CROSS_LEGGED_DEG
 
 TOUCHER, TOUCHED = 0, 1
@@ -163,7 +163,7 @@ class SocialTouch(Task):
         m = w.model
         self._world = w
         toucher, touched = w.agents[TOUCHER], w.agents[TOUCHED]
-        self._touch = touch_system(env)
+        self._touch = env.systems.get("touch")
         self._gaze = [Gaze(w, TOUCHER), Gaze(w, TOUCHED)]
         self._is_hand = np.zeros(m.ngeom, bool)
         self._is_hand[hand_geoms(w, TOUCHER, 0)] = True

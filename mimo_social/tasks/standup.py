@@ -213,7 +213,7 @@ class Standup(Task):
     def rewards(self, env):
         d = env.world.data
         self._height = float(d.site_xpos[self._head, 2])
-        u = env._controls[0]
+        u = env.controls[0]
         self._cost = float(self.options["cost_weight"]) * float(np.dot(u, u))
         return np.array([self._height - self._ref - self._cost])
 
