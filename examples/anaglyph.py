@@ -17,7 +17,8 @@ import mujoco
 import numpy as np
 
 from mimo_social.envs import free_play_v0
-from mimo_social.senses.vision import eye_images, render_now, save_anaglyph, write_png
+from mimo_social.render.png import write_png
+from mimo_social.senses.vision import eye_images, render_now, save_anaglyph
 
 
 def main(argv=None) -> None:

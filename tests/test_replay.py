@@ -405,7 +405,7 @@ def zero_actions(env, expression=0):
 
 
 def test_png_encoder_round_trips_every_byte():
-    from mimo_social.recording.recorder import encode_png
+    from mimo_social.render.png import encode_png
 
     rng = np.random.default_rng(0)
     for shape in ((5, 7, 3), (64, 64, 3), (3, 4)):

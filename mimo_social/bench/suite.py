@@ -64,7 +64,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..core.random_actions import agent_seeds, random_action_block
+from ..core.random_actions import random_action_block
 
 __all__ = [
     "CONFIGS", "DEFAULT_CONFIGS", "COMPONENTS", "BenchConfig",

@@ -32,14 +32,13 @@ paper).
 
 from __future__ import annotations
 
-import struct
-import zlib
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 from gymnasium import spaces
 
+from ..render.png import write_png
 from ..render.eye_renderer import Tile, TileRenderer
 
 __all__ = ["VisionSystem", "VisionSense", "build_vision", "vision_system", "eye_images",
@@ -198,30 +197,6 @@ def anaglyph(left: np.ndarray, right: np.ndarray) -> np.ndarray:
     out = right.copy()
     out[..., 0] = left[..., 0]
     return out
-
-
-def write_png(path, image: np.ndarray) -> Path:
-    """Write an (h, w, 3) or (h, w) uint8 image as PNG (no imaging library needed)."""
-    img = np.ascontiguousarray(image, dtype=np.uint8)
-    if img.ndim == 2:
-        colour = 0
-    elif img.ndim == 3 and img.shape[2] == 3:
-        colour = 2
-    else:
-        raise ValueError(f"write_png takes (h, w) or (h, w, 3) images, got {img.shape}")
-    h, w = img.shape[:2]
-    raw = b"".join(b"\x00" + img[r].tobytes() for r in range(h))
-
-    def chunk(kind: bytes, payload: bytes) -> bytes:
-        return (struct.pack(">I", len(payload)) + kind + payload
-                + struct.pack(">I", zlib.crc32(kind + payload) & 0xFFFFFFFF))
-
-    png = (b"\x89PNG\r\n\x1a\n"
-           + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, colour, 0, 0, 0))
-           + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b""))
-    path = Path(path)
-    path.write_bytes(png)
-    return path
 
 
 def save_anaglyph(env, agent, path, scale: int = 1) -> np.ndarray:
