@@ -7,7 +7,6 @@ parser's ``func`` to the function that runs it.
 from __future__ import annotations
 
 import argparse
-import sys
 
 from ..bench import suite as bench
 from ..experiments import calibration, compliance, demo
