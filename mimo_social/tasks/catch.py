@@ -7,10 +7,18 @@
 | scene | a ball: radius U(0.5, 2.5) cm, mass U(0.05, 0.5) kg, dropped from 9 cm (+-8 cm) above the palm surface, +-1 cm sideways |
 | reset | the wrist turned palm up (rotation -65 deg); 50 physics steps without gravity and without the ball settle the hand; then the ball is placed, at rest |
 | action | 40 muscle controls in [0, 1]: a negative and a positive muscle for each of the right wrist's 3 axes and the 17 finger joints other than the thumb's (with `actuation="spring_damper"`: 20 motors in [-1, 1]) |
-| observation | `proprioception`, `touch` (the right arm's and hand's skin only, at the published spacing; the normal force only, 1 float a point), `ball_size` (radius, m) |
+| observation | `proprioception` (196), `touch` (1702: the right arm's and hand's skin only, at the published spacing; the normal force only, 1 float a point), `ball_size` (1: radius, m) |
 | reward | `-100` when the ball falls more than 10 cm below the palm centre or goes more than 0.5 m from it; `+100` once the hand has touched the ball for 1 s without a break; otherwise `N_c - c_w(a)`: the number of the infant's body parts touching the ball minus the weighted muscle cost (paper eq. for muscles; `cost_weight` scales it) |
+| success | the hand has touched the ball for 1 s without a break (`is_success`) |
 | termination | on success (held 1 s) or failure (dropped); truncation at 800 steps |
 | infos | `is_success`, `dropped`, `parts_touching` (N_c), `held_steps`, `ball_radius`, `ball_mass` |
+| privileged cues | the task points the head and eyes at the ball every control step (its position reaches the learner as its own head and eye angles); `ball_size` gives the ball's radius directly |
+| baselines | PPO, 3 seeds, 31k steps each (1.4-2.6 min a run): evaluation return -87 -> -52 / -62 / -76 (the ball kept 50-64 steps instead of ~50), no success (`mimo-social compare --task catch --algos ppo --seeds 3 --steps 30000 --out runs/catch --jobs 2 --eval-every 3000 --eval-episodes 5 --checkpoint-every 0`). SAC, 3 seeds, 5k steps each (7-14 min a run): noisy, -90 .. +240 on 5 episodes, occasional successes (up to 2 of 5), final -52 / -78 / -88 (`mimo-social compare --task catch --algos sac --seeds 3 --steps 5000 --out runs/catch --jobs 2 --eval-every 500 --eval-episodes 5 --checkpoint-every 0`) |
+| sources | the MIMo paper (Mattern et al.), Sec. VI-A: the catching demo |
+| version history | v0: first version, with the paper's other one-agent demos (stand up, self-body touch) |
+
+`c_w(a) = sum(a_i^2 fmax_i) / (N sum fmax_i)` is at most `1/N` = 0.025 here; the published code
+scaled it by 40 (`task_options={"cost_weight": 40}`).
 """
 
 from __future__ import annotations

@@ -7,19 +7,15 @@
 | scene | a ball (radius `ball_radius` 3 cm, mass `ball_mass` 30 g) |
 | reset | the giver's arm is posed in its offer posture (:func:`~mimo_social.partners.hand_offer.offer_posture` for `offer_target` = 18 cm ahead of its right shoulder, 10 cm toward its midline, 8 cm lower; palm up, leaning slightly toward thumb and fingers), the ball laid in its palm, its four fingers curled kinematically until they touch the ball; then for `settle_time` (0.3 s) the giver's own motors hold the arm and the fingers grip gently (the :class:`HandOffer` controller): the episode starts with a physical grasp at rest, no weld. The receiver's right arm starts at a random offset (+-`arm_noise` 10 deg per joint of shoulder, elbow, wrist) from its hanging posture |
 | action | per agent: the right-arm motors, 29 (spring-damper, in [-1, 1]) or 58 (muscles, in [0, 1]); plus the expression when `expressions=True` |
-| observation | `proprioception` (the head and eye angles tell where the ball / the receiver's hand is), `touch` (the skin of both arms and hands, normal force, 1 float a point) |
+| observation | `proprioception` (210; the head and eye angles tell where the ball / the receiver's hand is), `touch` (3404: the skin of both arms and hands, normal force, 1 float a point); never the partner's joints or the ball's coordinates |
 | reward (both) | `-distance(receiver's right fingertips, ball)` every step; `+success_reward` (10) on success; `failure_reward` (-1) when the ball drops, and (`charge_remaining`, on) minus that step's distance times the steps left in the episode: the per-step shaping is negative, so without this charge ending the episode by knocking the ball down would beat holding still (measured without the charge: two random agents drop it within 0.35 s and score -10, a random receiver with the scripted giver scores -145 over the full episode) |
 | success | the ball touches at least `min_parts` (2) segments of the receiver's right hand (palm, finger segments), no longer touches the giver's hand and is above `drop_height`, continuously for `hold_time` (0.3 s) |
 | termination | both agents, on success or when the ball falls below `drop_height` (0.25 m: well below the hands, near the floor); truncation at `max_steps` (600, 6 s) |
 | infos | `is_success`, `holder` (`"giver"`: the ball touches the giver's hand; `"receiver"`: the receiver's hand in >= `min_parts` segments and not the giver's; `"none"` otherwise), `dropped`, `receiver_parts`, `held_steps`, `distance` |
-
-Rationale: from about 12 months infants give objects to others and take what is offered, and
-give-and-take games with caregivers fill much of the second year; an exchange needs each
-partner to read the other's hand (where it is, whether it grips or lets go) through sight and
-touch. Here the receiver learns the taking half (reach to the offered ball, close its fingers
-around it, hold it as the giver lets go) from proprioception of its gaze and touch alone; the
-scripted giver lets go only when it feels the other's hand on the ball, as a cooperative adult
-would. Both are rewarded: the exchange is a joint success.
+| privileged cues | the task points the receiver's head and eyes at the ball and the giver's at the receiver's right palm every control step (their angles tell where those are); the giver's grip and release reach the receiver only through its skin and the ball |
+| baselines | random policies (uniform actions, 20 episodes, reset seeds 0-19; no command in the package): `scripted_env()`, random receiver with the `HandOffer` giver: return -164.2 +- 33.4, 0 / 20 successes, ball dropped 3 / 20, 563 steps; `parallel_env()`, both random: -237.5 +- 64.8, 0 / 20, dropped 20 / 20, 34 steps. PPO receiver, scripted `HandOffer` giver, 2 seeds, 51k env steps (10 min): training return -171 -> -112 / -119 (random receiver: -164 +- 33), evaluation -130 -> -79 / -106; no handover (`mimo-social compare --task handover --mode scripted --algos ppo --seeds 2 --steps 50000 --out runs/handover --eval-every 5000 --eval-episodes 5`) |
+| sources | not in the MIMo paper: a social task of this package; rationale (give and take, 9-18 months) and figures: `docs/social/handover.md` |
+| version history | v0: first version, with the scripted partner `HandOffer` |
 
 A learning giver starts with the same grasp but holds it only if it acts: with zero actions its
 arm sinks under gravity and the ball falls (a failure) within half a second.

@@ -3,28 +3,25 @@
 | | |
 |---|---|
 | agents | 2 (`infant_0`, `infant_1`), `distance` (0.35 m) apart hip to hip, facing each other |
-| reset | each right arm starts in its own random posture: every joint at its standing-pose angle plus U(-1/2, 1/2) x `start_spread` (0.3) x its range (seeded by `reset(seed=...)`) |
-| body | hip fixed in the world; trunk, legs, left arm held; head and eyes fixate the partner's right hand (set by the task each control step) |
-| action | the right-arm motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five fingers: 29), plus the expression when expressions are on |
-| observation | `proprioception` (head and eye angles tell where the partner's hand is), `vestibular`, `touch`: the skin of the right hand only by default (hand and fingers, a tenth of the published point density, normal force only: 232 floats for the mitten hand); `touch=True` or a mapping gives more skin |
+| body | standing, hip fixed in the world; trunk, legs, left arm held; head and eyes fixate the partner's right hand (set by the task each control step) |
+| scene | the floor only: each infant's target is the partner's hand |
+| reset | each right arm starts in its own random posture: every joint at its standing-pose angle plus U(-1/2, 1/2) x `start_spread` (0.3) x its range, resampled until the hands touch nothing (seeded by `reset(seed=...)`) |
+| action | the right-arm motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five fingers: 29), plus the expression (`Discrete(7)`) while expressions are on (default) |
+| observation | `proprioception` (84 for the mitten body; head and eye angles tell where the partner's hand is), `vestibular` (6), `touch`: the skin of the right hand only by default (hand and fingers, a tenth of the published point density, normal force only: 232 floats for the mitten hand); `touch=True` or a mapping gives more skin |
 | reward (both) | `-distance(right palms)` (m) per step, `+touch_bonus` (100) on a step of success |
 | success (`is_success`) | both right hands feel the partner: each agent's right-hand skin (hand or fingers) senses a force whose source is the other agent, and the two right hands are in contact with each other. The partner's forearm, body or left hand on one's hand does not count (the partner's right hand feels nothing), nor do crossed arms (each right hand on the other's arm) |
 | termination | both, on success (if `end_on_touch`, default); truncation at `max_steps` (500 steps, 5 s) |
 | infos | `is_success`, `hands_touching` (the same, kept for older code), `hand_feels_partner` (this agent's right-hand skin senses the other agent, on any of its parts), `hand_distance` (m), and the skin's `touch` (who touches which part) |
-| options | `touch_bonus` (100.0), `end_on_touch` (True), `distance` (0.35 m, 0.25 to 0.6) |
+| options | `touch_bonus` (100.0), `end_on_touch` (True), `distance` (0.35 m, 0.25 to 0.6), `start_spread` (0.3, 0 to 1; 0: the same start every episode) |
 | scripted partner | `high_five_v0.scripted_env()`: `infant_1` is `HandOffer(grip=False, release=None)` (holds its right hand out, fingers open) |
+| privileged cues | the task points each agent's head and eyes at the partner's right hand every control step: the hand's position reaches the learner as its own head and eye angles (proprioception); the contact only through its skin |
+| baselines | random policies (uniform actions, 20 episodes, seeds 0-19; no command in the package): `parallel_env()`, both random: return of `infant_0` -230.6 +- 22.2, 0 / 20 successes, 500 steps; `scripted_env()`, random learner with the `HandOffer` partner: -139.3 +- 46.3, 1 / 20, 483 steps. Shared-parameter PPO (both infants, one policy), seed 0, 200k env steps (10 min): evaluation success (20 episodes, both infants) 0 % up to 30k steps, 60 % at 40k, 90 % at 50k, 100 % from 60k steps (5 min) on; on 100 fresh episodes 100 % for both infants, 16 steps to the high five (`mimo-social train --task high_five --mode shared --algo ppo --steps 200000 --seed 0 --out runs/high_five_s0 --eval-every 10000 --eval-episodes 20`, then `mimo-social eval runs/high_five_s0 --episodes 100 --seed 5000`); seed 1, 100k env steps (12 min): 100 % from 50k; 100 fresh episodes 100 % / 100 %, 20 steps |
+| sources | not in the MIMo paper: a social task of this package; rationale (touch games, contingency) and figures: `docs/social/high_five.md` |
+| version history | v0: first version, with the first env (the infants 0.45 m apart); later in v0: success sensed by both right-hand skins, 0.35 m apart, the `HandOffer` scripted partner, seeded random start postures (`start_spread`) |
 
-A high five is felt, not only seen: the task reads success from the same skin that the agents
-observe (:mod:`mimo_social.senses.touch`), so what ends the episode is exactly what both
-infants perceive. The skin must cover the right hand (`touch=False`, or an `exclude` that
-names a right-hand part, raises an error).
-
-Why: touch is the earliest channel of social contact. Infants feel and seek touch from their
-caregivers long before they reach for objects, and in the second year touch-based games (pat-a-
-cake, give-and-take, clapping hands together) are among the first joint actions with a partner:
-each partner's move is answered by a felt contact, a contingency infants are highly sensitive
-to. Reading success from both skins makes the reward a shared, perceived event rather than a
-geometric fact, the basis of the touch-based turn taking studied with two learning infants.
+Success is read from the same skin that the agents observe (:mod:`mimo_social.senses.touch`), so
+what ends the episode is what both infants perceive. The skin must cover the right hand
+(`touch=False`, or an `exclude` that names a right-hand part, raises an error).
 """
 
 from __future__ import annotations

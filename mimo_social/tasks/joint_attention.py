@@ -4,30 +4,25 @@
 |---|---|
 | agents | 2: `infant_0` (the learner) and `infant_1` (the partner: scripted, by default `GazeAtTarget`, which turns its head and eyes to one toy after another, or a second learner) |
 | body | sitting, hip fixed in the world, every joint held except the head (swivel, tilt, sideways tilt) and the eyes (horizontal, vertical, torsional), which are motors: each agent turns its own head and eyes; with `head_support` (on) the task cancels gravity on head and eyes (neck tone: a zero action does not let the head drop) |
-| scene | the two infants `distance` (0.7 m) apart, face to face; `n_toys` (4) toys on the floor beside them, a red ball, a blue cube, a yellow ball and a green cube (3.5 cm), placed at random each episode (seeded) to the left and right of the pair, 0.25-0.45 m off the line between the infants, each at least `min_separation_deg` (25) from every other as seen from either head |
-| observation | `eye_left`, `eye_right` (96x96 RGB), `proprioception` (its own joints: where its head and eyes point); never the partner's target or joint angles |
+| scene | the two infants `distance` (0.7 m) apart, face to face; `n_toys` (4) toys on the floor beside them, a red ball, a blue cube, a yellow ball and a green cube (3.5 cm), to the left and right of the pair, 0.25-0.45 m off the line between the infants, each at least `min_separation_deg` (25) from every other as seen from either head |
+| reset | the toys placed at random (seeded), each turned at random about the vertical; heads and eyes at rest, facing the partner |
 | action | the 9 head and eye motors (`Box(-1, 1, (9,))`; expressions are off by default) |
+| observation | `eye_left`, `eye_right` (96x96x3 RGB), `proprioception` (54: its own joints, where its head and eyes point); never the partner's target or joint angles |
 | gaze | an agent's gaze ray starts between its eyes (the mean of the two eye cameras) along the mean of the two cameras' viewing axes; it *lands on* a toy when the angle to the toy's centre is below the toy's angular radius plus `margin_deg` (5); the nearest such toy is the one looked at |
 | reward | +1 on a step where both agents' gaze lands on the same toy, else 0; with `shaping` > 0, minus `shaping` x the angle (rad) between the agent's gaze ray and the toy the other agent looks at (when it looks at one); with `scripted_partner` (set by `scripted_env`) only `infant_0` is rewarded and `infant_1` has no eyes |
 | success | `is_success`: both look at the same toy this step; infos also `looked_at` (own toy or -1), `target` (the toy the other agent looks at, -1 while it looks at none, e.g. mid-turn), `gaze_error_deg` (angle from the own gaze ray to `target`, -1 without one) |
 | termination | none; truncation at 500 steps (5 s) |
+| options | `distance` (0.6-1.5 m), `n_toys` (2-4), `margin_deg` (0-30), `shaping` (0-100, default 0), `min_separation_deg` (0-35), `head_support` (True), `scripted_partner` (False) |
+| privileged cues | none in the observation (the partner's head turn reaches the learner only through its eyes); with `shaping` > 0 the reward reads the partner's toy from the geometry |
+| baselines | 20 episodes of 500 steps, scripted partner (no command in the package): random policy (uniform motor commands) return 0.0 +- 0.0, success rate 0.000; zero action (keeps looking at the partner) 0; a privileged follower (a `GazeAtTarget` told the partner's current target; not a learner) 0.858 +- 0.028, the ceiling a follower with instant knowledge reaches. PPO, scripted `GazeAtTarget` partner, `shaping` 0.1, 2 seeds, 61k env steps (27-32 min): training return -76 / -66 -> -26 / -31 (mean gaze error to the partner's toy from ~1.5 rad to ~0.5 rad), no step of shared attention in evaluation (`mimo-social compare --task joint_attention --mode scripted --algos ppo --seeds 2 --steps 60000 --out runs/joint_attention --eval-every 5000 --eval-episodes 5 --env-kwargs '{"task_options": {"shaping": 0.1}}'`) |
+| sources | not in the MIMo paper: a social task of this package; rationale (gaze following, 9-18 months) and figures: `docs/social/joint_attention.md` |
+| version history | v0: first version, with mirror and the scripted partners `ExpressionShow` and `GazeAtTarget` |
 
 What the learner sees: the eyeballs of this body are hidden in renders (the face texture draws
-the eyes and they do not move), so only the partner's HEAD turn is visible, not its eye turn.
-`GazeAtTarget` turns the head fully to the toy (as `Gaze` does) and the eyes only correct the
-rest, so the head turn is large (a swivel of 20-75 degrees, median 40, and a tilt of 15-45
-degrees down), and the partner's face, seen 0.55 m away, slides to the side of its head in the
-learner's 96x96 eye images.
-
-`shaping` is off (0.0) by default: the return then counts the steps of shared attention
-(return / 500 is the success rate), comparable across methods and with the random baseline; a
-learner trained from scratch may turn it on (e.g. 0.1) to get a gradient toward the partner's
-toy before its first hit.
-
-Why: following another person's gaze to an object, and so attending to the same thing
-(joint attention), emerges between about 9 and 18 months: infants first follow head turns to
-targets in front of them and by 18 months also to targets outside their view; it is a
-foundation of word learning and social referencing (see docs/social/joint_attention.md).
+the eyes), so only the partner's head turn is visible. `GazeAtTarget` turns the head fully to
+the toy and the eyes only correct the rest: a swivel of 20-75 degrees (median 40) and a tilt of
+15-45 degrees down. `shaping` is off by default: the return then counts the steps of shared
+attention (return / 500 is the success rate); a learner trained from scratch may turn it on.
 """
 
 from __future__ import annotations

@@ -6,11 +6,15 @@
 | body | hip fixed; everything but the right arm held; head and eyes fixate the ball (set each step) |
 | scene | gravity off (as in the published task); a ball (r = 2.5 cm) placed at random within reach |
 | reset | the right arm starts in one of 10 postures (fixed set, drawn once from a seeded generator); the ball position is sampled in front of the right shoulder, 14-22 cm away and at least 2 cm from the body |
-| action | the right-arm motors: 8 (mitten hands: shoulder 3, elbow, wrist 3, fingers) or 29 (five fingers: + 22 finger joints instead of 1) |
-| observation | `proprioception` only (the head and eye angles tell where the ball is) |
+| action | the right-arm motors in [-1, 1]: 8 (mitten hands: shoulder 3, elbow, wrist 3, fingers) or 29 (five fingers: + 22 finger joints instead of 1) |
+| observation | `proprioception` only (84 floats; the head and eye angles tell where the ball is) |
 | reward | `-distance(right fingertips, ball)`, or `+100` when the target is reached |
 | success | the right hand or fingers touch the ball, or the ball has moved more than 1 cm from its start (the published task's criterion: in zero gravity any touch of the arm moves it) |
-| termination | on success; truncation at 1000 steps |
+| termination | on success (`is_success`); truncation at 1000 steps |
+| privileged cues | the task points the head and eyes at the ball every step: the ball's position reaches the learner as its own head and eye angles (proprioception), not through a sense of its own |
+| baselines | random policy (uniform actions, 100 episodes; no command in the package): the ball reached in 74 episodes, mean length 457 steps, return -17 +- 126; success alone says little here, the steps to the ball say how well a policy reaches. PPO, seed 0, 300k steps (5.4 min): evaluation success (10 episodes) 20-60 % up to 60k steps, 100 % from 75k steps (85 s) on; on 100 fresh episodes 100 % success, mean 7 steps to the ball (`mimo-social train --task reach --algo ppo --steps 300000 --seed 0 --out runs/reach_ppo_s0`, then `mimo-social eval runs/reach_ppo_s0 --episodes 100`). PPO, seeds 1 and 2, 150k steps (4.9 / 6.6 min): 100 % evaluation success from 105k / 90k steps on; on 100 fresh episodes 100 % and 100 %, mean 21 steps to the ball (`mimo-social train --task reach --algo ppo --steps 150000 --seed 1 --out runs/reach_ppo_s1`) |
+| sources | the MIMo paper (Mattern et al.), Sec. VI-A: the reaching demo |
+| version history | v0: first version, with the first env; later in v0: the published success criterion (ball moved > 1 cm) and no start touching the body |
 """
 
 from __future__ import annotations

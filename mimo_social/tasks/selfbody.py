@@ -1,24 +1,28 @@
-"""Self-body knowledge (paper Sec. VI-A): a cross-legged infant touches a named part of its own
-body with its right hand.
+"""Self-body touch (paper Sec. VI-A): a cross-legged infant touches a named part of its own body.
 
 | | |
 |---|---|
 | agents | 1 (`infant_0`), mitten hands, spring-damper motors |
 | body | hip fixed, sitting cross-legged (legs crossed in front, shins towards the midline), trunk bent forward; everything but the right arm held (trunk, head, eyes, legs, left arm: they cannot move, but their skin feels) |
+| scene | the floor only; the hip is fixed where the body's lowest point touches it |
 | reset | the right arm starts held out to the side, touching nothing; a target part is drawn uniformly from `targets` (task option `target` fixes it) |
 | physics | one physics step (5 ms) per control step (`frame_skip=1`), as published |
 | action | the right-arm motors: 8 in [-1, 1] (shoulder 3, elbow, wrist 3, fingers) |
-| observation | `proprioception`, `touch` (the whole skin; by default at a quarter of the published point density and the normal force only, 1 float a point), `target`: one-hot over `targets` (15 parts for the mitten body) |
+| observation | `proprioception` (48), `touch` (1400: the whole skin; by default at a quarter of the published point density and the normal force only, 1 float a point; `touch=True` gives the published density and 3 floats a point), `target` (15: one-hot over `targets`) |
 | reward | `+500` when the right hand (hand or fingers) touches the target part; else `-distance(contact, target part's centre of mass)` (m, the contact nearest the target) when the right hand touches another part of the body; else `-1` |
+| success | the right hand or fingers touch the target part (`is_success`) |
 | termination | when the target is touched; truncation at 500 steps |
 | infos | `target` (part name), `is_success`, `touched` (parts the right hand touches), `distance` (m; None when the hand touches no part) |
+| privileged cues | `target`: the named part as a one-hot code (the instruction; no sense carries it) |
+| baselines | PPO, seed 0, 100k steps (4.8 min): mean return -87.7 +- 150 on 50 episodes (6 % success) against a random policy's -414.5 +- 219 (8 %) and zero controls' -176 (5 %) on the same episodes (`mimo-social train --task selfbody --algo ppo --steps 100000 --seed 0 --out runs/selfbody_ppo --eval-every 10000 --eval-episodes 10`, then `mimo-social eval runs/selfbody_ppo --episodes 50 --seed 10000`) |
+| sources | the MIMo paper (Mattern et al.), Sec. VI-A: the self-body knowledge demo |
+| version history | v0: first version, with the paper's other one-agent demos (stand up, catch) |
 
-`targets` by default: every body part except the right arm's own (upper arm, lower arm, hand,
-fingers), the eyes and the left toes, which lie out of the right hand's reach in this pose (none of
-20,000 random right-arm postures touches them): hip, lower and upper trunk, head, the left arm's
-four parts, the right leg's four parts and the left leg's thigh, shin and foot (15 for the mitten
-body). The trunk is bent forward as far as it goes and the left hand rests on the lap so that the
-rest is within reach; the hip is fixed where the body's lowest point touches the floor.
+`targets` by default (15 for the mitten body): hip, lower and upper trunk, head, the left arm's
+four parts, the right leg's four parts and the left thigh, shin and foot. Not the right arm's
+own parts, the eyes, nor the left toes, which no right-arm posture reaches in this pose (none of
+20,000 random ones). The trunk is bent forward as far as it goes and the left hand rests on the
+lap so that the rest is within reach.
 """
 
 from __future__ import annotations

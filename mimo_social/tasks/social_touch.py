@@ -2,35 +2,27 @@
 
 | | |
 |---|---|
-| agents | 2: the toucher `infant_0` and the touched infant `infant_1`, sitting cross-legged face to face, `distance` (0.28 m) apart hip to hip, within arm's reach |
+| agents | 2: the toucher `infant_0` and the touched infant `infant_1`, sitting cross-legged face to face, `distance` (0.28 m) apart hip to hip, within arm's reach; exactly two (a third raises an error) |
 | body | hips fixed on the floor, legs crossed; the toucher: everything but the right arm held, the trunk bent forward towards the partner (lower trunk 20 deg, the upper trunk coupled), the left arm hanging at its side; the touched infant: everything but both arms held, leaning back a little (6 deg); heads upright; the eyes are set by the task each control step: the toucher's fixate the target part, the touched infant's the toucher's right hand |
+| scene | the floor only: the target is a part of the partner's body |
 | reset | the toucher's right arm starts out to its side, touching nothing; the touched infant's hands rest on its legs; the target part is drawn uniformly from `targets` (task option `target` fixes it) |
 | action | `infant_0`: the right arm's motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five fingers: 29) in [-1, 1]; `infant_1`: both arms' motors (16; 58), zero in the scripted env (`Still` partner); expressions off by default (`expressions=True` adds them) |
-| observation | both: `proprioception` (the toucher's eye angles tell where the target is), `touch` (normal force only, 1 float a point): the toucher's skin covers its right arm (upper arm to fingertips, a tenth of the published point density: 242 floats), the touched infant's its whole body (a quarter of the density: 1400); the toucher also gets `target`, one-hot over `targets` (9 for the mitten body) |
+| observation | both: `proprioception` (toucher 72, touched infant 120; the toucher's eye angles tell where the target is), `touch` (normal force only, 1 float a point): the toucher's skin covers its right arm (upper arm to fingertips, a tenth of the published point density: 242 floats), the touched infant's its whole body (a quarter of the density: 1400); the toucher also gets `target`, one-hot over `targets` (9 for the mitten body) |
 | reward (both) | `-distance(toucher's right fingertips, target part's centre of mass)` (m) per step, `+success_reward` (100) on success |
 | success (`is_success`) | the toucher's right hand (hand or fingers) touches the target part and the touched infant's skin feels it there, with the toucher as the source |
 | termination | both, on success (if `end_on_touch`, default); touching another part does not end the episode; truncation at `max_steps` (500 steps, 5 s) |
 | infos (both) | `target_part`, `is_success`, `touched_parts` (the partner's parts the toucher's right hand touches this step), `target_felt` (the touched infant's skin feels the toucher on the target part), `fingertip_distance` (m), and each agent's own skin record `touch` |
 | options | `targets` (None: :data:`DEFAULT_TARGETS`, those of them in the partner's body), `target` (None), `success_reward` (100.0), `end_on_touch` (True), `distance` (0.28 m, 0.25 to 0.4) |
+| privileged cues | the task points the toucher's eyes at the target part every control step (its eye angles tell where the target is) and gives the target as a one-hot code; the touched infant's eyes follow the toucher's right hand; the touch itself only through the skins |
+| baselines | random policies (uniform actions, 20 episodes, seeds 0-19; no command in the package): `parallel_env()`, both random: return of `infant_0` -16.7 +- 80.7, 11 / 20 successes, 354 steps; `scripted_env()`, random toucher with the `Still` partner: -19.2 +- 73.7, 10 / 20, 371 steps. PPO, scripted `Still` partner, 2 seeds, 61k env steps (4.5-5 min): evaluation success (10 episodes) 0 % -> 20 % / 60 % at the end, mean return -153 -> -43 / +10: not yet better than random (`mimo-social compare --task social_touch --mode scripted --algos ppo --seeds 2 --steps 60000 --out runs/social_touch --eval-every 5000 --eval-episodes 10`) |
+| sources | not in the MIMo paper: a social task of this package, the social version of self-body touch (paper Sec. VI-A); rationale (touch, body-part games) and figures: `docs/social/social_touch.md` |
+| version history | v0: first version, with the skin-sensed high five |
 
 Targets by default are the partner's parts within the toucher's reach in this pose: head, upper
 and lower trunk, the partner's left arm (upper arm, lower arm, hand and the mitten's fingers: it
-is on the toucher's right) and left thigh and shin. The partner's right arm, hip, feet and the
-far leg are out of reach (next to no random posture of the toucher's right arm touches them);
-the eyes are never targets. With another `distance`, give `targets` reachable there. Only two
-infants: a third raises an error (a dyad: one toucher, one touched).
-
-Why the toucher's trunk is held: a free trunk with zero command sags forward under gravity
-until the heads meet; held bent forward it gives the arm the reach, and the action stays the
-arm's alone.
-
-Why: being touched and touching others are, with gaze, the first channels of social exchange.
-Caregivers' touch regulates and engages infants from birth, and in the second year infants
-point to and touch named body parts of themselves and of others ("where is your nose?"), a
-game that builds a body map shared between self and partner. Here the touch is a contingent
-event felt on both sides: the toucher is rewarded when the partner feels the touch on the named
-part, and the partner's skin reports who touched where, the signal for touch-based turn taking
-when both infants learn.
+is on the toucher's right) and left thigh and shin; the eyes are never targets. With another
+`distance`, give `targets` reachable there. The toucher's trunk is held bent forward: free, with
+zero command, it sags forward under gravity until the heads meet.
 """
 
 from __future__ import annotations

@@ -3,19 +3,26 @@
 | | |
 |---|---|
 | agents | 1 (`infant_0`), mitten hands, spring-damper motors |
-| scene | a crib rail 0.45 m above the floor in front of the infant (two posts hold it); the infant's hands are welded to the rail and its feet to the floor (weld equalities); the rail itself takes no contacts |
 | body | free base (the infant can rise, lean and sag); head, eyes, fingers, toes and the ankles' inversion and rotation held |
+| scene | a crib rail 0.45 m above the floor in front of the infant (two posts hold it); the infant's hands are welded to the rail and its feet to the floor (weld equalities); the rail itself takes no contacts |
 | reset | a low squat (hips and knees bent as far as they go, feet flat, buttocks 8 cm above the floor), hands on the rail; every actuated joint gets U(-0.01, 0.01) rad, then 100 physics steps with zero controls settle the body before the first observation |
 | physics | one physics step (5 ms) per control step (`frame_skip=1`) |
 | action | 27 motors in [-1, 1]: trunk 3 (lean, twist, bend), each arm 7 (shoulder 3, elbow, wrist 3), each leg 5 (hip 3, knee, ankle flexion) |
-| observation | `proprioception` (joint angles, velocities, torques, limit sensors, motor state), `vestibular` (head gyro, accelerometer) |
+| observation | `proprioception` (190: joint angles, velocities, torques, limit sensors, motor state), `vestibular` (6: head gyro, accelerometer) |
 | reward | `z_head - z_ref - 0.01 * sum(u_i^2)`: head-centre height gain over its height after the settling steps (option `head_reference`: a height in m instead, 0.2 as published), minus the control cost |
+| success | none: no success criterion (no `is_success`); the head's height gain tells progress |
 | termination | none (a fixed 500 steps, then truncation); a simulation that goes unstable ends the episode |
 | infos | `head_height` (m), `head_gain` (m above the reference), `control_cost` |
+| privileged cues | none |
+| baselines | PPO, 3 seeds, 61k steps each (1.5-3 min a run): evaluation return 7 -> 68 / 71 / 74; the head rises 17-19 cm (0.45 -> 0.62-0.64 m) and stays there: the infant pulls itself up to a bent-knee stand (`mimo-social compare --task standup --algos ppo --seeds 3 --steps 60000 --out runs/standup --jobs 2 --eval-every 6000 --eval-episodes 5 --checkpoint-every 0`). SAC, 3 seeds, 15k steps each (7-12 min a run): evaluation return +9 -> -63 / -68 / -70: large controls, head at -6 .. +5 cm (`mimo-social compare --task standup --algos sac --seeds 3 --steps 15000 --out runs/standup --jobs 2 --eval-every 1500 --eval-episodes 5 --checkpoint-every 0`) |
+| sources | the MIMo paper (Mattern et al.), Sec. VI-A: the standing-up demo |
+| version history | v0: first version, with the paper's other one-agent demos (self-body touch, catch) |
 
 Differences from the published task: the hands rather than the mitten fingers are welded (the
-fingers are held), and each ankle's flexion is a motor (the published model lists hip 3 + knee
-per leg); the reference height defaults to the settled start height ("head height gain").
+fingers are held), each ankle's flexion is a motor (the published model lists hip 3 + knee per
+leg), the reference height defaults to the settled start height ("head height gain"), and the
+start is a low squat: with this body's thigh and shank lengths, soles flat on the floor next to
+the buttocks would put the feet 27 cm in front of the hip, beyond the rail.
 """
 
 from __future__ import annotations
