@@ -11,9 +11,9 @@ import argparse
 from ..bench import suite as bench
 from ..experiments import calibration, compliance, demo
 from ..train import runner as train
-from . import replay
+from . import docs, replay
 
-SUBCOMMANDS = (demo, bench, calibration, compliance, replay, train)
+SUBCOMMANDS = (demo, bench, calibration, compliance, replay, train, docs)
 
 
 def build_parser() -> argparse.ArgumentParser:
