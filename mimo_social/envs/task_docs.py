@@ -156,9 +156,11 @@ def _aspect(key: str) -> str:
 
 
 def task_class(entry: EnvEntry) -> type:
-    """The :class:`Task` subclass the entry's ``<task>_v0`` module builds (the one it imports)."""
+    """The :class:`Task` subclass the entry's ``<task>_v0`` module builds: the one it imports
+    (a base class imported beside it does not count)."""
     found = {v for v in vars(entry.module).values()
              if inspect.isclass(v) and issubclass(v, Task) and v is not Task}
+    found = {c for c in found if not any(o is not c and issubclass(o, c) for o in found)}
     if len(found) != 1:
         raise ValueError(f"{entry.module.__name__} holds {len(found)} Task classes "
                          f"({sorted(c.__name__ for c in found)}); the docs need exactly one")
