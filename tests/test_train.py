@@ -10,7 +10,7 @@ import pytest
 import torch
 
 from mimo_social import cli
-from mimo_social.train.runner import compare, evaluate, read_progress, train
+from mimo_social.train import compare, evaluate, read_progress, train
 
 torch.set_num_threads(1)
 
@@ -100,3 +100,27 @@ def test_compare_trains_seeds_and_plots_them_together(tmp_path):
     assert cli.main(["compare", "--task", "reach", "--algos", "ppo", "--seeds", "2", "--steps",
                      "128", "--out", str(tmp_path), "--plot-only"]) == 0
     assert png.exists()
+
+
+def test_a_run_saved_before_the_layout_still_loads_and_runs(tmp_path, capsys):
+    """tests/data/pre_layout_reach_run: PPO on reach with --normalize-obs, trained by the code of
+    commit f078d91 (before the package was laid out in layers); its model.zip names
+    ``mimo_social.obs_norm.RunningNorm``."""
+    from pathlib import Path
+
+    from stable_baselines3 import PPO
+
+    from mimo_social.train.obs_norm import RunningNorm
+
+    run = tmp_path / "old"
+    shutil.copytree(Path(__file__).parent / "data" / "pre_layout_reach_run", run)
+    config = json.loads((run / "config.json").read_text())
+    assert config["algo_kwargs"]["policy_kwargs"]["features_extractor_class"] == \
+        "mimo_social.obs_norm.RunningNorm"
+    norm = PPO.load(str(run / "model.zip"), device="cpu").policy.features_extractor
+    assert isinstance(norm, RunningNorm)
+    res = evaluate(run, episodes=2, seed=3)
+    assert res["task"] == "reach" and len(res["returns"]) == 2
+    assert all(n <= 30 for n in res["lengths"]) and np.isfinite(res["return_mean"])
+    assert cli.main(["eval", str(run), "--episodes", "1"]) == 0
+    assert "reach PPO model.zip: 1 episodes" in capsys.readouterr().out

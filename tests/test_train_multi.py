@@ -9,14 +9,13 @@ import numpy as np
 import pytest
 import torch
 
+import mimo_social.train as train_mod
 from mimo_social import cli
-from mimo_social.train import runner as train_mod
-from mimo_social.envs import high_five_v0
+from mimo_social.envs import handover_v0, high_five_v0
 from mimo_social.core.gym_adapter import SingleAgentEnv
-from mimo_social.core.wrappers import make_sb3_single
-from mimo_social.train.runner import TrainInputError, compare, evaluate, read_progress, train
-from mimo_social.train.multi import (Lockstep, LockstepAborted, LockstepError, run_lockstep,
-                                     make_parallel_env, make_scripted_env, task_module)
+from mimo_social.train import (Lockstep, LockstepAborted, LockstepError, TrainInputError, compare,
+                               evaluate, make_parallel_env, make_sb3_single, make_scripted_env,
+                               read_progress, run_lockstep, task_module, train)
 
 torch.set_num_threads(1)
 
@@ -334,12 +333,12 @@ def test_lockstep_learners_with_different_step_budgets_get_a_clear_error(budgets
 @pytest.mark.timeout(90)
 def test_independent_training_with_a_failing_evaluation_raises_instead_of_hanging(
         tmp_path, monkeypatch):
-    from mimo_social.train import multi as train_multi
+    from mimo_social.train import independent
 
     def broken(*args, **kwargs):
         raise RuntimeError("evaluation broke")
 
-    monkeypatch.setattr(train_multi, "evaluate_agents", broken)
+    monkeypatch.setattr(independent, "evaluate_agents", broken)
     with pytest.raises(RuntimeError, match="evaluation broke"):
         _train_in_thread(timeout_s=60, task="high_five", algo="ppo", steps=256, seed=0,
                          out=tmp_path / "broken", mode="independent", eval_every=64,
@@ -368,7 +367,6 @@ def test_scripted_mode_trains_and_evaluates_on_the_same_observations():
 def test_a_face_only_learner_trains_and_evaluates_with_a_discrete_expression(tmp_path):
     """Mirror with its scripted partner: the learner's only action is its face, a Discrete(7)
     in training and in evaluation alike."""
-    from mimo_social.train import runner as train_mod
     out = tmp_path / "mirror"
     train_mod.train("mirror", "ppo", 128, 0, out, mode="scripted", eval_every=128,
                     eval_episodes=1, checkpoint_every=0, progress=False,
@@ -396,12 +394,12 @@ def test_bad_mode_task_and_options_say_what_is_allowed(tmp_path, monkeypatch, ca
         train("high_five", "ppo", 64, 0, tmp_path / "c", mode="independent", n_envs=2)
     with pytest.raises(TrainInputError, match="allowed: reach.*high_five"):
         train("juggle", "ppo", 64, 0, tmp_path / "d")
-    # a registered task whose module is not in the checkout: named, with the allowed tasks
-    monkeypatch.setitem(train_mod.MULTI_TASKS, "handover", "mimo_social.envs.no_such_task_v0")
-    with pytest.raises(TrainInputError, match=r"no_such_task_v0 is not in this checkout.*"
-                                              r"high_five.*allowed: high_five, mirror"):
+    # a catalogued social task whose module lacks scripted_env: named, with what it needs
+    monkeypatch.delattr(handover_v0, "scripted_env")
+    with pytest.raises(TrainInputError, match=r"handover_v0 lacks scripted_env.*"
+                                              r"needs parallel_env and scripted_env"):
         task_module("handover")
-    with pytest.raises(TrainInputError, match="not in this checkout"):
+    with pytest.raises(TrainInputError, match="lacks scripted_env"):
         train("handover", "ppo", 64, 0, tmp_path / "e")
     assert not (tmp_path / "e").exists()       # nothing written before the error
     # shared mode needs one space for all agents

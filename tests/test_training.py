@@ -11,7 +11,8 @@ from stable_baselines3 import PPO
 
 from mimo_social.envs import high_five_v0, reach_v0
 from mimo_social.train.vector import sb3_vec_env
-from mimo_social.core.wrappers import FlattenParallel, make_sb3_single
+from mimo_social.core.wrappers import FlattenParallel
+from mimo_social.train.envs import make_sb3_single
 
 torch.set_num_threads(1)
 

@@ -18,15 +18,14 @@
     ``close``, ``state`` and ``state_space`` are the wrapped env's, other public attributes are
     looked up on it. The wrapper pickles (the wrapped env drops its renderer when pickled).
 
-``make_sb3_single(env_id_or_env)``
-    A Gymnasium env with a ``Box`` observation (``gymnasium.wrappers.FlattenObservation``) and a
-    ``Box`` action (expression logits as above, when the env has a ``Dict`` action), for SB3.
+``FlatObservationWrapper`` / ``FlatActionWrapper`` / ``ExpressionActionWrapper``
+    The same flat observations and actions for a Gymnasium env (one agent);
+    :func:`mimo_social.train.envs.make_sb3_single` puts them around an env for SB3.
 """
 
 from __future__ import annotations
 
-import traceback
-from typing import Any, Callable, Mapping
+from typing import Any, Mapping
 
 import gymnasium as gym
 import numpy as np
@@ -34,8 +33,8 @@ from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
 __all__ = ["ParallelWrapper", "FlattenParallel", "FlatActionWrapper", "FlatObservationWrapper",
-           "ExpressionActionWrapper", "is_expression_only", "make_sb3_single",
-           "flat_action_space", "flat_observation_space"]
+           "ExpressionActionWrapper", "is_expression_only", "flat_action_space",
+           "flat_observation_space"]
 
 LOGIT_LOW, LOGIT_HIGH = -1.0, 1.0
 
@@ -297,98 +296,3 @@ def is_expression_only(space: spaces.Space) -> bool:
             and isinstance(space["motors"], spaces.Box) and space["motors"].shape
             and int(np.prod(space["motors"].shape)) == 0
             and isinstance(space["expression"], spaces.Discrete))
-
-
-def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
-    """A one-agent Gymnasium env with a ``Box`` observation and a ``Box`` action, for SB3.
-
-    ``env_id_or_env``: a registered id (``"mimo_social/Reach-v0"``; ``make_kwargs`` go to
-    ``gymnasium.make``) or a ``gymnasium.Env``. A non-Box observation is flattened by
-    :class:`FlatObservationWrapper` (images scaled to [0, 1]); a ``Dict(motors, expression)``
-    action becomes the flat Box of :class:`FlatActionWrapper`, or, when the agent has no motors,
-    the ``Discrete`` expression of :class:`ExpressionActionWrapper`.
-    """
-    if isinstance(env_id_or_env, str):
-        import mimo_social  # noqa: F401  (registers the ids)
-        env = gym.make(env_id_or_env, **make_kwargs)
-    elif isinstance(env_id_or_env, gym.Env):
-        if make_kwargs:
-            raise TypeError("keyword arguments are only used with an env id, not with an env")
-        env = env_id_or_env
-    else:
-        raise TypeError(f"make_sb3_single takes an env id or a gymnasium.Env, got "
-                        f"{type(env_id_or_env).__name__}")
-    if not isinstance(env.observation_space, spaces.Box) or env.observation_space.dtype == np.uint8:
-        env = FlatObservationWrapper(env)
-    if is_expression_only(env.action_space):
-        env = ExpressionActionWrapper(env)
-    elif not isinstance(env.action_space, spaces.Box):
-        env = FlatActionWrapper(env)
-    return env
-
-
-# -- worker side of ``vector.SpawnConcatVecEnv`` ------------------------------------------------
-# (here rather than in ``vector`` because this module imports neither SB3 nor torch: a spawned
-# worker imports the module of its target function)
-def _markov_env(env_fn: Callable[[], ParallelEnv]):
-    """One world as SuperSuit's gymnasium vector env (one slot per agent)."""
-    import supersuit as ss
-    return ss.pettingzoo_env_to_vec_env_v1(FlattenParallel(env_fn()))
-
-
-def _world_call(par_env: FlattenParallel, kind: str, name: str, args: tuple = (),
-                kwargs: dict | None = None):
-    """Get or set an attribute of, or call a method of, one world (a FlattenParallel)."""
-    if kind == "get":
-        return getattr(par_env, name)
-    if kind == "set":
-        setattr(par_env.unwrapped, name, args[0])
-        return None
-    if kind == "call":
-        return getattr(par_env, name)(*args, **(kwargs or {}))
-    raise ValueError(f"unknown world call {kind!r}")
-
-
-def _vec_worker(conn, payload: bytes, n_worlds: int) -> None:
-    """Process entry point: SuperSuit's in-process vector env of ``n_worlds`` worlds built from
-    the cloudpickled ``env_fn`` in ``payload``; every answer on ``conn`` is ``(status, value)``."""
-    try:
-        import cloudpickle
-        import supersuit as ss
-        env_fn = cloudpickle.loads(payload)
-        venv = ss.concat_vec_envs_v1(_markov_env(env_fn), n_worlds, num_cpus=0,
-                                     base_class="gymnasium")
-        par_envs = [m.par_env for m in venv.vec_envs]
-        conn.send(("ok", (venv.num_envs, venv.observation_space, venv.action_space,
-                          dict(venv.metadata), venv.render_mode)))
-    except BaseException:
-        conn.send(("error", traceback.format_exc()))
-        conn.close()
-        return
-    try:
-        while True:
-            try:
-                cmd, data = conn.recv()
-            except EOFError:  # the parent is gone
-                break
-            if cmd == "close":
-                venv.close()
-                conn.send(("ok", None))
-                break
-            try:
-                if cmd == "step":
-                    out = venv.step(data)
-                elif cmd == "reset":
-                    out = venv.reset(seed=data[0], options=data[1])
-                elif cmd == "world":
-                    out = [_world_call(p, *data) for p in par_envs]
-                else:
-                    raise ValueError(f"unknown command {cmd!r}")
-            except Exception:
-                conn.send(("error", traceback.format_exc()))
-            else:
-                conn.send(("ok", out))
-    except KeyboardInterrupt:
-        pass
-    finally:
-        conn.close()

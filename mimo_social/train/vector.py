@@ -54,9 +54,9 @@ from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper
 from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices
 from supersuit.vector.sb3_vector_wrapper import SB3VecEnvWrapper
 
-from ..core.wrappers import _markov_env, _vec_worker, _world_call
+from .envs import _markov_env, _vec_worker, _world_call
 
-# Worker processes run ``wrappers._vec_worker``: importing that module pulls in neither SB3 nor
+# Worker processes run ``envs._vec_worker``: importing that module pulls in neither SB3 nor
 # torch, so a spawned worker starts (and exits) in about a second instead of several.
 
 __all__ = ["sb3_vec_env", "SeededVecEnv", "SpawnConcatVecEnv"]

@@ -1,0 +1,181 @@
+"""``mimo-social train | eval | compare``: the command line of :mod:`mimo_social.train`.
+
+``mimo-social train --task reach --algo ppo --steps 200000 --seed 0 --out runs/reach_ppo``
+    Trains with Stable-Baselines3's default hyperparameters and writes ``config.json``,
+    ``model.zip``, ``best_model.zip``, ``checkpoints/``, ``progress.csv``, ``episodes.csv`` and
+    ``learning_curve.png`` to ``--out`` (:mod:`mimo_social.train.runner`). A social task takes
+    ``--mode shared | independent | scripted`` (docs/training_multi.md).
+    ``--algo-kwargs '{"n_steps": 512}'`` and ``--env-kwargs '{"max_steps": 200}'`` override.
+
+``mimo-social eval DIR --episodes 10 [--record run.rrd] [--video run.mp4 | --frames DIR]``
+    Reloads ``DIR/model.zip`` (``--model best`` or a path for another), runs the episodes with the
+    deterministic policy (``--stochastic`` samples), prints the mean return, success rate and
+    length and writes ``DIR/eval_results.json`` (:mod:`mimo_social.train.evaluation`).
+
+``mimo-social compare --task standup --algos ppo,sac --seeds 3 --steps 50000 --out runs/cmp``
+    Trains every algorithm with seeds 0..n-1 (``--jobs`` processes at a time) into
+    ``OUT/<algo>_seed<k>`` and plots them together to ``OUT/compare.png`` / ``OUT/compare.csv``
+    (``--plot-only`` re-plots existing runs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from ..train import (ALGOS, ALL_TASKS, MULTI_TASKS, TASKS, TrainInputError, VideoUnavailable,
+                     compare, evaluate, train)
+
+__all__ = ["add_parser"]
+
+
+def _json_arg(text: str) -> dict:
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise argparse.ArgumentTypeError(f"not JSON: {e}") from None
+    if not isinstance(value, dict):
+        raise argparse.ArgumentTypeError("expected a JSON object, e.g. '{\"max_steps\": 200}'")
+    return value
+
+
+def _common(p):
+    p.add_argument("--task", required=True, choices=sorted(ALL_TASKS),
+                   help=f"one-agent: {', '.join(TASKS)}; multi-agent: {', '.join(MULTI_TASKS)}")
+    p.add_argument("--mode", default=None, choices=("shared", "independent", "scripted"),
+                   help="multi-agent tasks: shared (one policy for all agents, the default), "
+                   "independent (one policy per agent) or scripted (one learner, the partner "
+                   "scripted)")
+    p.add_argument("--steps", type=int, required=True, help="environment steps to train for")
+    p.add_argument("--eval-every", type=int, default=None,
+                   help="steps between evaluations (default: steps / 20)")
+    p.add_argument("--eval-episodes", type=int, default=5, help="episodes per evaluation")
+    p.add_argument("--checkpoint-every", type=int, default=None,
+                   help="steps between checkpoints (default: steps / 5; 0: none)")
+    p.add_argument("--env-kwargs", type=_json_arg, default={},
+                   help="JSON keyword arguments for the env, e.g. '{\"max_steps\": 200}'")
+    p.add_argument("--algo-kwargs", type=_json_arg, default={},
+                   help="JSON keyword arguments for the SB3 algorithm (default: SB3's defaults)")
+    p.add_argument("--normalize-obs", action="store_true",
+                   help="normalise every observation input by running statistics inside the "
+                   "policy (mimo_social.train.obs_norm.RunningNorm; saved in the model): for eye images")
+
+
+def _train_main(args) -> int:
+    try:
+        res = train(args.task, args.algo, args.steps, args.seed, args.out,
+                    eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+                    checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
+                    env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs, mode=args.mode,
+                    n_envs=args.n_envs, n_cpus=args.n_cpus, normalize_obs=args.normalize_obs)
+    except TrainInputError as e:
+        print(f"mimo-social train: {e}", file=sys.stderr)
+        return 2
+    last = res["last_eval"]
+    success = last["eval_success_rate"]
+    mode = f" ({res['mode']})" if res.get("mode") else ""
+    print(f"trained {args.algo.upper()} on {args.task}{mode} for {res['timesteps']} steps in "
+          f"{res['wall_time_s']:.0f} s; last evaluation: return {last['eval_return_mean']:.3g}"
+          + ("" if math.isnan(success) else f", success {success:.0%}"))
+    for a in res.get("agents", ()):
+        s = last[f"eval_success_rate_{a}"]
+        print(f"  {a}: return {last[f'eval_return_mean_{a}']:.3g}"
+              + ("" if math.isnan(s) else f", success {s:.0%}"))
+    models = sorted({Path(m).name for m in res.get("models", {"": res["model"]}).values()})
+    print(f"wrote {res['out']}/" + ("{" + ", ".join(models) + "}" if len(models) > 1 else models[0])
+          + ", progress.csv, learning_curve.png")
+    return 0
+
+
+def _eval_main(args) -> int:
+    try:
+        res = evaluate(args.dir, args.episodes, model=args.model, seed=args.seed,
+                       deterministic=not args.stochastic, record=args.record, video=args.video,
+                       frames=args.frames, frame_every=args.frame_every,
+                       env_kwargs=args.env_kwargs)
+    except (VideoUnavailable, FileNotFoundError, TrainInputError) as e:
+        print(f"mimo-social eval: {e}", file=sys.stderr)
+        return 2
+    success = res["success_rate"]
+    mode = f" {res['mode']}" if res.get("mode") else ""
+    print(f"{res['task']} {res['algo'].upper()}{mode} {Path(res['model']).name}: "
+          f"{res['episodes']} episodes, return {res['return_mean']:.4g} +- "
+          f"{res['return_std']:.3g}, length {res['length_mean']:.0f}"
+          + ("" if math.isnan(success) else f", success {success:.0%}"))
+    for a, r in res.get("agents", {}).items():
+        s = r["success_rate"]
+        print(f"  {a} ({Path(res['models'][a]).name}): return {r['return_mean']:.4g} +- "
+              f"{r['return_std']:.3g}" + ("" if math.isnan(s) else f", success {s:.0%}"))
+    for key in ("record", "video", "frames"):
+        if key in res:
+            print(f"wrote {res[key]}")
+    return 0
+
+
+def _compare_main(args) -> int:
+    algos = [a.strip() for a in args.algos.split(",") if a.strip()]
+    try:
+        png = _compare_run(args, algos)
+    except TrainInputError as e:
+        print(f"mimo-social compare: {e}", file=sys.stderr)
+        return 2
+    print(f"wrote {png} and {png.with_suffix('.csv')}")
+    return 0
+
+
+def _compare_run(args, algos):
+    return compare(args.task, algos, args.seeds, args.steps, args.out, jobs=args.jobs,
+                   plot_only=args.plot_only, mode=args.mode, eval_every=args.eval_every,
+                   eval_episodes=args.eval_episodes, checkpoint_every=args.checkpoint_every,
+                   env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs,
+                   normalize_obs=args.normalize_obs)
+
+
+def add_parser(subparsers) -> None:
+    p = subparsers.add_parser("train", help="train PPO or SAC on a one-agent or social task",
+                              description="Train a Stable-Baselines3 policy (default "
+                              "hyperparameters) with periodic evaluation, checkpoints and a "
+                              "learning curve (CSV and PNG).")
+    _common(p)
+    p.add_argument("--algo", required=True, choices=ALGOS)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--n-envs", type=int, default=1, help="--mode shared: worlds stepped "
+                   "together (one VecEnv slot per agent of each)")
+    p.add_argument("--n-cpus", type=int, default=0, help="--mode shared: worker processes for "
+                   "the worlds (0: all in this process)")
+    p.set_defaults(func=_train_main)
+
+    p = subparsers.add_parser("eval", help="run a trained policy (optionally record or film it)",
+                              description="Reload the policy of a 'train' directory and run "
+                              "episodes with it.")
+    p.add_argument("dir", help="a directory written by 'mimo-social train'")
+    p.add_argument("--episodes", type=int, default=10)
+    p.add_argument("--model", default="final", help="final (model.zip), best (best_model.zip) "
+                   "or a path to a .zip")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    p.add_argument("--stochastic", action="store_true", help="sample actions from the policy")
+    p.add_argument("--record", default=None, help="write a Rerun recording (.rrd)")
+    p.add_argument("--video", default=None, help="write an MP4 video (needs imageio+ffmpeg "
+                   "or an ffmpeg program)")
+    p.add_argument("--frames", default=None, help="write every frame as a PNG file into this "
+                   "directory")
+    p.add_argument("--frame-every", type=int, default=1, help="keep every k-th frame")
+    p.add_argument("--env-kwargs", type=_json_arg, default={},
+                   help="JSON keyword arguments for the env, over those of the training run")
+    p.set_defaults(func=_eval_main)
+
+    p = subparsers.add_parser("compare", help="train several algorithms and seeds, plot them "
+                              "together", description="Train each algorithm with several seeds "
+                              "and plot the learning curves together (the paper's Fig. 8).")
+    _common(p)
+    p.add_argument("--algos", default="ppo,sac", help="comma-separated: ppo,sac")
+    p.add_argument("--seeds", type=int, default=3, help="seeds 0 .. n-1 per algorithm")
+    p.add_argument("--out", required=True, help="output directory (one sub-directory a run)")
+    p.add_argument("--jobs", type=int, default=1, help="runs at a time (processes)")
+    p.add_argument("--plot-only", action="store_true", help="only re-plot existing runs")
+    p.set_defaults(func=_compare_main)

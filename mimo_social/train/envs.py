@@ -1,0 +1,153 @@
+"""The envs SB3 learns on, built from a task name of the catalogue.
+
+``make_env(task)``
+    The one path for one learner: a one-agent task and the scripted form of a social task (its
+    learner, the partner scripted) are both ``gym.make(entry.gym_id, **env_kwargs)`` (the
+    catalogue registers every id), then :func:`make_sb3_single`.
+``make_parallel_env(task)`` / ``make_scripted_env(task)``
+    A social task's ParallelEnv (every agent, or the learner only) as ``FlattenParallel``.
+``make_sb3_single(env_id_or_env)``
+    A Gymnasium env with a ``Box`` observation and a ``Box`` action (expression logits, when the
+    env has a ``Dict`` action), or a ``Discrete`` expression for a face-only agent (the flat
+    wrappers of :mod:`mimo_social.core.wrappers`).
+
+The worker side of :class:`~mimo_social.train.vector.SpawnConcatVecEnv` lives here too: a spawned
+worker imports the module of its target function, and this one imports neither SB3 nor torch.
+"""
+
+from __future__ import annotations
+
+import traceback
+from typing import Any, Callable, Mapping
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+
+from ..core.wrappers import (ExpressionActionWrapper, FlatActionWrapper, FlatObservationWrapper,
+                             FlattenParallel, is_expression_only)
+from ..envs.catalog import entry, register_envs
+from .tasks import check_task, task_module
+
+__all__ = ["make_env", "make_parallel_env", "make_scripted_env", "make_sb3_single",
+           "with_render"]
+
+
+def with_render(env_kwargs: Mapping[str, Any], render_mode: str | None) -> dict:
+    """``env_kwargs`` plus ``render_mode`` when one is given."""
+    kw = dict(env_kwargs)
+    if render_mode is not None:
+        kw["render_mode"] = render_mode
+    return kw
+
+
+def make_env(task: str, render_mode: str | None = None, **env_kwargs):
+    """The task's one-learner Gymnasium env with Box observations and actions (for SB3): the
+    catalogue's Gymnasium id of the task (for a social task: its learner, the partner
+    scripted)."""
+    check_task(task)
+    return make_sb3_single(entry(task).gym_id, **with_render(env_kwargs, render_mode))
+
+
+def make_parallel_env(task: str, render_mode: str | None = None, **env_kwargs):
+    """``FlattenParallel(parallel_env(...))``: all agents, Box observations and actions."""
+    return FlattenParallel(task_module(task).parallel_env(**with_render(env_kwargs, render_mode)))
+
+
+def make_scripted_env(task: str, render_mode: str | None = None, **env_kwargs):
+    """``FlattenParallel(scripted_env(...))``: the learner only (its partner scripted)."""
+    return FlattenParallel(task_module(task).scripted_env(**with_render(env_kwargs, render_mode)))
+
+
+def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
+    """A one-agent Gymnasium env with a ``Box`` observation and a ``Box`` action, for SB3.
+
+    ``env_id_or_env``: a registered id (``"mimo_social/Reach-v0"``; ``make_kwargs`` go to
+    ``gymnasium.make``) or a ``gymnasium.Env``. A non-Box observation is flattened by
+    :class:`FlatObservationWrapper` (images scaled to [0, 1]); a ``Dict(motors, expression)``
+    action becomes the flat Box of :class:`FlatActionWrapper`, or, when the agent has no motors,
+    the ``Discrete`` expression of :class:`ExpressionActionWrapper`.
+    """
+    if isinstance(env_id_or_env, str):
+        register_envs()
+        env = gym.make(env_id_or_env, **make_kwargs)
+    elif isinstance(env_id_or_env, gym.Env):
+        if make_kwargs:
+            raise TypeError("keyword arguments are only used with an env id, not with an env")
+        env = env_id_or_env
+    else:
+        raise TypeError(f"make_sb3_single takes an env id or a gymnasium.Env, got "
+                        f"{type(env_id_or_env).__name__}")
+    if not isinstance(env.observation_space, spaces.Box) or env.observation_space.dtype == np.uint8:
+        env = FlatObservationWrapper(env)
+    if is_expression_only(env.action_space):
+        env = ExpressionActionWrapper(env)
+    elif not isinstance(env.action_space, spaces.Box):
+        env = FlatActionWrapper(env)
+    return env
+
+
+# -- worker side of ``vector.SpawnConcatVecEnv`` ------------------------------------------------
+def _markov_env(env_fn: Callable[[], ParallelEnv]):
+    """One world as SuperSuit's gymnasium vector env (one slot per agent)."""
+    import supersuit as ss
+    return ss.pettingzoo_env_to_vec_env_v1(FlattenParallel(env_fn()))
+
+
+def _world_call(par_env: FlattenParallel, kind: str, name: str, args: tuple = (),
+                kwargs: dict | None = None):
+    """Get or set an attribute of, or call a method of, one world (a FlattenParallel)."""
+    if kind == "get":
+        return getattr(par_env, name)
+    if kind == "set":
+        setattr(par_env.unwrapped, name, args[0])
+        return None
+    if kind == "call":
+        return getattr(par_env, name)(*args, **(kwargs or {}))
+    raise ValueError(f"unknown world call {kind!r}")
+
+
+def _vec_worker(conn, payload: bytes, n_worlds: int) -> None:
+    """Process entry point: SuperSuit's in-process vector env of ``n_worlds`` worlds built from
+    the cloudpickled ``env_fn`` in ``payload``; every answer on ``conn`` is ``(status, value)``."""
+    try:
+        import cloudpickle
+        import supersuit as ss
+        env_fn = cloudpickle.loads(payload)
+        venv = ss.concat_vec_envs_v1(_markov_env(env_fn), n_worlds, num_cpus=0,
+                                     base_class="gymnasium")
+        par_envs = [m.par_env for m in venv.vec_envs]
+        conn.send(("ok", (venv.num_envs, venv.observation_space, venv.action_space,
+                          dict(venv.metadata), venv.render_mode)))
+    except BaseException:
+        conn.send(("error", traceback.format_exc()))
+        conn.close()
+        return
+    try:
+        while True:
+            try:
+                cmd, data = conn.recv()
+            except EOFError:  # the parent is gone
+                break
+            if cmd == "close":
+                venv.close()
+                conn.send(("ok", None))
+                break
+            try:
+                if cmd == "step":
+                    out = venv.step(data)
+                elif cmd == "reset":
+                    out = venv.reset(seed=data[0], options=data[1])
+                elif cmd == "world":
+                    out = [_world_call(p, *data) for p in par_envs]
+                else:
+                    raise ValueError(f"unknown command {cmd!r}")
+            except Exception:
+                conn.send(("error", traceback.format_exc()))
+            else:
+                conn.send(("ok", out))
+    except KeyboardInterrupt:
+        pass
+    finally:
+        conn.close()

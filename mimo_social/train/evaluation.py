@@ -1,0 +1,236 @@
+"""``evaluate``: reload the policy of a ``train`` directory and run episodes with it.
+
+``evaluate(run, episodes=10)`` reloads ``run/model.zip`` (``model="best"`` or a path for another;
+a multi-agent run: every agent's model), runs the episodes with the deterministic policy
+(``deterministic=False`` samples), and writes ``run/eval_results.json``. ``record`` writes a Rerun
+recording of all episodes; ``video`` an MP4 of ``env.render()`` frames, which needs ``imageio``
+with its ffmpeg plugin or an ``ffmpeg`` program (:class:`VideoUnavailable` says so if neither is
+there: ``frames`` writes the frames as PNG files instead).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import time
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from .envs import make_env, make_parallel_env, make_scripted_env
+from .rollouts import evaluate_agents, evaluate_policy
+from .tasks import algo_class
+
+__all__ = ["evaluate", "EvalOutputs", "VideoUnavailable"]
+
+
+class VideoUnavailable(RuntimeError):
+    """No MP4 encoder on this machine."""
+
+
+def _mp4_writer(path: Path, fps: int):
+    """A function that takes frames and a close function, or VideoUnavailable."""
+    try:
+        import imageio.v2 as imageio  # needs its ffmpeg plugin (imageio-ffmpeg) for mp4
+        writer = imageio.get_writer(str(path), fps=fps)
+        return writer.append_data, writer.close
+    except Exception as e:  # ImportError, or no ffmpeg backend
+        reason = f"imageio: {e}"
+    ffmpeg = shutil.which("ffmpeg")
+    if ffmpeg is None:
+        raise VideoUnavailable(
+            f"cannot write {path}: no MP4 encoder on this machine ({reason}; and no ffmpeg "
+            "program on PATH). Install one (pip install imageio imageio-ffmpeg, or apt-get "
+            "install ffmpeg), or use --frames DIR to write the frames as PNG files.")
+    state = {}
+
+    def write(frame):
+        if "proc" not in state:
+            h, w = frame.shape[:2]
+            state["proc"] = subprocess.Popen(
+                [ffmpeg, "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
+                 "-s", f"{w}x{h}", "-r", str(fps), "-i", "-", "-pix_fmt", "yuv420p",
+                 "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", str(path)],
+                stdin=subprocess.PIPE)
+        state["proc"].stdin.write(np.ascontiguousarray(frame, dtype=np.uint8).tobytes())
+
+    def close():
+        if "proc" in state:
+            state["proc"].stdin.close()
+            state["proc"].wait()
+    return write, close
+
+
+class EvalOutputs:
+    """What an evaluation writes besides its numbers: a Rerun recording of the inner
+    ParallelEnv ``penv``, an MP4 and/or PNG frames of ``env.render()`` every ``frame_every``
+    steps. ``on_reset()`` / ``on_step(actions, rewards)`` after each reset / step; ``close()``."""
+
+    def __init__(self, env, penv, record=None, video=None, frames=None, frame_every: int = 1):
+        self.env, self.frames, self.frame_every = env, frames, int(frame_every)
+        self.want_frames = video is not None or frames is not None
+        self.write = self._close_video = None
+        if video is not None:
+            self.write, self._close_video = _mp4_writer(
+                Path(video), int(penv.metadata.get("render_fps", 100)))
+        if frames is not None:
+            Path(frames).mkdir(parents=True, exist_ok=True)
+        self.recorder = None
+        if record is not None:
+            from ..recording.recorder import Recorder
+            self.recorder = Recorder(penv, record)
+        self.episode, self.step = -1, 0
+
+    def on_reset(self) -> None:
+        self.episode += 1
+        self.step = 0
+        if self.recorder is not None:
+            self.recorder.log_reset()
+        self._frame()
+
+    def on_step(self, actions: Mapping[str, Any], rewards: Mapping[str, float]) -> None:
+        self.step += 1
+        if self.recorder is not None:
+            self.recorder.log_step(actions, rewards)
+        self._frame()
+
+    def _frame(self) -> None:
+        if not self.want_frames or self.step % self.frame_every:
+            return
+        frame = self.env.render()
+        if self.write is not None:
+            self.write(frame)
+        if self.frames is not None:
+            import matplotlib.image as mpimg
+            mpimg.imsave(Path(self.frames) / f"ep{self.episode:03d}_{self.step:05d}.png", frame)
+
+    def close(self) -> None:
+        if self.recorder is not None:
+            self.recorder.close()
+        if self._close_video is not None:
+            self._close_video()
+
+
+def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed: int = 0,
+             deterministic: bool = True, record: str | Path | None = None,
+             video: str | Path | None = None, frames: str | Path | None = None,
+             frame_every: int = 1, env_kwargs: Mapping[str, Any] | None = None) -> dict:
+    """Reload a trained policy from a ``train`` directory and run ``episodes`` episodes."""
+    import torch
+    torch.set_num_threads(1)
+    run = Path(run)
+    if not (run / "config.json").exists():
+        raise FileNotFoundError(f"{run}/config.json not found: give a directory written by "
+                                "'mimo-social train'")
+    config = json.loads((run / "config.json").read_text())
+    if config.get("mode") is not None:
+        return _evaluate_multi(run, config, episodes, model=model, seed=seed,
+                              deterministic=deterministic, record=record, video=video,
+                              frames=frames, frame_every=frame_every, env_kwargs=env_kwargs)
+    path = {"final": run / "model.zip", "best": run / "best_model.zip"}.get(model, Path(model))
+    if not path.exists():
+        raise FileNotFoundError(f"model {path} not found (--model final, best or a .zip path)")
+    policy = algo_class(config["algo"]).load(str(path), device="cpu")
+    kw = dict(config.get("env_kwargs", {}))
+    kw.update(env_kwargs or {})
+    want_frames = video is not None or frames is not None
+    env = make_env(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
+    penv = env.unwrapped.parallel
+    outputs = EvalOutputs(env, penv, record, video, frames, frame_every)
+    agent = penv.possible_agents[0]
+
+    def on_step(action, reward, info, reset):
+        if reset:
+            outputs.on_reset()
+        else:
+            outputs.on_step({agent: np.asarray(action)}, {agent: float(reward)})
+
+    t0 = time.perf_counter()
+    try:
+        res = evaluate_policy(policy, env, episodes, seed, deterministic, on_step)
+    finally:
+        outputs.close()
+        env.close()
+    res.update({"task": config["task"], "algo": config["algo"], "model": str(path),
+                "episodes": episodes, "deterministic": deterministic, "seed": seed,
+                "wall_time_s": round(time.perf_counter() - t0, 2)})
+    if record is not None:
+        res["record"] = str(record)
+    if video is not None:
+        res["video"] = str(video)
+    if frames is not None:
+        res["frames"] = str(frames)
+    (run / "eval_results.json").write_text(json.dumps(res, indent=2, default=float))
+    return res
+
+
+def _motor_slicer(env) -> Callable[[str, np.ndarray], dict]:
+    """Flat action -> ``{"motors": ...}`` for the recorder (its action-norm scalar)."""
+    inner = env.unwrapped
+    counts = {}
+    for a in env.possible_agents:
+        space = inner.action_space(a)
+        motors = space["motors"] if hasattr(space, "spaces") and "motors" in space.spaces else space
+        counts[a] = int(np.prod(motors.shape))
+    return lambda a, act: {"motors": np.asarray(act).ravel()[:counts[a]]}
+
+
+def _load_policies(run: Path, config: dict, model: str) -> tuple[dict, dict]:
+    cls = algo_class(config["algo"])
+    agents = config["agents"]
+    if config["mode"] == "independent":
+        if model in ("final", "best"):
+            prefix = "model" if model == "final" else "best_model"
+            paths = {a: run / f"{prefix}_{a}.zip" for a in agents}
+        else:
+            raise FileNotFoundError(f"--model {model!r}: an independent run has one model per "
+                                    "agent; use --model final or best")
+    else:
+        path = {"final": run / "model.zip", "best": run / "best_model.zip"}.get(model, Path(model))
+        paths = {a: path for a in agents}
+    for p in set(paths.values()):
+        if not Path(p).exists():
+            raise FileNotFoundError(f"model {p} not found (--model final, best"
+                                    + (")" if config["mode"] == "independent"
+                                       else " or a .zip path)"))
+    loaded = {p: cls.load(str(p), device="cpu") for p in sorted(set(paths.values()))}
+    return {a: loaded[p] for a, p in paths.items()}, {a: str(p) for a, p in paths.items()}
+
+
+def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed: int,
+                   deterministic: bool, record, video, frames, frame_every: int,
+                   env_kwargs: Mapping[str, Any] | None) -> dict:
+    """The multi-agent part of :func:`evaluate`."""
+    policies, paths = _load_policies(run, config, model)
+    kw = dict(config.get("env_kwargs", {}))
+    kw.update(env_kwargs or {})
+    want_frames = video is not None or frames is not None
+    make = make_scripted_env if config["mode"] == "scripted" else make_parallel_env
+    env = make(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
+    inner = env.unwrapped
+    outputs = EvalOutputs(env, inner, record, video, frames, frame_every)
+    motors = _motor_slicer(env)
+
+    def on_step(actions, rewards, obs, reset):
+        if reset:
+            outputs.on_reset()
+        else:
+            outputs.on_step({a: motors(a, act) for a, act in actions.items()}, rewards)
+
+    t0 = time.perf_counter()
+    try:
+        res = evaluate_agents(policies, env, episodes, seed, deterministic, on_step)
+    finally:
+        outputs.close()
+        env.close()
+    res.update({"task": config["task"], "algo": config["algo"], "mode": config["mode"],
+                "model": paths[next(iter(paths))], "models": paths, "episodes": episodes,
+                "deterministic": deterministic, "seed": seed,
+                "wall_time_s": round(time.perf_counter() - t0, 2)})
+    for key, value in (("record", record), ("video", video), ("frames", frames)):
+        if value is not None:
+            res[key] = str(value)
+    (run / "eval_results.json").write_text(json.dumps(res, indent=2, default=float))
+    return res

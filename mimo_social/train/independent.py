@@ -1,0 +1,95 @@
+"""``--mode independent``: one SB3 policy per agent, all acting in one world at the same time.
+
+Every model's ``learn()`` runs in its own thread on an :class:`~mimo_social.train.lockstep.
+AgentView` of one shared ParallelEnv (:mod:`mimo_social.train.lockstep`); episodes, evaluations
+and checkpoints are handled in the stepping thread while every model is parked. Writes
+``model_<agent>.zip``, ``best_model_<agent>.zip`` and ``checkpoints/model_<agent>_<steps>_steps.zip``.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+from typing import Any
+
+from .envs import make_parallel_env
+from .lockstep import Lockstep, run_lockstep
+from .rollouts import evaluate_agents
+from .runlog import RunLog, Schedule
+
+__all__ = ["train_independent"]
+
+
+class _IndependentLog:
+    """Episode returns of the shared env, evaluations and checkpoints of the independent mode
+    (runs in the stepping thread, every model parked)."""
+
+    def __init__(self, log: RunLog, schedule: Schedule, models: dict, out: Path):
+        self.log, self.schedule, self.models, self.out = log, schedule, models, out
+        self.hub: Lockstep | None = None
+        self.returns = {a: 0.0 for a in models}
+        self.lengths = {a: 0 for a in models}
+
+    @property
+    def rows(self):
+        return self.log.rows
+
+    def on_reset(self, obs, infos):
+        self.returns = {a: 0.0 for a in self.models}
+        self.lengths = {a: 0 for a in self.models}
+
+    def on_step(self, obs, rewards, terms, truncs, infos):
+        n = self.hub.env_steps
+        for a, r in rewards.items():
+            self.returns[a] += float(r)
+            self.lengths[a] += 1
+            if terms.get(a) or truncs.get(a):
+                self.log.episode(n, a, self.returns[a], self.lengths[a],
+                                 infos.get(a, {}).get("is_success"))
+        if self.log.bar is not None:
+            self.log.bar.update(n - self.log.bar.n)
+        if self.schedule.checkpoint_due(n):
+            self.checkpoint(n)
+        if self.schedule.eval_due(n):
+            self.log.evaluate(n)
+
+    def checkpoint(self, n: int) -> None:
+        (self.out / "checkpoints").mkdir(exist_ok=True)
+        for a, m in self.models.items():
+            m.save(self.out / "checkpoints" / f"model_{a}_{n}_steps.zip")
+
+
+def train_independent(cls, algo_kwargs, task, env_kwargs, steps, seed, out, eval_env,
+                      eval_episodes, eval_seed, schedule, bar, t0, verbose):
+    """Train one model per agent in lockstep; returns ``(models, log)`` (``log.rows``: the
+    evaluations)."""
+    from stable_baselines3.common.monitor import Monitor
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    env = make_parallel_env(task, **env_kwargs)
+    agents = list(env.possible_agents)
+    models: dict[str, Any] = {}
+    log = RunLog(out, agents, lambda: evaluate_agents(models, eval_env, eval_episodes, eval_seed),
+                 lambda: [m.save(out / f"best_model_{a}.zip") for a, m in models.items()], t0, bar)
+    state = _IndependentLog(log, schedule, models, out)
+    hub = Lockstep(env, on_step=state.on_step, on_reset=state.on_reset)
+    state.hub = hub
+    try:
+        for k, a in enumerate(agents):  # built in order: each seeds the global RNGs (SB3)
+            view = hub.view(a)
+            venv = DummyVecEnv([lambda v=view: Monitor(v)])
+            models[a] = cls("MlpPolicy", venv, seed=seed + k, device="cpu", verbose=verbose,
+                            **algo_kwargs)
+        run_lockstep(hub, {a: functools.partial(models[a].learn, total_timesteps=steps)
+                           for a in agents})
+        n = hub.env_steps   # every model has made its last update
+        if schedule.final_checkpoint_due(n):
+            state.checkpoint(n)
+        log.evaluate(n)
+        for a, m in models.items():
+            m.save(out / f"model_{a}.zip")
+    finally:
+        log.close()
+        env.close()
+    return models, state
+

@@ -1,0 +1,192 @@
+"""Pictures of runs: a run's learning curve and several runs compared.
+
+``plot_learning_curve(run)``
+    ``learning_curve.png``: evaluation return (mean and std) and training returns against steps,
+    and the success rate where the task reports one; one line per agent for multi-agent runs.
+``plot_compare(out)``
+    ``compare.png`` / ``compare.csv`` of every ``<algo>_seed<k>`` run below ``out`` (the paper's
+    Fig. 8: each algorithm's mean over seeds with the min-max band, PPO red, SAC blue).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .progress import PROGRESS_FIELDS, progress_agents, read_progress
+
+__all__ = ["COLORS", "plot_learning_curve", "plot_compare"]
+
+COLORS = {"ppo": "tab:red", "sac": "tab:blue"}
+
+
+def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path:
+    """``learning_curve.png`` of one run (from its ``progress.csv`` and ``episodes.csv``)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    run = Path(run)
+    path = Path(path) if path else run / "learning_curve.png"
+    p = read_progress(run / "progress.csv")
+    config = json.loads((run / "config.json").read_text()) if (run / "config.json").exists() else {}
+    agents = progress_agents(p)
+    if agents:
+        return _plot_agents(run, path, p, config, agents)
+    has_success = np.isfinite(p["eval_success_rate"]).any()
+    fig, axes = plt.subplots(1, 2 if has_success else 1, figsize=(11 if has_success else 6.5, 4),
+                             squeeze=False)
+    ax = axes[0, 0]
+    ep_path = run / "episodes.csv"
+    if ep_path.exists():
+        with open(ep_path, newline="") as f:
+            eps = [(float(r["timesteps"]), float(r["return"])) for r in csv.DictReader(f)]
+        if eps:
+            x, y = np.array(eps).T
+            ax.plot(x, y, ".", ms=2, color="0.6", alpha=0.5, label="training episodes")
+    t, m, s = p["timesteps"], p["eval_return_mean"], p["eval_return_std"]
+    color = COLORS.get(config.get("algo"), "tab:green")
+    ax.plot(t, m, "-o", ms=3, color=color, label="evaluation (mean)")
+    ax.fill_between(t, m - s, m + s, color=color, alpha=0.2, lw=0)
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("episode return")
+    ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
+                 f"(seed {config.get('seed', '?')})")
+    ax.legend(loc="best", fontsize=8)
+    ax.grid(alpha=0.3)
+    if has_success:
+        ax = axes[0, 1]
+        ax.plot(t, 100 * p["eval_success_rate"], "-o", ms=3, color=color)
+        ax.set_ylim(-5, 105)
+        ax.set_xlabel("environment steps")
+        ax.set_ylabel("evaluation success rate (%)")
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> Path:
+    """Learning curve of a multi-agent run: one line per agent (return; success rate)."""
+    import matplotlib.pyplot as plt
+
+    success_keys = [f"eval_success_rate_{a}" for a in agents]
+    has_success = any(np.isfinite(p[k]).any() for k in success_keys if k in p)
+    fig, axes = plt.subplots(1, 2 if has_success else 1, figsize=(11 if has_success else 6.5, 4),
+                             squeeze=False)
+    colors = {a: f"C{i}" for i, a in enumerate(agents)}
+    # line style and marker per agent too: cooperative tasks give the agents the same numbers
+    styles = {a: (("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"))[i % 4]
+              for i, a in enumerate(agents)}
+    ax = axes[0, 0]
+    ep_path = run / "episodes.csv"
+    if ep_path.exists():
+        with open(ep_path, newline="") as f:
+            eps = list(csv.DictReader(f))
+        for a in agents:
+            xy = [(float(r["timesteps"]), float(r["return"])) for r in eps if r.get("agent") == a]
+            if xy:
+                x, y = np.array(xy).T
+                ax.plot(x, y, ".", ms=2, color=colors[a], alpha=0.25)
+    t = p["timesteps"]
+    for a in agents:
+        ls, mk = styles[a]
+        ax.plot(t, p[f"eval_return_mean_{a}"], ls=ls, marker=mk, ms=4, color=colors[a],
+                label=f"{a} (evaluation)")
+    ax.set_xlabel("environment steps")
+    ax.set_ylabel("episode return")
+    ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
+                 f"{config.get('mode', '')} (seed {config.get('seed', '?')})")
+    ax.legend(loc="best", fontsize=8)
+    ax.grid(alpha=0.3)
+    if has_success:
+        ax = axes[0, 1]
+        for a in agents:
+            ls, mk = styles[a]
+            ax.plot(t, 100 * p[f"eval_success_rate_{a}"], ls=ls, marker=mk, ms=4, color=colors[a],
+                    label=a)
+        ax.set_ylim(-5, 105)
+        ax.set_xlabel("environment steps")
+        ax.set_ylabel("evaluation success rate (%)")
+        ax.legend(loc="best", fontsize=8)
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_compare(out: str | Path, task: str | None = None) -> Path:
+    """``compare.png`` / ``compare.csv`` from every ``<algo>_seed<k>`` run below ``out``."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    by_algo: dict[str, list] = {}
+    for run in sorted(out.glob("*_seed*")):
+        if not (run / "progress.csv").exists():
+            continue
+        config = json.loads((run / "config.json").read_text())
+        by_algo.setdefault(config["algo"], []).append((config, read_progress(run / "progress.csv")))
+    if not by_algo:
+        raise FileNotFoundError(f"no runs with a progress.csv below {out}")
+    has_success = any(np.isfinite(p["eval_success_rate"]).any()
+                      for runs in by_algo.values() for _, p in runs)
+    fig, axes = plt.subplots(1, 2 if has_success else 1, figsize=(11 if has_success else 6.5, 4),
+                             squeeze=False)
+    rows = []
+    fields = ["algo", "seed", *PROGRESS_FIELDS]
+    for runs in by_algo.values():
+        for _, p in runs:
+            fields += [k for k in p if k not in fields]
+    for algo, runs in sorted(by_algo.items()):
+        color = COLORS.get(algo, None)
+        end = min(p["timesteps"][-1] for _, p in runs)
+        grid = np.unique(np.concatenate([p["timesteps"][p["timesteps"] <= end] for _, p in runs]))
+        for key, ax, scale in (("eval_return_mean", axes[0, 0], 1.0),
+                               ("eval_success_rate", axes[0, 1] if has_success else None, 100.0)):
+            if ax is None:
+                continue
+            ys = np.array([np.interp(grid, p["timesteps"], p[key]) for _, p in runs]) * scale
+            for y in ys:
+                ax.plot(grid, y, color=color, alpha=0.25, lw=0.8)
+            ax.plot(grid, np.nanmean(ys, axis=0), color=color, lw=2,
+                    label=f"{algo.upper()} ({len(runs)} seeds)")
+            ax.fill_between(grid, np.nanmin(ys, axis=0), np.nanmax(ys, axis=0), color=color,
+                            alpha=0.15, lw=0)
+        for config, p in runs:
+            for i in range(len(p["timesteps"])):
+                rows.append({"algo": algo, "seed": config["seed"],
+                             **{k: p[k][i] for k in p}})
+    first = next(iter(by_algo.values()))[0][0]
+    task = task or first["task"]
+    if first.get("mode"):
+        task = f"{task} ({first['mode']}, mean over agents)"
+    fig.suptitle(task)
+    axes[0, 0].set_title("evaluation return (mean over seeds, min-max band)", fontsize=10)
+    axes[0, 0].set_xlabel("environment steps")
+    axes[0, 0].set_ylabel("episode return")
+    axes[0, 0].legend(loc="best", fontsize=8)
+    axes[0, 0].grid(alpha=0.3)
+    if has_success:
+        axes[0, 1].set_title("evaluation success rate", fontsize=10)
+        axes[0, 1].set_xlabel("environment steps")
+        axes[0, 1].set_ylabel("success (%)")
+        axes[0, 1].set_ylim(-5, 105)
+        axes[0, 1].grid(alpha=0.3)
+    fig.tight_layout()
+    png = out / "compare.png"
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    with open(out / "compare.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    return png
+
