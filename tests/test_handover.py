@@ -3,11 +3,8 @@
 import mujoco
 import numpy as np
 import pytest
-from gymnasium.utils.env_checker import check_env
-from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import handover_v0
-from mimo_social.core.gym_adapter import SingleAgentEnv
 from mimo_social.tasks.handover import OFFER_TARGET
 from mimo_social.partners import ScriptedPartners, zero_action
 from mimo_social.partners.hand_offer import HandOffer
@@ -20,16 +17,11 @@ def _ball(env):
     return w.data.xpos[w.prop_bodies["ball"]].copy()
 
 
-def test_pettingzoo_parallel_api():
+def test_agents_and_spaces():   # the API checks: tests/conformance
     env = handover_v0.parallel_env(max_steps=40)
-    parallel_api_test(env, num_cycles=60)
     assert env.possible_agents == ["infant_0", "infant_1"]
     assert env.action_space("infant_0").shape == (29,)            # right arm 7 + 22 fingers
     assert set(env.observation_space("infant_0").spaces) == {"proprioception", "touch"}
-
-
-def test_seeds_give_identical_episodes():
-    parallel_seed_test(lambda: handover_v0.parallel_env(max_steps=30), num_cycles=40)
 
 
 def test_reset_seed_draws_the_receivers_arm():
@@ -45,12 +37,11 @@ def test_reset_seed_draws_the_receivers_arm():
     assert np.abs(q1 - q2).max() > 1e-3
 
 
-def test_scripted_env_exposes_the_receiver_and_passes_gymnasium_check():
+def test_scripted_env_exposes_the_receiver():   # check_env: tests/conformance
     env = handover_v0.scripted_env(max_steps=20)
     assert env.possible_agents == ["infant_0"]
     assert isinstance(env.partners["infant_1"], HandOffer)
     assert env.partners["infant_1"].release == "on_touch"
-    check_env(SingleAgentEnv(handover_v0.scripted_env(max_steps=20)), skip_render_check=True)
 
 
 @pytest.mark.parametrize("actuation", ["spring_damper", "muscle"])

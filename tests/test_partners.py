@@ -1,11 +1,8 @@
 """The scripted-partner wrapper: only learners are exposed, partners act through their actions."""
 
-import numpy as np
 import pytest
-from gymnasium.utils.env_checker import check_env
 
 from mimo_social.envs import high_five_v0
-from mimo_social.core.gym_adapter import SingleAgentEnv
 from mimo_social.partners import Partner, ScriptedPartners, Still, zero_action
 
 
@@ -68,11 +65,3 @@ def test_bad_use_is_reported():
                   "infant_1": zero_action(base.action_space("infant_1"))})
     with pytest.raises(KeyError, match="learners"):
         env.action_space("infant_1")
-
-
-def test_one_learner_is_a_gymnasium_env():
-    env = SingleAgentEnv(high_five_v0.scripted_env())
-    check_env(env, skip_render_check=True)
-    obs, _ = env.reset(seed=0)
-    _, r, *_ = env.step(env.action_space.sample())
-    assert np.isfinite(r)
