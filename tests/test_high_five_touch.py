@@ -3,7 +3,6 @@
 import mujoco
 import numpy as np
 import pytest
-from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import high_five_v0
 from mimo_social.core.config import ConfigError
@@ -38,11 +37,6 @@ def _hands_together(env):
     d = w.data
     _place_palm(env, 1, [CLOSE / 2 + 0.02, 0.0, 0.58])
     _place_palm(env, 0, d.site_xpos[w.agents[1].palm_sites[0]].copy())
-
-
-def test_api_and_seed():
-    parallel_api_test(high_five_v0.parallel_env(max_steps=40), num_cycles=50)
-    parallel_seed_test(lambda: high_five_v0.parallel_env(max_steps=40))
 
 
 def test_the_default_skin_covers_the_right_hand_only():

@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 from gymnasium import spaces
-from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import joint_attention_v0
 from mimo_social.core.gym_adapter import SingleAgentEnv
@@ -11,11 +10,6 @@ from mimo_social.core.wrappers import FlattenParallel, make_sb3_single
 from mimo_social.partners.gaze import GazeAtTarget
 
 STILL = np.zeros(9, np.float32)
-
-
-def test_api_and_seed():
-    parallel_api_test(joint_attention_v0.parallel_env(max_steps=40), num_cycles=50)
-    parallel_seed_test(lambda: joint_attention_v0.parallel_env(max_steps=20), num_cycles=20)
 
 
 @pytest.mark.parametrize("kwargs, match", [

@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 from gymnasium import spaces
-from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 from mimo_social.envs import mirror_v0
 from mimo_social.core.gym_adapter import SingleAgentEnv
@@ -27,11 +26,6 @@ class Shows(Partner):
 
     def act(self, env, agent, observation):
         return act(self.expression)
-
-
-def test_api_and_seed():
-    parallel_api_test(mirror_v0.parallel_env(max_steps=40), num_cycles=50)
-    parallel_seed_test(lambda: mirror_v0.parallel_env(max_steps=20), num_cycles=20)
 
 
 def test_three_agents_and_bad_options_raise_clear_errors():

@@ -1,30 +1,22 @@
 """The PettingZoo env through its public API."""
 
-import pickle
-
 import gymnasium as gym
 import numpy as np
 import pytest
-from gymnasium.utils.env_checker import check_env
 from pettingzoo.test import parallel_api_test, parallel_seed_test
 
 import mimo_social  # noqa: F401
 from mimo_social.envs import free_play_v0, high_five_v0
 
 
-@pytest.mark.parametrize("n_agents", [2, 3])
+@pytest.mark.parametrize("n_agents", [3])   # 2: tests/conformance
 def test_free_play_api(n_agents):
     parallel_api_test(free_play_v0.parallel_env(n_agents=n_agents, max_steps=60), num_cycles=80)
 
 
-@pytest.mark.parametrize("n_agents", [2, 3])
+@pytest.mark.parametrize("n_agents", [3])   # 2: tests/conformance
 def test_free_play_seed(n_agents):
     parallel_seed_test(lambda: free_play_v0.parallel_env(n_agents=n_agents, max_steps=60))
-
-
-def test_high_five_api_and_seed():
-    parallel_api_test(high_five_v0.parallel_env(max_steps=60), num_cycles=80)
-    parallel_seed_test(lambda: high_five_v0.parallel_env(max_steps=60))
 
 
 def _rollout(seed, steps=200):
@@ -49,9 +41,8 @@ def test_same_seed_same_trajectory_over_200_steps():
     assert not np.array_equal(t1, t3)
 
 
-def test_reach_check_env():
+def test_reach_gym_spaces():
     env = gym.make("mimo_social/Reach-v0")
-    check_env(env.unwrapped, skip_render_check=True)
     obs, info = env.reset(seed=0)
     assert set(obs) == {"proprioception"}
     assert env.action_space.shape == (8,)
@@ -140,20 +131,6 @@ def test_gravity_makes_an_unactuated_infant_settle():
     assert np.abs(d.qvel).max() < 0.5                  # and came to rest
 
 
-def test_pickle_round_trip():
-    env = high_five_v0.parallel_env()
-    env.reset(seed=3)
-    for _ in range(5):
-        env.step({a: env.action_space(a).sample() for a in env.agents})
-    clone = pickle.loads(pickle.dumps(env))
-    np.testing.assert_array_equal(clone.world.data.qpos, env.world.data.qpos)
-    actions = {a: {"motors": np.full(8, 0.3, np.float32), "expression": 2} for a in env.agents}
-    o1, *_ = env.step(actions)
-    o2, *_ = clone.step(actions)
-    for a in o1:
-        np.testing.assert_allclose(o1[a]["proprioception"], o2[a]["proprioception"], atol=1e-9)
-
-
 def test_spaces_follow_configuration():
     env = free_play_v0.parallel_env(n_agents=2, vestibular=False,
                                     per_agent=[{}, {"proprioception": {"components": ["qpos"]}}])
@@ -164,12 +141,6 @@ def test_spaces_follow_configuration():
     assert env.observation_space("infant_0") is s0
     obs, _ = env.reset(seed=0)
     assert s0.contains(obs["infant_0"]) and s1.contains(obs["infant_1"])
-
-
-def test_state_for_centralised_critics():
-    env = free_play_v0.parallel_env(n_agents=2)
-    env.reset(seed=0)
-    assert env.state().shape == env.state_space().shape
 
 
 def test_instability_ends_the_episode_with_a_reason():
