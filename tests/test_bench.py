@@ -6,7 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from mimo_social.bench import suite as bench
+from mimo_social import bench
+from mimo_social.cli import bench as bench_cli
 from mimo_social.core import random_actions
 
 TOP_KEYS = {"machine", "settings", "cold_start", "results"}
@@ -80,7 +81,7 @@ def test_unknown_name_is_rejected():
 
 def test_cli_writes_json_markdown_and_plot(tmp_path, capsys):
     parser = argparse.ArgumentParser(prog="mimo-social")
-    bench.add_parser(parser.add_subparsers(dest="command", required=True))
+    bench_cli.add_parser(parser.add_subparsers(dest="command", required=True))
     out, md, png = tmp_path / "b.json", tmp_path / "B.md", tmp_path / "docs" / "b.png"
     args = parser.parse_args(["bench", "--json", str(out), "--sim-seconds", "0.3",
                               "--only", "physics_only,reach", "--markdown", str(md),
@@ -122,6 +123,7 @@ def test_smoke_two_small_configurations(small):
             assert comps[key] > 0, key
         assert entry["recording"]["on"] and entry["recording"]["error"] is None
         assert entry["senses"]["vision"] == [64, 64] and entry["senses"]["touch"] == 1.0
+        assert entry["touch_points"] > 0 and entry["skin_cache"]
         assert entry["mimo_reference"]["value"] == bench.MIMO_REFERENCE["default"]
     assert v64["group"] == "grid" and agents_2["group"] == "scaling"
 
@@ -133,8 +135,8 @@ def test_default_set_and_names():
     assert want <= set(bench.DEFAULT_CONFIGS)
     assert not any(n.startswith("jacobian_") for n in bench.DEFAULT_CONFIGS)
     assert "jacobian_dense_4" in bench.CONFIGS
-    assert bench._check_names(None) == bench.DEFAULT_CONFIGS
-    assert bench._check_names("all") == list(bench.CONFIGS)
+    assert bench.check_names(None) == bench.DEFAULT_CONFIGS
+    assert bench.check_names("all") == list(bench.CONFIGS)
     # the grid: vision sizes at touch x1, touch densities at vision 256
     for name, size, density in (("v64", 64, 1.0), ("v128", 128, 1.0), ("default", 256, 1.0),
                                 ("v512", 512, 1.0), ("t0.25", 256, 0.25), ("t0.5", 256, 0.5),
@@ -145,6 +147,15 @@ def test_default_set_and_names():
         assert kw["task_options"] == {"props": True} and kw["n_agents"] == 1
     # agents_1 is v64 (the run's noise check)
     assert bench.CONFIGS["agents_1"].key() == bench.CONFIGS["v64"].key()
+
+
+def test_every_catalogue_env_is_a_configuration():
+    from mimo_social.envs.catalog import CATALOG
+
+    for e in CATALOG:  # a new catalogue line is benchmarked with its defaults, recorded
+        cfg = bench.CONFIGS[e.name]
+        assert (cfg.task, dict(cfg.kwargs), cfg.record, cfg.group) == (e.name, {}, True, "tasks")
+        assert e.summary in cfg.description and cfg.name in bench.DEFAULT_CONFIGS
 
 
 def test_muscle_actions_fill_their_bounds():
@@ -167,7 +178,7 @@ def test_muscle_actions_fill_their_bounds():
 
 
 def test_configuration_that_cannot_be_built_is_skipped(monkeypatch):
-    bad = bench.BenchConfig("claws", "free_play_v0", {"n_agents": 1, "hands": "claws"})
+    bad = bench.BenchConfig("claws", "free_play", {"n_agents": 1, "hands": "claws"})
     monkeypatch.setitem(bench.CONFIGS, "claws", bad)
     report = bench.run_benchmarks(["claws", "physics_only"], sim_seconds=0.1, progress=False,
                                   measure_cold_start=False)

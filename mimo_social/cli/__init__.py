@@ -8,10 +8,9 @@ from __future__ import annotations
 
 import argparse
 
-from ..bench import suite as bench
 from ..experiments import calibration, compliance, demo
 from ..train import runner as train
-from . import docs, replay
+from . import bench, docs, replay
 
 SUBCOMMANDS = (demo, bench, calibration, compliance, replay, train, docs)
 
