@@ -143,6 +143,28 @@ def test_spaces_follow_configuration():
     assert s0.contains(obs["infant_0"]) and s1.contains(obs["infant_1"])
 
 
+def test_senses_come_from_the_registry():
+    from dataclasses import fields
+
+    from mimo_social.core.config import AgentConfig
+    from mimo_social.core.env import TIMING_KEYS
+    from mimo_social.senses import SENSES, Sense, SharedSystem
+
+    assert list(SENSES) == ["proprioception", "vestibular", "touch", "vision"]
+    assert set(SENSES) <= {f.name for f in fields(AgentConfig)}
+    assert set(SENSES) <= set(TIMING_KEYS)
+    for name, entry in SENSES.items():
+        assert entry.name == name and (entry.per_agent is None) != (entry.shared is None)
+    env = free_play_v0.parallel_env(n_agents=2, touch=True, per_agent=[{}, {"vestibular": False}])
+    assert sorted(env.systems) == ["touch"] and env.system("touch") is env.systems["touch"]
+    assert all(isinstance(s, SharedSystem) for s in env.systems.values())
+    assert [s.name for s in env.senses[0]] == ["proprioception", "vestibular", "touch"]
+    assert [s.name for s in env.senses[1]] == ["proprioception", "touch"]
+    assert all(isinstance(s, Sense) for senses in env.senses for s in senses)
+    with pytest.raises(ValueError, match="vision=True"):
+        env.system("vision")
+
+
 def test_instability_ends_the_episode_with_a_reason():
     env = free_play_v0.parallel_env(n_agents=2, expressions=False)
     env.reset(seed=0)

@@ -20,8 +20,9 @@ from mimo_social.core.config import ConfigError
 from mimo_social.core.env import MimoParallelEnv
 from mimo_social.core.task import Task, held_posture
 from mimo_social.core.world import AgentSetup, Prop
+from mimo_social.figures import hand_ball_scene
 from mimo_social.senses import skin as skin_module
-from mimo_social.senses.touch import hand_ball_scene, save_skin_png
+from mimo_social.senses.touch import save_skin_png
 
 G = 9.81
 # right arm forward, palm up (deg), sitting

@@ -345,3 +345,18 @@ def test_two_process_vector_env_with_vision_does_not_hang(tmp_path, start_method
         out, _ = proc.communicate()
         pytest.fail(f"the vector env with vision hung:\n{out[-3000:]}")
     assert proc.returncode == 0 and "VEC-OK" in out, out[-3000:]
+
+
+def test_bench_vision_command_and_report():
+    from mimo_social.bench import vision_cost
+    from mimo_social.cli import build_parser
+
+    args = build_parser().parse_args(["bench-vision", "--backends", "egl", "--rounds", "2"])
+    assert (args.backends, args.rounds, args.sim_seconds, args.worker) == ("egl", 2, 5.0, False)
+    res = {"egl": {"images": [{"agents": 1, "size": 64, "variant": "final", "ms_per_image": 0.2},
+                              {"variant": "readback_rgb_mjr_readPixels", "ms_per_2x256x256": 1.0}],
+                   "env": [{"config": "1 infant", "vision": 0.05, "total": 0.3,
+                            "physics": 0.2}]}}
+    text = vision_cost.format_results(res)
+    assert "| final | 0.200 |" in text and "readback_rgb_mjr_readPixels: 1.000 ms" in text
+    assert "egl | 1 infant | vision 0.0500 | total 0.3000" in text

@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import argparse
 
+from ..bench import suite as bench
 from ..experiments import calibration, compliance, demo
 from ..train import runner as train
-from . import bench, docs, replay
+from . import bench_vision, docs, figure, replay
 
-SUBCOMMANDS = (demo, bench, calibration, compliance, replay, train, docs)
+SUBCOMMANDS = (demo, bench, calibration, compliance, replay, train, docs, bench_vision, figure)
 
 
 def build_parser() -> argparse.ArgumentParser:

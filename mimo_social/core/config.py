@@ -2,7 +2,9 @@
 
 Every env factory takes keyword arguments that apply to every agent plus an optional
 ``per_agent=[{...}, {...}]`` list of overrides. Senses are switched the same way for every
-sense: ``False`` (off), ``True`` (defaults) or a mapping of settings.
+sense: ``False`` (off), ``True`` (defaults) or a mapping of settings of the sense's own config
+class (found through the registry :data:`mimo_social.senses.SENSES`; the config classes are
+re-exported here).
 """
 
 from __future__ import annotations
@@ -14,17 +16,21 @@ from dataclasses import dataclass, fields
 from typing import Any, Mapping, Sequence
 
 from ..body.tables import HAND_VERSIONS, SCALE_RANGE, STRENGTH_RANGE
+from ..senses import SENSES
+from ..senses.proprioception import ProprioceptionConfig
+from ..senses.touch import TouchConfig
+from ..senses.vestibular import VestibularConfig
+from ..senses.vision import VisionConfig
 from ..util.checks import ConfigError
 
 __all__ = [
-    "ProprioceptionConfig", "VestibularConfig", "AgentConfig", "PhysicsConfig",
-    "ConfigError", "resolve_agents", "parse_physics", "ACTUATION_MODELS", "POSTURES",
+    "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig", "AgentConfig",
+    "PhysicsConfig", "ConfigError", "resolve_agents", "parse_physics", "ACTUATION_MODELS",
+    "POSTURES",
 ]
 
 ACTUATION_MODELS = ("spring_damper", "muscle")
 POSTURES = ("standing", "sitting", "lying")
-PROPRIOCEPTION_COMPONENTS = ("qpos", "qvel", "torque", "limits", "actuation")
-VESTIBULAR_COMPONENTS = ("gyro", "accel")
 
 
 def _from_mapping(cls, what: str, value: Mapping[str, Any]):
@@ -33,95 +39,6 @@ def _from_mapping(cls, what: str, value: Mapping[str, Any]):
     if unknown:
         raise ConfigError(f"{what}: unknown setting(s) {unknown}; allowed: {names}")
     return cls(**value)
-
-
-def _components(what: str, given, allowed: Sequence[str]) -> tuple[str, ...]:
-    given = tuple(given)
-    bad = [c for c in given if c not in allowed]
-    if bad or not given:
-        raise ConfigError(f"{what}: components {list(given)} not allowed; choose a non-empty "
-                          f"subset of {list(allowed)}")
-    return tuple(c for c in allowed if c in given)
-
-
-@dataclass(frozen=True)
-class ProprioceptionConfig:
-    """Joint positions, velocities, actuator torques, limit proximity, actuation state."""
-
-    components: tuple[str, ...] = PROPRIOCEPTION_COMPONENTS
-    limit_margin_deg: float = 5.0  # a limit sensor rises from 0 to 1 over this last stretch
-
-    def __post_init__(self):
-        object.__setattr__(self, "components", _components(
-            "proprioception", self.components, PROPRIOCEPTION_COMPONENTS))
-        if not 0 < self.limit_margin_deg <= 90:
-            raise ConfigError(f"proprioception: limit_margin_deg={self.limit_margin_deg} "
-                              "must be in (0, 90] degrees")
-
-
-@dataclass(frozen=True)
-class VestibularConfig:
-    """Angular velocity (gyro, rad/s) and linear acceleration (accel, m/s^2) at the head centre."""
-
-    components: tuple[str, ...] = VESTIBULAR_COMPONENTS
-
-    def __post_init__(self):
-        object.__setattr__(self, "components", _components(
-            "vestibular", self.components, VESTIBULAR_COMPONENTS))
-
-
-TOUCH_RESPONSES = ("spread_linear", "nearest")
-TOUCH_FRAMES = ("body", "world")
-
-
-@dataclass(frozen=True)
-class TouchConfig:
-    """The full-body skin: sensor points over every body part, each sensing a force vector.
-
-    ``density`` multiplies the published per-part point density (spacing / sqrt(density));
-    ``exclude`` lists body parts without skin; ``response`` spreads each contact over nearby
-    points; ``frame`` is the frame of the force vectors; ``normal_only`` keeps 1 value a point.
-    """
-
-    density: float = 1.0
-    response: str = "spread_linear"
-    frame: str = "body"
-    normal_only: bool = False
-    exclude: tuple[str, ...] = ()
-    cache: bool = True
-
-    def __post_init__(self):
-        if not 0.05 <= float(self.density) <= 8.0:
-            raise ConfigError(f"touch: density={self.density}; allowed: 0.05 to 8 (a multiplier "
-                              "of the published point density)")
-        if self.response not in TOUCH_RESPONSES:
-            raise ConfigError(f"touch: response={self.response!r}; allowed: {list(TOUCH_RESPONSES)}")
-        if self.frame not in TOUCH_FRAMES:
-            raise ConfigError(f"touch: frame={self.frame!r}; allowed: {list(TOUCH_FRAMES)}")
-        object.__setattr__(self, "exclude", tuple(self.exclude))
-
-
-@dataclass(frozen=True)
-class VisionConfig:
-    """Two eye cameras (60 degree field of view) rendering RGB images, optionally depth."""
-
-    width: int = 256
-    height: int = 256
-    depth: bool = False
-    every: int = 1          # render every k-th control step, holding the last images between
-
-    def __post_init__(self):
-        for key in ("width", "height"):
-            v = getattr(self, key)
-            if not isinstance(v, int) or not 8 <= v <= 2048:
-                raise ConfigError(f"vision: {key}={v!r}; allowed: an integer 8 to 2048 pixels")
-        if not isinstance(self.every, int) or not 1 <= self.every <= 1000:
-            raise ConfigError(f"vision: every={self.every!r}; allowed: an integer 1 to 1000")
-
-
-_SENSES = {"proprioception": ProprioceptionConfig, "vestibular": VestibularConfig,
-           "touch": TouchConfig, "vision": VisionConfig}
-_NOT_YET: dict = {}
 
 
 @dataclass(frozen=True)
@@ -172,12 +89,13 @@ class AgentConfig:
             object.__setattr__(self, key, float(v))
 
 
+_NO_FIELD = sorted(set(SENSES) - {f.name for f in fields(AgentConfig)})
+if _NO_FIELD:  # a registered sense is switched by an AgentConfig field of its name
+    raise TypeError(f"senses {_NO_FIELD} are registered but AgentConfig has no field for them")
+
+
 def _parse_sense(name: str, value):
-    if name in _NOT_YET:
-        if value in (False, None):
-            return None
-        raise ConfigError(f"{name}={value!r}: {_NOT_YET[name]}; allowed now: False")
-    cls = _SENSES[name]
+    cls = SENSES[name].config
     if value is False or value is None:
         return None
     if value is True:
@@ -196,7 +114,7 @@ def _agent_config(settings: Mapping[str, Any], where: str) -> AgentConfig:
     if unknown:
         raise ConfigError(f"{where}: unknown agent setting(s) {unknown}; allowed: {names}")
     values = dict(settings)
-    for sense in ("proprioception", "vestibular", "touch", "vision"):
+    for sense in SENSES:
         if sense in values:
             try:
                 values[sense] = _parse_sense(sense, values[sense])

@@ -7,11 +7,14 @@ per motor; muscles: two values in [0, 1] per motor), or, when expressions are on
 an expression id out of range raise ``ValueError`` naming the agent, the field and what is
 allowed. A simulation that goes unstable ends the episode for every agent with the reason in
 ``infos[agent]["instability"]``.
+
+The senses come from the registry :data:`mimo_social.senses.SENSES`: for each registered sense
+that an agent has on, a sense of its own, or one shared system for the world (the skin reads the
+contacts once for everyone, the eyes of everyone share one renderer) with a sense per agent.
 """
 
 from __future__ import annotations
 
-import importlib
 import time
 from typing import Any, Mapping, Sequence
 
@@ -22,19 +25,32 @@ from pettingzoo import ParallelEnv
 
 from ..body.actuation import MODELS as ACTUATION_MODELS
 from ..expressions.faces import EXPRESSIONS
-from ..render.gl import make_renderer
-from ..senses import Proprioception, Vestibular
+from ..render.scene import make_renderer
+from ..senses import SENSES
 from .config import ConfigError, parse_physics, resolve_agents
 from .task import Task
 from .world import World
 
 __all__ = ["MimoParallelEnv", "TIMING_KEYS"]
 
-TIMING_KEYS = ("actuation", "physics", "proprioception", "vestibular", "touch", "vision", "task",
-               "other")
+TIMING_KEYS = ("actuation", "physics", *SENSES, "task", "other")
 
 
 class MimoParallelEnv(ParallelEnv):
+    """N agents in one world doing ``task`` (PettingZoo's ParallelEnv API).
+
+    What task hooks, partners and tools may read (the public view of the env):
+
+    * ``env.world``: the compiled world (``model``, ``data``, per-agent index tables);
+    * ``env.systems``: dict sense name -> the shared system of that sense (``"touch"``: the
+      skin of every agent, ``"vision"``: the eyes of every agent), only for senses some agent
+      has on; ``env.system(name)`` returns one or raises a ValueError saying how to turn it on;
+    * ``env.controls``: per agent (index order) the motor controls applied at the last step,
+      after clipping;
+    * ``env.steps``: control steps since the last reset;
+    * ``env.agent_configs``, ``env.physics``, ``env.dt``, ``env.timing`` (seconds per
+      component, keys :data:`TIMING_KEYS`).
+    """
     metadata = {"name": "mimo_social", "render_modes": ["rgb_array"], "is_parallelizable": True}
 
     def __init__(self, task: Task, physics: Mapping[str, Any] | None = None,
@@ -71,41 +87,32 @@ class MimoParallelEnv(ParallelEnv):
     def _bind(self):
         """Actuation and senses of every agent, and the observation and action spaces.
 
-        A sense is an object with ``name`` (its timing key), ``spaces`` (observation key ->
-        space) and ``observe(model, data, out)``. A shared system (one per world, e.g. the
-        touch skin reading the contacts once for everyone) has ``name``, ``reset(model, data)``
-        and ``update(model, data)``, run once per step before the senses read.
+        Each sense of the registry is built for the agents that have it on
+        (:class:`mimo_social.senses.base.SenseEntry`); a sense with a shared system adds it to
+        ``self.systems``, run once per step before the senses read.
         """
         w = self.world
         self.actuation, self.senses = [], []
         self.systems = {}
         self._obs_spaces, self._act_spaces = {}, {}
         self._needs_substep = False
-        for i, (name, cfg, a) in enumerate(zip(self.possible_agents, self.agent_configs, w.agents)):
-            tables = w.tables[i]
-            by_name = {j.name: j for j in tables.joints}
+        for i, (cfg, a) in enumerate(zip(self.agent_configs, w.agents)):
+            by_name = {j.name: j for j in w.tables[i].joints}
             act = ACTUATION_MODELS[cfg.actuation]([by_name[n] for n in a.actuated_names],
                                                   a.actuator_ids)
             self._needs_substep |= act.needs_substep
             self.actuation.append(act)
-            senses = []
-            if cfg.proprioception:
-                senses.append(Proprioception(cfg.proprioception, a, act))
-            if cfg.vestibular:
-                senses.append(Vestibular(cfg.vestibular, a))
-            self.senses.append(senses)
-        # Senses that share one per-world system: the skin reads the contacts once for every
-        # agent; the eyes share one renderer per process.
-        for key, module, builder in (("touch", "touch", "build_touch"),
-                                     ("vision", "vision", "build_vision")):
+            self.senses.append([])
+        for key, entry in SENSES.items():
             configs = [getattr(c, key) for c in self.agent_configs]
-            if any(configs):
-                mod = importlib.import_module(f"mimo_social.senses.{module}")
-                system, per_agent = getattr(mod, builder)(w, configs)
+            if not any(configs):
+                continue
+            system, per_agent = entry.build(w, configs, self.actuation)
+            if system is not None:
                 self.systems[key] = system
-                for i, sense in enumerate(per_agent):
-                    if sense is not None:
-                        self.senses[i].append(sense)
+            for i, sense in enumerate(per_agent):
+                if sense is not None:
+                    self.senses[i].append(sense)
         for i, name in enumerate(self.possible_agents):
             obs = {}
             for sense in self.senses[i]:
@@ -113,7 +120,7 @@ class MimoParallelEnv(ParallelEnv):
             obs.update(self.task.task_spaces(self, i))
             if not obs:
                 raise ConfigError(f"{name}: every sense is off; turn on at least one of "
-                                  "proprioception, vestibular, touch, vision")
+                                  f"{', '.join(SENSES)}")
             self._obs_spaces[name] = spaces.Dict(obs)
             act = self.actuation[i]
             motors = spaces.Box(act.control_low, act.control_high, dtype=np.float32)

@@ -25,8 +25,8 @@ read-back waits for the rasterizer threads). So:
 * colours read as RGBA (a plain copy in Mesa; RGB goes through a slow per-pixel conversion)
   and split into channels with numpy.
 
-:func:`make_scene_renderer` gives a drop-in for ``mujoco.Renderer`` (``update_scene``,
-``render``, ``close``) that shares the process's GL context (used by ``env.render()``).
+:mod:`mimo_social.render.scene` gives a drop-in for ``mujoco.Renderer`` on the same shared
+context (used by ``env.render()``).
 
 All MuJoCo visual settings changed to make a context (offscreen size, quality) are restored on
 the model right after, so other renderers of the same model see the model's own settings.
@@ -46,7 +46,7 @@ import numpy as np
 from .gl import INSTALL_HINT, gl_backend, gl_context_class
 
 __all__ = ["shared_gl_context", "free_shared_gl_context", "TileRenderer", "Tile",
-           "tessellation_for", "SceneRenderer", "make_scene_renderer", "MAX_BUFFER_SIDE"]
+           "tessellation_for", "coarse_planes", "free_render_context", "MAX_BUFFER_SIDE"]
 
 MAX_BUFFER_SIDE = 4096      # tiles are packed in batches no larger than this (pixels per side)
 _GL = None                  # the process's GL context
@@ -117,7 +117,7 @@ def tessellation_for(max_side: int) -> tuple[int, int]:
     return 28, 16
 
 
-def _coarse_planes(model):
+def coarse_planes(model):
     """Set every finite plane's grid spacing (``size[2]``) to its whole size, so a new
     ``MjrContext`` bakes it as one quad instead of (2 size / size[2])^2 of them; returns the
     planes and their old spacing, to put back once the context is made. Under directional
@@ -132,7 +132,7 @@ def _coarse_planes(model):
     return planes, grid
 
 
-def _free_render_context(con) -> None:
+def free_render_context(con) -> None:
     """Free an MjrContext made on this process's shared GL context (no-op after a fork)."""
     if con is not None and _GL is not None and _GL_PID == os.getpid():
         try:
@@ -214,7 +214,7 @@ class TileRenderer:
         saved = (vis.global_.offwidth, vis.global_.offheight, vis.quality.offsamples,
                  vis.quality.numslices, vis.quality.numstacks, vis.quality.numquads,
                  vis.quality.shadowsize)
-        planes, grid = _coarse_planes(model) if self.floor_quads else (slice(0, 0), None)
+        planes, grid = coarse_planes(model) if self.floor_quads else (slice(0, 0), None)
         try:
             vis.global_.offwidth, vis.global_.offheight = self.buffer_size
             vis.quality.offsamples = 0
@@ -260,7 +260,7 @@ class TileRenderer:
         self._depth_b = np.float32(near / (far - near))
 
     def close(self):
-        _free_render_context(self._con)
+        free_render_context(self._con)
         self._con = self._scn = None
 
     def __getstate__(self):
@@ -402,93 +402,3 @@ class TileRenderer:
             if tile.depth:
                 d = self._depth_a / (depth[rows, cols] + self._depth_b)
             out[t] = (rgb, d)
-
-
-# -- a drop-in for mujoco.Renderer on the shared context (env.render) ---------------------------
-class SceneRenderer:
-    """``update_scene(data, camera)`` / ``render()`` / ``close()`` like ``mujoco.Renderer``, on
-    the process's shared GL context, with the model's own visual quality (anti-aliasing as the
-    model says) but floor planes as one quad (under directional lights: ~2.5x faster at
-    640x480, a handful of pixels differ at the far edge). Made lazily; does not pickle."""
-
-    def __init__(self, model, height: int = 240, width: int = 320, max_geom: int = 10000):
-        self._model = model
-        self._height, self._width = int(height), int(width)
-        self._max_geom = max_geom
-        self._con = None
-        self._scene = mujoco.MjvScene(model, max_geom)
-        self._scene_option = mujoco.MjvOption()
-        self._rect = mujoco.MjrRect(0, 0, self._width, self._height)
-
-    @property
-    def width(self):
-        return self._width
-
-    @property
-    def height(self):
-        return self._height
-
-    @property
-    def scene(self):
-        return self._scene
-
-    def _make(self):
-        shared_gl_context()
-        model = self._model
-        vis = model.vis.global_
-        saved = (vis.offwidth, vis.offheight)
-        planes, grid = _coarse_planes(model)
-        try:
-            vis.offwidth, vis.offheight = max(saved[0], self._width), max(saved[1], self._height)
-            self._con = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_150)
-        finally:
-            vis.offwidth, vis.offheight = saved
-            if grid is not None:
-                model.geom_size[planes, 2] = grid
-
-    def update_scene(self, data, camera=-1, scene_option=None):
-        model = self._model
-        if not isinstance(camera, mujoco.MjvCamera):
-            cam_id = camera
-            if isinstance(cam_id, str):
-                cam_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, cam_id)
-                if cam_id == -1:
-                    raise ValueError(f'the camera "{camera}" does not exist')
-            if not -1 <= cam_id < model.ncam:
-                raise ValueError(f"camera id {cam_id} out of range [-1, {model.ncam})")
-            camera = mujoco.MjvCamera()
-            if cam_id == -1:
-                camera.type = mujoco.mjtCamera.mjCAMERA_FREE
-                mujoco.mjv_defaultFreeCamera(model, camera)
-            else:
-                camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
-                camera.fixedcamid = cam_id
-        mujoco.mjv_updateScene(model, data, scene_option or self._scene_option, None, camera,
-                               mujoco.mjtCatBit.mjCAT_ALL, self._scene)
-
-    def render(self, *, out: np.ndarray | None = None) -> np.ndarray:
-        if self._con is None:
-            self._make()
-        else:
-            shared_gl_context()
-        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._con)
-        mujoco.mjr_render(self._rect, self._scene, self._con)
-        buf = np.empty((self._height, self._width, 3), np.uint8)
-        mujoco.mjr_readPixels(buf, None, self._rect, self._con)
-        img = np.flipud(buf)
-        if out is not None:
-            np.copyto(out, img)
-            return out
-        return np.ascontiguousarray(img)
-
-    def close(self):
-        _free_render_context(self._con)
-        self._con = None
-
-    def __getstate__(self):
-        raise TypeError("a SceneRenderer holds GL objects and does not pickle; make a new one")
-
-
-def make_scene_renderer(model, height: int, width: int) -> SceneRenderer:
-    """A :class:`SceneRenderer`; its GL context is made (and errors raised) on first render."""
-    return SceneRenderer(model, height, width)

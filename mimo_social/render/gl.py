@@ -11,8 +11,8 @@ was as fast as any other thread count, and ``softpipe`` is ~50x slower.
 
 Every renderer of the package shares ONE GL context per process (made on first use, in the
 process that renders): the eyes (:mod:`mimo_social.render.eye_renderer`) and ``env.render()``
-(:func:`make_renderer`). A GL context does not survive ``fork``, so subprocess vector envs must
-use the ``spawn`` or ``forkserver`` start method. When ``mujoco`` was imported before
+(:mod:`mimo_social.render.scene`). A GL context does not survive ``fork``, so subprocess vector
+envs must use the ``spawn`` or ``forkserver`` start method. When ``mujoco`` was imported before
 ``mimo_social`` (so it chose GLFW, useless without a display), :func:`gl_context_class` loads
 EGL's or OSMesa's context class when the first context is made.
 """
@@ -98,14 +98,3 @@ def gl_context_class():
                        "was chosen, and none could be loaded now (" + "; ".join(errors) + "); "
                        "set MUJOCO_GL=egl (or osmesa) before starting Python, or import "
                        f"mimo_social first; if that fails too, {INSTALL_HINT}")
-
-
-def make_renderer(model, height: int, width: int):
-    """A renderer with ``mujoco.Renderer``'s ``update_scene(data, camera)`` / ``render()`` /
-    ``close()`` on the process's shared GL context (the model's own visual quality); errors
-    explain what to install."""
-    ensure_gl_backend()
-    from .eye_renderer import make_scene_renderer, shared_gl_context
-
-    shared_gl_context()  # fail here, with the install hint, if no context can be made
-    return make_scene_renderer(model, height, width)

@@ -7,8 +7,32 @@ positive near the upper limit, negative near the lower one, 0 elsewhere.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from gymnasium import spaces
+
+from ..util.checks import ConfigError
+from .base import SenseEntry, components
+
+__all__ = ["ProprioceptionConfig", "Proprioception", "SENSE", "COMPONENTS"]
+
+COMPONENTS = ("qpos", "qvel", "torque", "limits", "actuation")
+
+
+@dataclass(frozen=True)
+class ProprioceptionConfig:
+    """Joint positions, velocities, actuator torques, limit proximity, actuation state."""
+
+    components: tuple[str, ...] = COMPONENTS
+    limit_margin_deg: float = 5.0  # a limit sensor rises from 0 to 1 over this last stretch
+
+    def __post_init__(self):
+        object.__setattr__(self, "components", components(
+            "proprioception", self.components, COMPONENTS))
+        if not 0 < self.limit_margin_deg <= 90:
+            raise ConfigError(f"proprioception: limit_margin_deg={self.limit_margin_deg} "
+                              "must be in (0, 90] degrees")
 
 
 class Proprioception:
@@ -54,3 +78,10 @@ class Proprioception:
             else:
                 out[sl] = self.actuation.observation(data)
         return out
+
+
+def _build(config: ProprioceptionConfig, world, index: int, actuation) -> Proprioception:
+    return Proprioception(config, world.agents[index], actuation)
+
+
+SENSE = SenseEntry("proprioception", ProprioceptionConfig, per_agent=_build)

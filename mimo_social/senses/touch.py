@@ -1,6 +1,6 @@
 """Touch (paper Sec. V-C): a full-body skin of force sensors on every infant, infant-to-infant too.
 
-Turn it on with ``touch=True`` or a mapping of :class:`~mimo_social.core.config.TouchConfig`
+Turn it on with ``touch=True`` or a mapping of :class:`TouchConfig`
 settings (``density``, ``response``, ``frame``, ``normal_only``, ``exclude``, ``cache``), for all
 agents or per agent (``per_agent=[...]``).
 
@@ -49,24 +49,57 @@ Infos
 For people
     :meth:`TouchSystem.view` gives per part the points, normals and forces in world coordinates;
     :func:`save_skin_png` draws one agent's skin coloured by force (paper Fig. 5b);
-    ``python -m mimo_social.senses.touch out.png`` draws a hand holding a ball.
+    ``mimo-social figure skin-hand-ball out.png`` draws a hand holding a ball
+    (:mod:`mimo_social.figures`).
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from typing import Sequence
 
 import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from ..core.config import TouchConfig
 from ..util.checks import ConfigError
+from .base import SenseEntry
 from .skin import GRID_CELL, Skin, build_skin
 
-__all__ = ["build_touch", "TouchSystem", "AgentTouch", "save_skin_png", "hand_ball_scene",
-           "save_hand_ball_png"]
+__all__ = ["TouchConfig", "build_touch", "TouchSystem", "AgentTouch", "save_skin_png", "SENSE",
+           "RESPONSES", "FRAMES"]
+
+RESPONSES = ("spread_linear", "nearest")
+FRAMES = ("body", "world")
+
+
+@dataclass(frozen=True)
+class TouchConfig:
+    """The full-body skin: sensor points over every body part, each sensing a force vector.
+
+    ``density`` multiplies the published per-part point density (spacing / sqrt(density));
+    ``exclude`` lists body parts without skin; ``response`` spreads each contact over nearby
+    points; ``frame`` is the frame of the force vectors; ``normal_only`` keeps 1 value a point.
+    """
+
+    density: float = 1.0
+    response: str = "spread_linear"
+    frame: str = "body"
+    normal_only: bool = False
+    exclude: tuple[str, ...] = ()
+    cache: bool = True
+
+    def __post_init__(self):
+        if not 0.05 <= float(self.density) <= 8.0:
+            raise ConfigError(f"touch: density={self.density}; allowed: 0.05 to 8 (a multiplier "
+                              "of the published point density)")
+        if self.response not in RESPONSES:
+            raise ConfigError(f"touch: response={self.response!r}; allowed: {list(RESPONSES)}")
+        if self.frame not in FRAMES:
+            raise ConfigError(f"touch: frame={self.frame!r}; allowed: {list(FRAMES)}")
+        object.__setattr__(self, "exclude", tuple(self.exclude))
+
 
 _SHIFT = 0.5   # a contact is looked up this many spacings outward along its normal
 _PYRAMIDAL = int(mujoco.mjtCone.mjCONE_PYRAMIDAL)
@@ -468,6 +501,9 @@ def build_touch(world, configs: Sequence[TouchConfig | None]):
     return system, senses
 
 
+SENSE = SenseEntry("touch", TouchConfig, shared=build_touch)
+
+
 # -- pictures --------------------------------------------------------------------------------
 def save_skin_png(env, agent, path, parts: Sequence[str] | None = None,
                   elev: float | None = None, azim: float | None = None,
@@ -539,88 +575,3 @@ def save_skin_png(env, agent, path, parts: Sequence[str] | None = None,
     fig.savefig(path)
     plt.close(fig)
     return str(path)
-
-
-# the right arm held forward, palm up, the hand tilted 12 degrees towards the fingertips
-# (degrees; found by minimising the palm's deviation from that pose over the arm's joints)
-HOLD_BALL_ARM = {"right_shoulder_horizontal": 95.7, "right_shoulder_abduction": 24.3,
-                 "right_shoulder_rotation": -89.7, "right_elbow": -84.2,
-                 "right_wrist_rotation": -76.9, "right_wrist_flexion": 34.7,
-                 "right_wrist_ulnar": 12.3}
-
-
-def hand_ball_scene(steps: int = 100, touch: dict | bool = True, ball_radius: float = 0.025,
-                    grip: float = -0.1, along: float = 0.015):
-    """A sitting infant holding a ball in its upturned right hand, the mitten closing over it.
-
-    Every joint but the mitten fingers is held (the arm forward, palm up: :data:`HOLD_BALL_ARM`);
-    the infant sits on the floor as one rigid body (so MuJoCo's parent-child contact filter
-    keeps the fingers from colliding with the palm). After the infant has settled, the ball
-    (``ball_radius``, 0.1 kg) is laid on the palm, ``along`` m from its centre towards the
-    fingers, and the mitten closes on it with action ``grip`` for ``steps`` control steps (the
-    ball then rests in the cup of palm, fingers and wrist). Returns the env.
-    """
-    from ..body.postures import POSTURES
-    from ..body.tables import load_body
-    from ..core.env import MimoParallelEnv
-    from ..core.task import held_posture
-    from ..tasks.free_play import FreePlay
-    from ..core.world import AgentSetup, Prop
-
-    class HoldBall(FreePlay):
-        def setup(self, i, config):
-            angles = dict(POSTURES["sitting"]["joints"])
-            angles.update(HOLD_BALL_ARM)
-            frozen = held_posture(load_body(config.hands), keep=("right_fingers",), angles=angles)
-            return AgentSetup(config, position=(0.0, 0.0), facing=(1.0, 0.0), frozen=frozen,
-                              actuated=("right_fingers",))
-
-        def props(self):
-            return [Prop("ball", "sphere", (ball_radius,), (0.5, 0.5, ball_radius), 0.1,
-                         (0.9, 0.25, 0.2, 1.0))]
-
-    env = MimoParallelEnv(HoldBall(1), touch=touch, posture="sitting", expressions=False,
-                          proprioception=False)
-    env.reset(seed=0)
-    w = env.world
-    m, d = w.model, w.data
-    a = w.agents[0]
-    name = env.agents[0]
-    rest = {name: np.zeros(1, np.float32)}
-    for _ in range(50):                                 # let the sitting infant settle
-        env.step(rest)
-    hand = m.site_bodyid[a.palm_sites[0]]
-    palm_normal = -d.xmat[hand].reshape(3, 3)[:, 1]   # the palm side of the right mitten
-    q = w.prop_qpos["ball"]
-    along_hand = d.xmat[hand].reshape(3, 3)[:, 2]
-    d.qpos[q:q + 3] = (d.site_xpos[a.palm_sites[0]] + (0.0105 + ball_radius) * palm_normal
-                       + along * along_hand)
-    d.qpos[q + 3:q + 7] = (1.0, 0.0, 0.0, 0.0)
-    mujoco.mj_forward(m, d)
-    hold = {name: np.array([grip], np.float32)}
-    for _ in range(steps):
-        env.step(hold)
-    return env
-
-
-def save_hand_ball_png(path, steps: int = 100) -> str:
-    """The paper's Fig. 5b: the skin of a hand holding a ball, coloured by force, as a PNG."""
-    env = hand_ball_scene(steps)
-    parts = ["right_lower_arm", "right_hand", "right_fingers"]
-    view = getattr(env, "unwrapped", env).system("touch").view(0)
-    total = sum(view[k]["normal_force"].sum() for k in parts)
-    w = env.world
-    ball = w.data.xpos[w.prop_bodies["ball"]]
-    radius = float(w.model.geom_size[w.model.geom("ball").id, 0])
-    side = w.data.xmat[w.model.site_bodyid[w.agents[0].palm_sites[0]]].reshape(3, 3)[:, 0]
-    out = save_skin_png(env, 0, path, parts=parts, spheres=[(ball, radius)], elev=35.0,
-                        azim=float(np.degrees(np.arctan2(side[1], side[0]))) + 35.0,
-                        title=f"right hand holding a ball (0.1 kg): {total:.2f} N normal force "
-                              "sensed")
-    env.close()
-    return out
-
-
-if __name__ == "__main__":  # pragma: no cover
-    import sys
-    print(save_hand_ball_png(sys.argv[1] if len(sys.argv) > 1 else "hand_ball_touch.png"))

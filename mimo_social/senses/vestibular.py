@@ -3,8 +3,27 @@ both in the head's frame (MuJoCo's gyro and accelerometer sensors)."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from gymnasium import spaces
+
+from .base import SenseEntry, components
+
+__all__ = ["VestibularConfig", "Vestibular", "SENSE", "COMPONENTS"]
+
+COMPONENTS = ("gyro", "accel")
+
+
+@dataclass(frozen=True)
+class VestibularConfig:
+    """Angular velocity (gyro, rad/s) and linear acceleration (accel, m/s^2) at the head centre."""
+
+    components: tuple[str, ...] = COMPONENTS
+
+    def __post_init__(self):
+        object.__setattr__(self, "components", components(
+            "vestibular", self.components, COMPONENTS))
 
 
 class Vestibular:
@@ -27,3 +46,10 @@ class Vestibular:
 
     def read(self, model, data) -> np.ndarray:
         return data.sensordata[self.idx].astype(np.float32)
+
+
+def _build(config: VestibularConfig, world, index: int, actuation) -> Vestibular:
+    return Vestibular(config, world.agents[index])
+
+
+SENSE = SenseEntry("vestibular", VestibularConfig, per_agent=_build)

@@ -13,15 +13,15 @@ One :class:`VisionSystem` per world renders every agent's eyes once per control 
 physics and before any agent observes, every ``every``-th step (``every=1``: every step; the
 images of the steps between are the last ones rendered), and at once after a reset. All eyes
 of all agents are tiles of one offscreen buffer of one GL context per process (see
-:mod:`.eye_renderer` for what makes it fast); the renderer is made lazily in the process that
-steps the env and is dropped when the env is pickled, so vector envs in worker processes work
-with the ``spawn`` / ``forkserver`` start methods (not ``fork`` after rendering).
+:mod:`mimo_social.render.eye_renderer` for what makes it fast); the renderer is made lazily in
+the process that steps the env and is dropped when the env is pickled, so vector envs in worker
+processes work with the ``spawn`` / ``forkserver`` start methods (not ``fork`` after rendering).
 
-Speed (2 cores, Mesa llvmpipe software rendering; ``python -m mimo_social.senses.vision``
-measures it, each variant of :data:`BENCH_VARIANTS` against the one before): one infant's two
-64x64 eyes every control step cost ~0.05 real s per simulated s (~0.15 ms an image, against
-~3.7 ms for a plain ``mujoco.Renderer`` per eye), two 256x256 eyes ~0.2 (~0.5 ms an image);
-images with another infant in view cost ~3x more.
+Speed (2 cores, Mesa llvmpipe software rendering; ``mimo-social bench-vision`` measures it, each
+variant of :data:`mimo_social.bench.vision_cost.BENCH_VARIANTS` against the one before): one
+infant's two 64x64 eyes every control step cost ~0.05 real s per simulated s (~0.15 ms an
+image, against ~3.7 ms for a plain ``mujoco.Renderer`` per eye), two 256x256 eyes ~0.2 (~0.5 ms
+an image); images with another infant in view cost ~3x more.
 
 Helpers: :func:`vision_system` (the system of an env), :func:`eye_images` (an agent's current
 images), :func:`render_now` (re-render after changing the state by hand, e.g. after
@@ -32,19 +32,39 @@ paper).
 
 from __future__ import annotations
 
-from pathlib import Path
+from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
 from gymnasium import spaces
 
-from ..render.png import write_png
 from ..render.eye_renderer import Tile, TileRenderer
+from ..render.png import write_png
+from ..util.checks import ConfigError
+from .base import SenseEntry
 
-__all__ = ["VisionSystem", "VisionSense", "build_vision", "vision_system", "eye_images",
-           "render_now", "anaglyph", "save_anaglyph", "write_png", "EYES"]
+__all__ = ["VisionConfig", "VisionSystem", "VisionSense", "build_vision", "vision_system",
+           "eye_images", "render_now", "anaglyph", "save_anaglyph", "write_png", "EYES", "SENSE"]
 
 EYES = ("left", "right")
+
+
+@dataclass(frozen=True)
+class VisionConfig:
+    """Two eye cameras (60 degree field of view) rendering RGB images, optionally depth."""
+
+    width: int = 256
+    height: int = 256
+    depth: bool = False
+    every: int = 1          # render every k-th control step, holding the last images between
+
+    def __post_init__(self):
+        for key in ("width", "height"):
+            v = getattr(self, key)
+            if not isinstance(v, int) or not 8 <= v <= 2048:
+                raise ConfigError(f"vision: {key}={v!r}; allowed: an integer 8 to 2048 pixels")
+        if not isinstance(self.every, int) or not 1 <= self.every <= 1000:
+            raise ConfigError(f"vision: every={self.every!r}; allowed: an integer 1 to 1000")
 
 
 class VisionSystem:
@@ -153,6 +173,9 @@ def build_vision(world, configs: Sequence):
     return system, [VisionSense(system, i, c) if c else None for i, c in enumerate(configs)]
 
 
+SENSE = SenseEntry("vision", VisionConfig, shared=build_vision)
+
+
 # -- helpers -------------------------------------------------------------------------------------
 def vision_system(env) -> VisionSystem:
     """The :class:`VisionSystem` of an env of this package (wrappers are looked through)."""
@@ -210,254 +233,3 @@ def save_anaglyph(env, agent, path, scale: int = 1) -> np.ndarray:
     big = img.repeat(scale, axis=0).repeat(scale, axis=1) if scale > 1 else img
     write_png(path, big)
     return img
-
-
-# -- benchmark -----------------------------------------------------------------------------------
-#: Per-image variants, each adding one change to the one before (``final`` is what the env uses).
-BENCH_VARIANTS = {
-    "naive": "one mujoco.Renderer per image size, update_scene + render per eye (model defaults: "
-             "4x MSAA, tessellation 28/16, floor grid 0.1 m, RGB read-back per image)",
-    "tiles": "one GL context, one MjrContext, eyes as tiles of one buffer sized to them, no MSAA, "
-             "no shadows/reflections/skybox/haze, one RGBA read-back per step",
-    "floor": "+ floor plane as one quad instead of a 0.1 m grid",
-    "tess": "+ coarse capsule/sphere tessellation (slices/stacks 12/6 up to 128 px, 16/8 up "
-            "to 320 px, 20/10 up to 640 px)",
-    "cull": "+ frustum culling of geoms outside each eye's view",
-    "final": "+ both eyes of an agent in one side-by-side stereo mjr_render",
-    "final_notex": "final with the face textures off (the cost of the 7 cube textures)",
-}
-
-
-def _bench_states(n_agents: int, n_steps: int, seed: int = 0):
-    """A world and ``n_steps`` of its qpos under gentle smooth random actions (standing)."""
-    from ..core.random_actions import smooth_random_actions
-    from ..envs import free_play_v0
-
-    env = free_play_v0.parallel_env(n_agents=n_agents)
-    env.reset(seed=seed)
-    n_motors = env.action_space(env.agents[0])["motors"].shape[0]
-    motors = [0.3 * smooth_random_actions(n_steps, n_motors, seed + i)[0] for i in range(n_agents)]
-    states = []
-    for k in range(n_steps):
-        env.step({a: {"motors": motors[i][k], "expression": 0} for i, a in enumerate(env.agents)})
-        states.append(env.world.data.qpos.copy())
-    return env, states
-
-
-def bench_images(sizes=(64, 256), agents=(1, 2), rounds: int = 5, n_states: int = 30,
-                 variants=tuple(BENCH_VARIANTS)) -> list[dict]:
-    """Milliseconds per eye image (render + read-back, two eyes per infant), per variant of
-    :data:`BENCH_VARIANTS`; the variants take turns (``rounds`` turns over ``n_states`` states
-    each) so a change of the machine's speed touches them alike. Also times ``mjv_updateScene``
-    per eye and the read-back of one 2x256x256 buffer as RGB (``mjr_readPixels``) and RGBA."""
-    import time
-
-    import mujoco
-
-    from ..render.eye_renderer import TileRenderer, shared_gl_context
-
-    out = []
-    for n in agents:
-        env, states = _bench_states(n, n_states)
-        m, d = env.world.model, env.world.data
-        cams = [int(c) for a in env.world.agents for c in a.eye_cameras]
-        heads = [a.head_material for a in env.world.agents]
-        for size in sizes:
-            tiles = [Tile(size, size) for _ in cams]
-            groups = [[2 * i, 2 * i + 1] for i in range(n)]
-            jobs = list(enumerate(cams))
-            renderers, naive = {}, None
-            for v in variants:
-                if v == "naive":
-                    naive = mujoco.Renderer(m, size, size)
-                    continue
-                kw = {"tiles": dict(tessellation=(28, 16), floor_quads=False, cull=False,
-                                    stereo=False),
-                      "floor": dict(tessellation=(28, 16), cull=False, stereo=False),
-                      "tess": dict(cull=False, stereo=False),
-                      "cull": dict(stereo=False)}.get(v, {})
-                renderers[v] = TileRenderer(tiles, groups, **kw)
-            d.qpos[:] = states[0]
-            mujoco.mj_forward(m, d)
-            for _ in range(3):  # warm up: llvmpipe compiles its shaders on first use
-                if naive is not None:
-                    naive.update_scene(d, cams[0])
-                    naive.render()
-                for r in renderers.values():
-                    r.render(m, d, jobs)
-            times = {v: [] for v in variants}
-            cpu = {v: [] for v in variants}
-            texid = m.mat_texid.copy()
-            for _ in range(rounds):
-                for v in variants:
-                    if v == "final_notex":
-                        m.mat_texid[heads] = -1
-                    t, c = 0.0, time.process_time()
-                    for q in states:
-                        d.qpos[:] = q
-                        mujoco.mj_kinematics(m, d)
-                        mujoco.mj_camlight(m, d)
-                        t0 = time.perf_counter()
-                        if v == "naive":
-                            for cam in cams:
-                                naive.update_scene(d, cam)
-                                naive.render()
-                        else:
-                            renderers[v].render(m, d, jobs)
-                        t += time.perf_counter() - t0
-                    m.mat_texid[:] = texid
-                    k = len(states) * len(cams)
-                    times[v].append(1e3 * t / k)
-                    cpu[v].append(1e3 * (time.process_time() - c) / k)
-            if naive is not None:
-                naive.close()
-            for r in renderers.values():
-                r.close()
-            for v in variants:
-                out.append({"agents": n, "size": size, "variant": v,
-                            "ms_per_image": float(np.median(times[v])),
-                            "ms_per_image_min": float(np.min(times[v])),
-                            "cpu_ms_per_image": float(np.median(cpu[v]))})
-        # scene update alone, per eye
-        scn, opt, cam = mujoco.MjvScene(m, m.ngeom + 200), mujoco.MjvOption(), mujoco.MjvCamera()
-        cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
-        t0 = time.perf_counter()
-        for q in states:
-            for c in cams:
-                cam.fixedcamid = c
-                mujoco.mjv_updateScene(m, d, opt, None, cam, mujoco.mjtCatBit.mjCAT_ALL, scn)
-        out.append({"agents": n, "variant": "mjv_updateScene",
-                    "ms_per_image": 1e3 * (time.perf_counter() - t0) / (len(states) * len(cams))})
-    # read-back alone: one 512x256 buffer
-    r = TileRenderer([Tile(256, 256), Tile(256, 256)], [[0, 1]])
-    r.render(m, d, [(0, cams[0]), (1, cams[1])])
-    shared_gl_context()
-    rect = mujoco.MjrRect(0, 0, 512, 256)
-    rgb, rgba = np.empty((256, 512, 3), np.uint8), np.empty((256, 512, 4), np.uint8)
-    import ctypes
-
-    def read_rgb():
-        mujoco.mjr_readPixels(rgb, None, rect, r._con)
-
-    def read_rgba():
-        r._read(0, 0, 512, 256, 0x1908, 0x1401, rgba.ctypes.data_as(ctypes.c_void_p))
-
-    for name, fn in (("readback_rgb_mjr_readPixels", read_rgb),
-                     ("readback_rgba_glReadPixels", read_rgba)):
-        fn()
-        t0 = time.perf_counter()
-        for _ in range(100):
-            fn()
-        out.append({"variant": name, "ms_per_2x256x256": 1e3 * (time.perf_counter() - t0) / 100})
-    r.close()
-    return out
-
-
-def bench_env(configs=None, sim_seconds: float = 5.0, seed: int = 0) -> list[dict]:
-    """Real seconds per simulated second of whole env steps (vision and total, from
-    ``env.timing`` and the wall clock), the configurations taking turns of 100 steps."""
-    import time
-
-    from ..core.random_actions import smooth_random_actions
-    from ..envs import free_play_v0
-
-    configs = configs or {
-        "1 infant, 2 x 64x64": dict(n_agents=1, vision={"width": 64, "height": 64}),
-        "1 infant, 2 x 256x256": dict(n_agents=1, vision={"width": 256, "height": 256}),
-        "2 infants, 2 x 64x64 each, all senses": dict(
-            n_agents=2, vision={"width": 64, "height": 64}, touch=True),
-    }
-    runs = {}
-    for name, kw in configs.items():
-        env = free_play_v0.parallel_env(max_steps=10 ** 9, **kw)
-        env.reset(seed=seed)
-        n_steps = int(round(sim_seconds / env.dt))
-        acts = [smooth_random_actions(n_steps, env.action_space(a)["motors"].shape[0], seed + i)
-                for i, a in enumerate(env.possible_agents)]
-        for k in env.timing:
-            env.timing[k] = 0.0
-        runs[name] = {"env": env, "acts": acts, "k": 0, "n": n_steps, "wall": 0.0}
-    while any(r["k"] < r["n"] for r in runs.values()):
-        for r in runs.values():
-            env, acts = r["env"], r["acts"]
-            stop = min(r["n"], r["k"] + 100)
-            t0 = time.perf_counter()
-            for k in range(r["k"], stop):
-                env.step({a: {"motors": acts[i][0][k], "expression": int(acts[i][1][k])}
-                          for i, a in enumerate(env.possible_agents)})
-            r["wall"] += time.perf_counter() - t0
-            r["k"] = stop
-    out = []
-    for name, r in runs.items():
-        env, sim = r["env"], r["n"] * r["env"].dt
-        out.append({"config": name, "sim_s": sim, "vision": env.timing["vision"] / sim,
-                    "total": r["wall"] / sim,
-                    **{k: v / sim for k, v in env.timing.items() if k != "vision"}})
-    return out
-
-
-def _bench_main(argv=None) -> None:
-    import argparse
-    import json
-    import os
-    import subprocess
-    import sys
-
-    p = argparse.ArgumentParser(
-        prog="python -m mimo_social.senses.vision",
-        description="Vision benchmark: ms per eye image by variant, and real s per simulated s "
-                    "of whole env steps; each backend in its own process.")
-    p.add_argument("--backends", default="egl,osmesa", help="MUJOCO_GL values to compare")
-    p.add_argument("--rounds", type=int, default=5)
-    p.add_argument("--sim-seconds", type=float, default=5.0)
-    p.add_argument("--json", default=None, help="write all results here")
-    p.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
-    args = p.parse_args(argv)
-    if args.worker:
-        res = {"images": bench_images(rounds=args.rounds),
-               "env": bench_env(sim_seconds=args.sim_seconds)}
-        print("JSON" + json.dumps(res))
-        return
-    results = {}
-    for backend in args.backends.split(","):
-        envvars = dict(os.environ, MUJOCO_GL=backend, PYOPENGL_PLATFORM=backend)
-        proc = subprocess.run([sys.executable, "-m", "mimo_social.senses.vision", "--worker",
-                               "--rounds", str(args.rounds), "--sim-seconds",
-                               str(args.sim_seconds)], env=envvars, capture_output=True,
-                              text=True)
-        line = [ln for ln in proc.stdout.splitlines() if ln.startswith("JSON")]
-        if proc.returncode or not line:
-            print(f"{backend}: failed\n{proc.stderr[-2000:]}")
-            continue
-        results[backend] = json.loads(line[0][4:])
-    print("ms per eye image (median over rounds; render + read-back):")
-    print("| variant | " + " | ".join(f"{b} {n} inf. {s}px" for b in results
-                                      for n in (1, 2) for s in (64, 256)) + " |")
-    for v in BENCH_VARIANTS:
-        cells = []
-        for b, res in results.items():
-            for n in (1, 2):
-                for s in (64, 256):
-                    x = [r for r in res["images"] if r.get("agents") == n
-                         and r.get("size") == s and r["variant"] == v]
-                    cells.append(f"{x[0]['ms_per_image']:.3f}" if x else "-")
-        print(f"| {v} | " + " | ".join(cells) + " |")
-    for b, res in results.items():
-        extra = [r for r in res["images"] if "size" not in r]
-        parts = []
-        for r in extra:
-            who = f" ({r['agents']} inf.)" if "agents" in r else ""
-            ms = r.get("ms_per_image", r.get("ms_per_2x256x256"))
-            parts.append(f"{r['variant']}{who}: {ms:.3f} ms")
-        print(b, "; ".join(parts))
-    print("\nreal s per simulated s (whole env steps):")
-    for b, res in results.items():
-        for r in res["env"]:
-            print(f"{b} | {r['config']} | vision {r['vision']:.4f} | total {r['total']:.4f} | "
-                  f"physics {r['physics']:.4f} | touch {r.get('touch', 0):.4f}")
-    if args.json:
-        Path(args.json).write_text(json.dumps(results, indent=1))
-
-
-if __name__ == "__main__":
-    _bench_main()

@@ -1,0 +1,48 @@
+"""``mimo-social bench-vision``: what the eyes cost, per OpenGL backend, each in its own process.
+
+Prints milliseconds per eye image for each variant of
+:data:`mimo_social.bench.vision_cost.BENCH_VARIANTS` and real seconds per simulated second of
+whole env steps with vision; ``--json`` keeps all results.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from ..bench import vision_cost
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "bench-vision", help="vision benchmark: ms per eye image by variant, env steps",
+        description="Vision benchmark: ms per eye image by variant, and real s per simulated s "
+                    "of whole env steps; each backend in its own process.")
+    parser.add_argument("--backends", default="egl,osmesa", help="MUJOCO_GL values to compare")
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--sim-seconds", type=float, default=5.0)
+    parser.add_argument("--json", default=None, help="write all results here")
+    parser.add_argument("--worker", action="store_true",
+                        help="measure in this process only and print one JSON line")
+    parser.set_defaults(func=run)
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.worker:
+        print("JSON" + json.dumps(vision_cost.measure(args.rounds, args.sim_seconds)))
+        return 0
+    results = {}
+    for backend in args.backends.split(","):
+        try:
+            results[backend] = vision_cost.measure_backend(backend, args.rounds,
+                                                           args.sim_seconds)
+        except RuntimeError as e:
+            print(e)
+    print(vision_cost.format_results(results))
+    if args.json:
+        Path(args.json).write_text(json.dumps(results, indent=1))
+    return 0
