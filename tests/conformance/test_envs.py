@@ -194,7 +194,7 @@ def test_render_rgb_array(entry, form):
     env.step(_actions(env, 1, seed=0)[0])
     image = env.render()
     assert isinstance(image, np.ndarray) and image.dtype == np.uint8 and image.shape == (48, 64, 3)
-    assert image.std() > 0                       # a scene, not a blank frame
+    assert image.std() > 5                       # a scene, not a blank frame
     env.close()
     assert entry.parallel_env().render() is None  # no render_mode: nothing drawn
 
