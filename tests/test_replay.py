@@ -1,8 +1,7 @@
-"""Rerun recordings (`mimo_social.recording.recorder`) and the `demo` subcommand, checked by reading the .rrd
+"""Rerun recordings (`mimo_social.recording`) and the `demo` subcommand, checked by reading the .rrd
 files back with Rerun's own reader (`rerun.chunk.RrdReader`)."""
 
 import argparse
-import importlib.util
 import shutil
 import subprocess
 import warnings
@@ -15,11 +14,11 @@ import pytest
 import rerun.blueprint as rrb
 from rerun.chunk import RrdReader
 
+from mimo_social.cli import demo as demo_cli
 from mimo_social.experiments import demo
 from mimo_social.envs import free_play_v0
 from mimo_social.expressions.faces import EXPRESSIONS, face_image
-from mimo_social.recording.recorder import (HIDDEN_GEOM_GROUP, SKIN_POINT_RADIUS, Recorder,
-                                            record_episode)
+from mimo_social.recording import HIDDEN_GEOM_GROUP, SKIN_POINT_RADIUS, Recorder, record_episode
 
 N_STEPS = 50
 CHANGE_STEP = 20          # infant_1 turns happy at this step (1-based env.step count)
@@ -317,26 +316,26 @@ def test_single_agent_adapter(tmp_path):
 
 def test_demo_parser_defaults():
     parser = argparse.ArgumentParser()
-    demo.add_parser(parser.add_subparsers(dest="command"))
+    demo_cli.add_parser(parser.add_subparsers(dest="command"))
     args = parser.parse_args(["demo"])
     assert (args.record, args.seconds, args.n_agents, args.seed) == (
         "recordings/demo.rrd", 10.0, 2, 0)
-    assert args.func is demo.run
+    assert args.func is demo_cli.run
 
 
 def test_demo_noise_is_smooth_and_seeded():
-    a = demo.SmoothNoise(44, 0.01, np.random.default_rng(3))
-    b = demo.SmoothNoise(44, 0.01, np.random.default_rng(3))
-    xs = np.array([a() for _ in range(2000)])
-    np.testing.assert_array_equal(xs[-1], [b() for _ in range(2000)][-1])
+    env = free_play_v0.parallel_env(n_agents=1)
+    a = demo.demo_actions(env, 2000, 3)
+    b = demo.demo_actions(env, 2000, 3)
+    env.close()
+    xs = np.array([x["infant_0"]["motors"] for x in a])
+    np.testing.assert_array_equal(xs[-1], b[-1]["infant_0"]["motors"])
     assert 0.25 < xs[500:].std() < 0.6                      # moves over the whole range ...
     steps = np.abs(np.diff(xs, axis=0))
     assert steps.mean() < 0.02 and steps.max() < 0.1        # ... without jumping
 
 
 def test_demo_subcommand_writes_a_readable_recording(tmp_path, capsys):
-    if importlib.util.find_spec("mimo_social.bench.suite") is None:
-        pytest.skip("mimo_social.cli also needs mimo_social.bench.suite, which is not there yet")
     from mimo_social.cli import main
 
     path = tmp_path / "sub" / "demo.rrd"
@@ -583,7 +582,7 @@ def touch_episode(tmp_path_factory):
 
 
 def test_skin_points_with_force_every_step_in_world_coordinates(touch_episode):
-    from mimo_social.recording.recorder import force_colors
+    from mimo_social.recording import force_colors
 
     data, views = touch_episode["data"], touch_episode["views"]
     for agent, view in views.items():
@@ -611,7 +610,7 @@ def test_skin_points_with_force_every_step_in_world_coordinates(touch_episode):
 
 
 def test_force_colours_go_from_yellow_to_dark_red():
-    from mimo_social.recording.recorder import force_colors
+    from mimo_social.recording import force_colors
 
     colors = force_colors(np.array([0.0, 0.1, 1.0, 100.0]))
     rgb = [[(int(c) >> s) & 0xFF for s in (24, 16, 8, 0)] for c in colors]
@@ -725,7 +724,7 @@ def hip_steps(path) -> list[int]:
 def test_recording_wrapper_records_every_kth_episode_and_pickles(tmp_path):
     import pickle
 
-    from mimo_social.recording.recorder import RecordingParallelEnv
+    from mimo_social.recording import RecordingParallelEnv
 
     env = RecordingParallelEnv(free_play_v0.parallel_env(n_agents=2, max_steps=4),
                                tmp_path / "ep{episode:02d}.rrd", every_k_episodes=2)
@@ -769,7 +768,7 @@ def test_vector_env_records_every_kth_episode_of_sub_env_0_only(tmp_path, n_cpus
     pytest.importorskip("stable_baselines3")
     pytest.importorskip("supersuit")
     from mimo_social.train.vector import sb3_vec_env
-    from mimo_social.recording.recorder import recording_env_fn
+    from mimo_social.recording import recording_env_fn
 
     env_fn = recording_env_fn(_high_five_short, str(tmp_path / "ep{episode:03d}.rrd"),
                               every_k_episodes=2)
@@ -798,7 +797,7 @@ import os, signal, sys
 import numpy as np
 import mimo_social
 from mimo_social.envs import free_play_v0
-from mimo_social.recording.recorder import Recorder
+from mimo_social.recording import Recorder
 
 env = free_play_v0.parallel_env(n_agents=2, max_steps=10**9)
 obs, _ = env.reset(seed=0)

@@ -12,7 +12,7 @@ from rerun.chunk import RrdReader
 from mimo_social import cli
 from mimo_social.cli import replay as replay_cli
 from mimo_social.envs import free_play_v0, high_five_v0
-from mimo_social.recording.recorder import Recorder
+from mimo_social.recording import Recorder, summarize
 
 N_STEPS = 90
 
@@ -87,7 +87,7 @@ def test_summary_says_what_the_file_holds(high_five_file, capsys):
 
 
 def test_summary_dict(high_five_file):
-    s = replay_cli.summarize(high_five_file["path"])
+    s = summarize(high_five_file["path"])
     assert s["agents"] == ["infant_0", "infant_1"] and s["complete"]
     assert (s["steps"], s["pose_rows"], s["pose_rows_per_body"]) == (
         N_STEPS + 1, N_STEPS + 1, [N_STEPS + 1])
@@ -195,3 +195,17 @@ def test_command_line_end_to_end(high_five_file):
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert f"steps: {N_STEPS + 1}" in done.stdout
+
+
+def test_bench_recording_subcommand_measures_chosen_configurations(tmp_path, capsys):
+    from mimo_social.cli import bench_recording
+
+    assert bench_recording in cli.SUBCOMMANDS
+    assert cli.main(["bench-recording", "--sim-seconds", "0.2", "--only", "0",
+                     "--folder", str(tmp_path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 3 and lines[0].startswith("| configuration |")
+    assert lines[2].startswith("| 2 infants, no images |")
+    assert (tmp_path / "bench_0.rrd").stat().st_size > 0
+    with pytest.raises(SystemExit, match="--only"):
+        cli.main(["bench-recording", "--only", "first"])

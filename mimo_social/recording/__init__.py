@@ -1,0 +1,45 @@
+"""Rerun recordings of simulations (``.rrd`` files on disk: no viewer, no network).
+
+``recorder``: :class:`Recorder`, which writes an env's steps (the layout of a recording is in
+its docstring); ``episodes``: one episode (:func:`record_episode`) or every k-th episode during
+training (:class:`RecordingParallelEnv`, :func:`recording_env_fn`); ``summary``: what a file
+holds (:func:`summarize`). The parts of a recording: ``geometry`` (geom shapes), ``faces``
+(expressions), ``eyes``, ``skin``, ``contacts``, ``blueprint`` (viewer layout), ``columns``
+(Arrow columns and the row buffer).
+"""
+
+from .columns import SIM_TIME, STEP
+from .contacts import CONTACTS_PATH
+from .episodes import (
+                       FIRST_VEC_WORKER,
+                       RecordingParallelEnv,
+                       RecordSubEnv,
+                       record_episode,
+                       recording_env_fn,
+)
+from .eyes import EYE_FORMATS
+from .geometry import HIDDEN_GEOM_GROUP, geom_archetype, geom_rgba
+from .recorder import Recorder
+from .skin import SKIN_FORCE_RANGE, SKIN_POINT_RADIUS, force_colors
+from .summary import format_summary, summarize
+
+__all__ = [
+                       "CONTACTS_PATH",
+                       "EYE_FORMATS",
+                       "FIRST_VEC_WORKER",
+                       "HIDDEN_GEOM_GROUP",
+                       "SIM_TIME",
+                       "SKIN_FORCE_RANGE",
+                       "SKIN_POINT_RADIUS",
+                       "STEP",
+                       "RecordSubEnv",
+                       "Recorder",
+                       "RecordingParallelEnv",
+                       "force_colors",
+                       "format_summary",
+                       "geom_archetype",
+                       "geom_rgba",
+                       "record_episode",
+                       "recording_env_fn",
+                       "summarize",
+]
