@@ -1,0 +1,131 @@
+"""What recording costs: the share of the env's step time spent recording with
+:class:`~mimo_social.recording.Recorder`, and the file's size per simulated minute.
+
+``mimo-social bench-recording`` runs it (:mod:`mimo_social.cli.bench_recording`); the numbers go
+to BENCHMARKS.md and the recorder's docstring.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from collections.abc import Mapping
+from pathlib import Path
+
+from ..core.random_actions import smooth_random_actions
+from ..envs import free_play_v0
+from ..recording import Recorder
+
+__all__ = ["BENCH_CONFIGS", "bench_recording", "format_table"]
+
+#: the configurations of :func:`bench_recording`: env keyword arguments of ``free_play_v0``
+BENCH_CONFIGS = {
+    "2 infants, no images": {"n_agents": 2},
+    "2 infants, touch (skin points)": {"n_agents": 2, "touch": True},
+    "2 infants, 2 x 64x64 eyes each": {"n_agents": 2, "vision": {"width": 64, "height": 64}},
+}
+
+
+def _render_threads_cpu() -> float:
+    """CPU seconds so far of Mesa's rendering threads (``llvmpipe-*``) of this process (Linux;
+    else 0)."""
+    total = 0
+    try:
+        tasks = os.listdir("/proc/self/task")
+    except OSError:
+        return 0.0
+    for tid in tasks:
+        try:
+            with open(f"/proc/self/task/{tid}/comm") as f:
+                if not f.read().startswith("llvmpipe"):
+                    continue
+            with open(f"/proc/self/task/{tid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            total += int(fields[11]) + int(fields[12])      # utime + stime, in clock ticks
+        except (OSError, ValueError, IndexError):
+            continue
+    return total / os.sysconf("SC_CLK_TCK")
+
+
+def bench_recording(configs: Mapping[str, dict] | None = None, sim_seconds: float = 60.0,
+                    block: int = 100, seed: int = 0, folder: str | Path | None = None,
+                    **recorder_options) -> list[dict]:
+    """Cost and file size of recording, per configuration (default :data:`BENCH_CONFIGS`).
+
+    Two envs of a configuration take the same smooth random actions (with expressions switching
+    about every second), in alternating blocks of ``block`` steps: one plain, one recorded (its
+    observations go to :meth:`~mimo_social.recording.Recorder.log_step`). The recording's cost
+    is given as a share of the plain env's step time, three ways:
+
+    * ``cpu_pct``: CPU time, the main thread's (env + recorder) plus Rerun's own threads
+      (encoding, compressing, writing: the process's CPU time less the main thread's and Mesa's
+      rendering threads', read from ``/proc``), against the plain env's main-thread CPU time;
+      the most stable figure on a busy machine, and the whole price on one core;
+    * ``main_cpu_pct``: the main thread's CPU time alone (what stepping feels while Rerun's
+      threads have another core);
+    * ``wall_pct``: wall clock, which on a loaded machine also holds waiting for a core.
+
+    Also the wall-clock ms per step of both and the file's size in MB per simulated minute.
+    """
+    configs = BENCH_CONFIGS if configs is None else configs
+    folder = Path(folder) if folder is not None else Path(tempfile.mkdtemp(prefix="mimo_rec_"))
+    out = []
+    for k, (name, kwargs) in enumerate(configs.items()):
+        envs = [free_play_v0.parallel_env(max_steps=10 ** 9, **kwargs) for _ in range(2)]
+        n_steps = round(sim_seconds / envs[0].dt)
+        agents = envs[0].possible_agents
+        acts = [smooth_random_actions(n_steps, envs[0].action_space(a)["motors"].shape[0],
+                                      seed + i) for i, a in enumerate(agents)]
+        path = folder / f"bench_{k}.rrd"
+        obs = [env.reset(seed=seed)[0] for env in envs]
+        rec = Recorder(envs[1], path, **recorder_options)
+        rec.log_reset(obs[1])
+        wall, cpu = [0.0, 0.0], [0.0, 0.0]
+        process0, main0, render0 = time.process_time(), time.thread_time(), _render_threads_cpu()
+        for start in range(0, n_steps, block):
+            for e, env in enumerate(envs):
+                t0, c0 = time.perf_counter(), time.thread_time()
+                for s in range(start, min(n_steps, start + block)):
+                    actions = {a: {"motors": acts[i][0][s], "expression": int(acts[i][1][s])}
+                               for i, a in enumerate(agents)}
+                    o, rewards, _, _, _ = env.step(actions)
+                    if e == 1:
+                        rec.log_step(actions, rewards, o)
+                wall[e] += time.perf_counter() - t0
+                cpu[e] += time.thread_time() - c0
+        render = _render_threads_cpu() - render0
+        t0, c0 = time.perf_counter(), time.thread_time()
+        rec.close()
+        wall[1] += time.perf_counter() - t0
+        cpu[1] += time.thread_time() - c0
+        # every thread but the main one and the renderer's: Rerun's (they end at close, so
+        # they are counted through the process's total, which keeps the time of ended threads)
+        other_threads = max(0.0, time.process_time() - process0 - (time.thread_time() - main0)
+                            - render)
+        for env in envs:
+            env.close()
+        size = path.stat().st_size
+        minutes = n_steps * envs[0].dt / 60.0
+        out.append({"config": name, "steps": n_steps, "sim_s": n_steps * envs[0].dt,
+                    "ms_per_step": 1e3 * wall[0] / n_steps,
+                    "ms_per_step_recorded": 1e3 * wall[1] / n_steps,
+                    "cpu_pct": 100.0 * (cpu[1] + other_threads - cpu[0]) / cpu[0],
+                    "main_cpu_pct": 100.0 * (cpu[1] - cpu[0]) / cpu[0],
+                    "wall_pct": 100.0 * (wall[1] - wall[0]) / wall[0],
+                    "in_recorder_pct": 100.0 * rec.overhead_s / wall[0],
+                    "mb_per_sim_minute": size / 1e6 / minutes, "file_mb": size / 1e6,
+                    "rerun_threads_cpu_s": other_threads, "eye_frames": rec.eye_frames,
+                    "path": str(path)})
+    return out
+
+
+def format_table(results: list[dict]) -> str:
+    """The results of :func:`bench_recording` as a Markdown table."""
+    header = ("| configuration | ms/step plain | ms/step recorded | cost: CPU (all threads) | "
+              "CPU (main thread) | wall clock | MB per sim. minute |")
+    lines = [header, "|---|---|---|---|---|---|---|"]
+    lines += [f"| {r['config']} | {r['ms_per_step']:.3f} | {r['ms_per_step_recorded']:.3f} | "
+              f"{r['cpu_pct']:.1f} % | {r['main_cpu_pct']:.1f} % | {r['wall_pct']:.1f} % | "
+              f"{r['mb_per_sim_minute']:.1f} |" for r in results]
+    return "\n".join(lines)
