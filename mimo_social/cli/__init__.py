@@ -8,12 +8,13 @@ from __future__ import annotations
 
 import argparse
 
-from ..bench import suite as bench
-from ..experiments import calibration, compliance, demo
-from ..train import runner as train
-from . import bench_vision, docs, figure, replay
+from . import train
+from . import bench, bench_vision, calibrate, compliance, demo, figure, replay
+from . import docs
+from . import bench_recording
 
-SUBCOMMANDS = (demo, bench, calibration, compliance, replay, train, docs, bench_vision, figure)
+SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, bench_vision, figure, docs,
+               bench_recording)
 
 
 def build_parser() -> argparse.ArgumentParser:

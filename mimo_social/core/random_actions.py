@@ -58,8 +58,9 @@ def to_bounds(motors: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarr
     return np.clip(out, low, high).astype(np.float32)
 
 
-def random_action_block(env, n_steps: int, seed: int) -> list[dict]:
-    """Every action dict of the run, built before timing (agent i always gets stream i)."""
+def random_action_block(env, n_steps: int, seed: int, **options) -> list[dict]:
+    """Every action dict of the run, built before timing (agent i always gets stream i);
+    ``options`` (``tau``, ``expression_period``) go to :func:`smooth_random_actions`."""
     from gymnasium import spaces
 
     per_agent = []
@@ -69,7 +70,7 @@ def random_action_block(env, n_steps: int, seed: int) -> list[dict]:
         box = space["motors"] if with_expr else space
         n_expr = space["expression"].n if with_expr else 7
         motors, expr = smooth_random_actions(n_steps, box.shape[0], s, env.dt,
-                                             n_expressions=n_expr)
+                                             n_expressions=n_expr, **options)
         motors = to_bounds(motors, box.low, box.high)
         per_agent.append((name, with_expr, motors, expr))
     block = []

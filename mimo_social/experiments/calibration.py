@@ -24,14 +24,13 @@ new value per axis.
 one infant, each hand version (:func:`measure_speed`).
 
 From Python: :func:`calibrate_fmax`, :func:`measure_fmax` (one measurement run, used by the
-tests), :func:`calibrate_vmax`, :func:`measure_speed`.
+tests), :func:`calibrate_vmax`, :func:`measure_speed`; the command is
+:mod:`mimo_social.cli.calibrate`.
 """
 
 from __future__ import annotations
 
-import argparse
 import csv
-import sys
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -39,9 +38,11 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from ..core.random_actions import smooth_random_actions
+
 __all__ = ["StaticScene", "static_scene", "measure_fmax", "calibrate_fmax", "calibrate_vmax",
-           "floating_scene", "write_parameters", "measure_speed", "add_parser", "run",
-           "fmax_table", "vmax_table"]
+           "floating_scene", "write_parameters", "measure_speed", "fmax_table", "vmax_table",
+           "HAND_CHOICES", "hand_versions"]
 
 HOLD_ANGLE = 0.0          # rad, clipped into each joint's range
 PHASE_STEPS = 500         # physics steps per phase (negative, rest, positive)
@@ -285,7 +286,6 @@ def measure_speed(hands: str = "mitten", seconds: float = 20.0, seed: int = 0,
     """
     import time
 
-    from ..core.random_actions import smooth_random_actions
     from ..envs import free_play_v0
 
     out = {"hands": hands, "seconds": seconds}
@@ -363,92 +363,6 @@ def write_parameters(hands: str, updates: dict, path: Path | None = None) -> Pat
     return path
 
 
-# -- the command -----------------------------------------------------------------------------------
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    parser = subparsers.add_parser(
-        "calibrate", help="calibrate the muscle model (fmax, vmax) and print target vs achieved",
-        description=__doc__.split("\n\n")[1] if __doc__ else None)
-    which = parser.add_subparsers(dest="parameter", required=True, metavar="PARAMETER")
-    f = which.add_parser("fmax", help="maximum isometric forces: held joints, full activation, "
-                                      "achieved vs Table I torques")
-    f.add_argument("--hands", choices=HAND_CHOICES, default="both",
-                   help="body version(s) to calibrate (default: both)")
-    f.add_argument("--iterations", type=int, default=ITERATIONS,
-                   help=f"fmax updates (default: {ITERATIONS}); 0 only checks the shipped values")
-    f.add_argument("--steps", type=int, default=PHASE_STEPS,
-                   help=f"physics steps per phase (default: {PHASE_STEPS})")
-    f.add_argument("--write", action="store_true",
-                   help="store the calibrated fmax in mimo_social/body/data/<hands>_muscles.csv")
-    f.set_defaults(func=run)
-    v = which.add_parser("vmax", help="maximum contraction speeds: floating infant, bang-bang "
-                                      "muscles, peak speeds")
-    v.add_argument("--hands", choices=HAND_CHOICES, default="mitten",
-                   help="body version(s) (default: mitten)")
-    v.add_argument("--episodes", type=int, default=30, help="episodes (default: 30)")
-    v.add_argument("--seconds", type=float, default=30.0,
-                   help="simulated seconds per episode (default: 30)")
-    v.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
-    v.add_argument("--no-scale", action="store_true",
-                   help="keep the raw values (no common factor matching the knee reference)")
-    v.add_argument("--write", action="store_true",
-                   help="store the new vmax in mimo_social/body/data/<hands>_muscles.csv")
-    v.set_defaults(func=run)
-    sp = which.add_parser("speed", help="the muscle model's cost per physics step and the "
-                                        "physics-only speed of one infant")
-    sp.add_argument("--hands", choices=HAND_CHOICES, default="both",
-                    help="body version(s) (default: both)")
-    sp.add_argument("--seconds", type=float, default=20.0,
-                    help="simulated seconds per measurement (default: 20)")
-    sp.set_defaults(func=run)
-    return parser
-
-
-def _versions(hands: str) -> tuple[str, ...]:
+def hand_versions(hands: str) -> tuple[str, ...]:
+    """The body versions of a ``--hands`` choice (``"both"``: mitten and five fingers)."""
     return ("mitten", "five_fingers") if hands == "both" else (hands,)
-
-
-def run(args: argparse.Namespace) -> int:
-    out = sys.stdout
-    if args.parameter == "fmax":
-        if args.iterations < 0 or args.steps < 4:
-            raise SystemExit("mimo-social calibrate fmax: --iterations must be >= 0 and "
-                             "--steps >= 4")
-        worst = 0.0
-        for hands in _versions(args.hands):
-            res = calibrate_fmax(hands, args.iterations, args.steps)
-            print(f"\nfmax, {hands} body ({args.iterations} iterations, {args.steps} steps a "
-                  "phase, joints held at 0 deg or their nearest limit):", file=out)
-            print(fmax_table(res), file=out)
-            err = np.abs(np.r_[res["achieved_neg"] / res["target_neg"],
-                               res["achieved_pos"] / res["target_pos"]] - 1).max()
-            worst = max(worst, float(err))
-            if args.write:
-                updates = {name: (res["vmax"][k], res["fmax_neg"][k], res["fmax_pos"][k])
-                           for k, name in enumerate(res["names"])}
-                print(f"wrote {write_parameters(hands, updates)}", file=out)
-        return 0 if worst <= 0.05 else 1
-    if args.parameter == "speed":
-        if not args.seconds > 0:
-            raise SystemExit("mimo-social calibrate speed: --seconds must be positive")
-        print(f"{'body':14s} {'physics only':>22s} {'physics + muscles':>22s} "
-              f"{'muscle model':>28s}", file=out)
-        for hands in _versions(args.hands):
-            r = measure_speed(hands, args.seconds)
-            print(f"{hands:14s} {r['physics_real_per_sim']:11.4f} real s/sim s "
-                  f"{r['muscle_real_per_sim']:11.4f} real s/sim s "
-                  f"{r['muscle_ms_per_step']:8.4f} ms/physics step ({r['muscle_axes']} axes)",
-                  file=out)
-        return 0
-    # vmax
-    if args.episodes < 1 or not args.seconds > 0:
-        raise SystemExit("mimo-social calibrate vmax: --episodes must be >= 1 and --seconds > 0")
-    for hands in _versions(args.hands):
-        res = calibrate_vmax(hands, args.episodes, args.seconds, seed=args.seed,
-                             scale_to_reference=not args.no_scale)
-        print(f"\nvmax, {hands} body ({args.episodes} episodes of {args.seconds:g} s):", file=out)
-        print(vmax_table(res), file=out)
-        if args.write:
-            updates = {name: (res["vmax"][k], res["fmax_neg"][k], res["fmax_pos"][k])
-                       for k, name in enumerate(res["names"])}
-            print(f"wrote {write_parameters(hands, updates)}", file=out)
-    return 0

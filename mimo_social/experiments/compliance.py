@@ -15,20 +15,20 @@ angle and the actuation torque (actuator plus the joint's passive spring-damper)
 ``SECONDS``; for the spring-damper model the motor torque alone is drawn dashed (it stays
 constant). Higher co-contraction makes the arm stiffer: it deflects less.
 
-From Python: :func:`run_compliance` (the data) and :func:`plot_compliance` (the figure).
+From Python: :func:`run_compliance` (the data) and :func:`plot_compliance` (the figure);
+the command is :mod:`mimo_social.cli.compliance`.
 """
 
 from __future__ import annotations
 
-import argparse
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-__all__ = ["CO_CONTRACTION", "Trial", "run_trial", "run_compliance", "plot_compliance",
-           "add_parser", "run"]
+__all__ = ["CO_CONTRACTION", "SECONDS", "Trial", "run_trial", "run_compliance",
+           "plot_compliance"]
 
 SHOULDER = "right_shoulder_abduction"
 ARM_POSE_DEG = {SHOULDER: 90.0, "right_shoulder_horizontal": 0.0, "right_shoulder_rotation": 0.0,
@@ -64,7 +64,7 @@ class Trial:
 def _world(hands: str, actuation: str):
     from ..body.tables import load_body
     from ..core.config import AgentConfig, PhysicsConfig
-    from ..core.task import held_posture
+    from ..body.joint_groups import held_posture
     from ..core.world import AgentSetup, Prop, World
 
     tables = load_body(hands)
@@ -200,27 +200,3 @@ def plot_compliance(trials: list[Trial], out: str | Path) -> Path:
     fig.savefig(out, dpi=120)
     plt.close(fig)
     return out
-
-
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    parser = subparsers.add_parser(
-        "compliance", help="drop a ball on the outstretched arm; plot shoulder angle and torque",
-        description=__doc__.split("\n\n")[1])
-    parser.add_argument("--out", default="compliance.png", help="the plot (default: compliance.png)")
-    parser.add_argument("--hands", choices=("mitten", "five_fingers"), default="mitten",
-                        help="body version (default: mitten)")
-    parser.add_argument("--seconds", type=float, default=SECONDS,
-                        help=f"simulated seconds (default: {SECONDS})")
-    parser.set_defaults(func=run)
-    return parser
-
-
-def run(args: argparse.Namespace) -> int:
-    if not args.seconds > 0.3:
-        raise SystemExit(f"mimo-social compliance: --seconds {args.seconds}: must exceed 0.3")
-    trials = run_compliance(hands=args.hands, seconds=args.seconds)
-    for tr in trials:
-        print(f"{tr.label:34s} controls {np.round(tr.controls, 3)}  impact {tr.impact_time:.3f} s  "
-              f"deflection {tr.deflection_deg:.2f} deg")
-    print(f"wrote {plot_compliance(trials, args.out)}")
-    return 0
