@@ -82,10 +82,10 @@ def _step(env, actions):
 def assert_same(a, b, where="result"):
     """Nested dicts / sequences / arrays / scalars are equal, bit for bit."""
     if isinstance(a, dict):
-        assert isinstance(b, dict) and a.keys() == b.keys(), f"{where}: keys {a.keys()} != {b.keys()}"
+        assert isinstance(b, dict) and a.keys() == b.keys(), f"{where}: keys {a.keys()} != {b}"
         for k in a:
             assert_same(a[k], b[k], f"{where}[{k!r}]")
-    elif isinstance(a, (list, tuple)) and not (a and isinstance(a[0], str)):
+    elif isinstance(a, (list, tuple)):
         assert len(a) == len(b), f"{where}: lengths {len(a)} != {len(b)}"
         for k, (x, y) in enumerate(zip(a, b)):
             assert_same(x, y, f"{where}[{k}]")
