@@ -4,10 +4,10 @@ Every ``hold_s`` seconds (a time drawn uniformly from the range) it picks anothe
 random (never the same twice in a row) and turns to it with its own motors: a PD law with
 compensation of gravity, springs and any force the task applies drives its head (swivel, tilt; sideways tilt to 0) and eye
 joints (horizontal, vertical; torsion to 0) from their current angles to the angles that look at
-the target. Those angles come from the same geometry as :class:`~mimo_social.core.task.Gaze`
-(the head turns, swivel then tilt, to face the target from the neck; each eye then turns,
-horizontal then vertical, to look at it from its own centre), computed on a private copy of the
-state: the partner never writes the world's ``qpos``, so its head turn is physical (it takes
+the target. Those angles come from :class:`~mimo_social.core.kinematics.LookAt`, the geometry
+that the tasks' :class:`~mimo_social.core.kinematics.Gaze` sets directly (the head turns, swivel
+then tilt, to face the target from the neck; each eye then turns, horizontal then vertical, to
+look at it from its own centre), computed on a private copy of the state: the partner never writes the world's ``qpos``, so its head turn is physical (it takes
 about 0.3 s) and visible to whoever watches it.
 
 Targets: by default the task's toys (``env.task.toy_bodies``, a list of body ids), else a list
@@ -23,74 +23,29 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
+from ..core.kinematics import LookAt
 from .base import Partner
 from .expression import hold_range
 
 __all__ = ["GazeAtTarget", "look_angles"]
 
-HEAD = ("head_swivel", "head_tilt", "head_tilt_side")
-EYES = (("right", -1.0), ("left", 1.0))
 NEEDED = ("head_swivel", "head_tilt", "right_eye_horizontal", "right_eye_vertical",
           "left_eye_horizontal", "left_eye_vertical")
 
 
-class _LookGeometry:
-    """The joint angles that point one agent's head and eyes at a world point (Gaze's geometry).
-
-    ``joints``: the agent's joint indices (into ``joint_names``) of the head and eye joints it
-    has; ``__call__`` returns their target angles (rad, within range) in that order, computed on
-    ``scratch`` (a private ``MjData``) from the state in ``data``.
-    """
-
-    def __init__(self, world, i: int):
-        m = world.model
-        a = world.agents[i]
-        names = list(a.joint_names)
-        self.joints = np.array([names.index(n) for n in HEAD + tuple(
-            f"{s}_eye_{k}" for s, _ in EYES for k in ("horizontal", "vertical", "torsional"))
-            if n in names], dtype=np.intp)
-        self.qpos = a.qpos_adr[self.joints]
-        self.lo, self.hi = a.joint_range[self.joints, 0], a.joint_range[self.joints, 1]
-        slot = {names[k]: n for n, k in enumerate(self.joints)}
-        self.swivel, self.tilt = slot.get("head_swivel"), slot.get("head_tilt")
-        self.head_body = int(m.site_bodyid[a.head_site])
-        self.eyes = [(int(m.cam_bodyid[cam]), sign, slot.get(f"{side}_eye_horizontal"),
-                      slot.get(f"{side}_eye_vertical"))
-                     for (side, sign), cam in zip(EYES, (a.eye_cameras[0], a.eye_cameras[1]))]
-
-    def __call__(self, model, data, scratch, kind: str, obj: int) -> np.ndarray:
-        s = scratch
-        s.qpos[:] = data.qpos
-        s.qpos[self.qpos] = 0.0
-        mujoco.mj_kinematics(model, s)
-        target = (s.xpos if kind == "body" else s.site_xpos)[obj].copy()
-        q = np.zeros(len(self.joints))
-        hb = self.head_body
-        if self.swivel is not None:
-            v = s.xmat[hb].reshape(3, 3).T @ (target - s.xpos[hb])
-            q[self.swivel] = np.arctan2(v[1], v[0])
-            if self.tilt is not None:
-                q[self.tilt] = -np.arctan2(v[2], np.hypot(v[0], v[1]))
-            np.clip(q, self.lo, self.hi, out=q)
-            s.qpos[self.qpos] = q
-            mujoco.mj_kinematics(model, s)
-        R = s.xmat[hb].reshape(3, 3)
-        for body, sign, horizontal, vertical in self.eyes:
-            v = R.T @ (target - s.xpos[body])
-            if horizontal is not None:
-                q[horizontal] = sign * np.arctan2(v[1], v[0])
-            if vertical is not None:
-                q[vertical] = np.arctan2(v[2], np.hypot(v[0], v[1]))
-        return np.clip(q, self.lo, self.hi)
+def _angles(look: LookAt, model, data, scratch, kind: str, obj: int) -> np.ndarray:
+    """``look``'s angles for the state in ``data``, computed on ``scratch`` (a private MjData)."""
+    scratch.qpos[:] = data.qpos
+    return look(model, scratch, kind, obj)
 
 
 def look_angles(env, agent: str, kind: str, obj: int) -> dict[str, float]:
     """Head and eye angles (rad) that make ``agent`` look at body/site ``obj``, by joint name
     (a convenience for inspection; :class:`GazeAtTarget` keeps its geometry between steps)."""
     i = env.possible_agents.index(agent)
-    geo = _LookGeometry(env.world, i)
+    geo = LookAt(env.world, i)
     scratch = mujoco.MjData(env.world.model)
-    q = geo(env.world.model, env.world.data, scratch, kind, obj)
+    q = _angles(geo, env.world.model, env.world.data, scratch, kind, obj)
     names = env.world.agents[i].joint_names
     return {names[k]: float(v) for k, v in zip(geo.joints, q)}
 
@@ -155,7 +110,7 @@ class GazeAtTarget(Partner):
             raise ValueError(f"GazeAtTarget: {agent} has no motor on {missing}; it turns its head "
                              "and eyes with its own motors (the task must leave them actuated)")
         self._found = self._resolve_targets(env)
-        self._geo = _LookGeometry(env.world, i)
+        self._geo = LookAt(env.world, i)
         self._scratch = mujoco.MjData(env.world.model)
         act = env.actuation[i]
         names = list(a.joint_names)
@@ -189,7 +144,7 @@ class GazeAtTarget(Partner):
         w = env.world
         if self.__dict__.get("_scratch") is None:   # dropped when pickled
             self._scratch = mujoco.MjData(w.model)
-        q = self._geo(w.model, w.data, self._scratch, kind, obj)
+        q = _angles(self._geo, w.model, w.data, self._scratch, kind, obj)
         return q[self._pick]
 
     def act(self, env, agent, observation):

@@ -31,6 +31,8 @@ from typing import Mapping
 import mujoco
 import numpy as np
 
+from ..body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
+from ..core.kinematics import hand_geoms
 from ..util.checks import check_number
 from .base import Partner, zero_action
 
@@ -45,9 +47,8 @@ OFFER_POSTURE_DEG = {"right_shoulder_horizontal": 101.0, "right_shoulder_abducti
 # Open fingers: straight (0 deg) except the thumb at its rest angles; mitten: straight.
 OPEN_FINGERS_DEG = {"right_thumb_swivel": 40.0, "right_thumb_adduction": -35.0,
                     "right_fingers": 0.0}
-SHOULDER_ELBOW = ("right_shoulder_horizontal", "right_shoulder_abduction",
-                  "right_shoulder_rotation", "right_elbow")
-ARM = SHOULDER_ELBOW + ("right_wrist_rotation", "right_wrist_flexion", "right_wrist_ulnar")
+SHOULDER_ELBOW = RIGHT_SHOULDER_ELBOW
+ARM = RIGHT_SHOULDER_ELBOW + RIGHT_WRIST
 RELEASES = (None, "on_touch")
 PALMS = ("up", "forward", "posture")
 # mitten: the finger joint closes towards its lower limit (-160 deg)
@@ -272,7 +273,6 @@ class HandOffer(Partner):
             if self.prop not in w.prop_bodies:
                 raise ValueError(f"HandOffer: prop {self.prop!r} is not in this env; props: "
                                  f"{sorted(w.prop_bodies)}")
-            from ..core.task import hand_geoms
             self._object_geom = int(np.flatnonzero(m.geom_bodyid == w.prop_bodies[self.prop])[0])
             self._others = np.zeros(m.ngeom, bool)
             for j in range(len(w.agents)):

@@ -16,7 +16,6 @@ import numpy as np
 from pettingzoo import ParallelEnv
 
 from ..core.wrappers import ParallelWrapper
-
 from .base import Partner
 
 __all__ = ["ScriptedPartners"]
