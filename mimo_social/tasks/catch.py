@@ -23,19 +23,22 @@ scaled it by 40 (`task_options={"cost_weight": 40}`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import mujoco
 import numpy as np
 from gymnasium import spaces
 
+from ..body.joint_groups import GAZE_JOINTS, RIGHT_WRIST, held_posture
 from ..body.tables import load_body, subtree
+from ..core.kinematics import Gaze, hand_geoms
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
-from ..core.task import (GAZE_JOINTS, Gaze, Task, geoms_touching, hand_geoms, held_posture,
-                         parts_outside)
-from .standup import settle
+from .common import geoms_touching, parts_outside, settle
 
 ARM_DEG = {"right_shoulder_horizontal": 92.0, "right_shoulder_abduction": 44.0,
            "right_shoulder_rotation": -99.0, "right_elbow": -30.0}
-WRIST = ("right_wrist_rotation", "right_wrist_flexion", "right_wrist_ulnar")
+WRIST = RIGHT_WRIST
 WRIST_START_DEG = -65.0   # wrist rotation that turns the palm up with the arm above
 PARKED = (0.0, 1.5, 0.5)  # where the ball waits while the hand settles
 
@@ -52,19 +55,49 @@ def touch_exclude(tables) -> tuple[str, ...]:
     return parts_outside(tables, ("right_upper_arm",))
 
 
+@dataclass(frozen=True)
+class CatchOptions(TaskOptions):
+    """Ball radius and mass ranges (drawn each episode), drop height above the palm and position
+    noise (m), hold time (s), failure margins (m), rewards, muscle cost weight, settling steps."""
+
+    task = "catch"
+    radius: tuple[float, float] = (0.005, 0.025)
+    mass: tuple[float, float] = (0.05, 0.5)
+    drop_height: float = 0.09
+    position_noise: tuple[float, float, float] = (0.01, 0.01, 0.08)
+    hold_time: float = 1.0
+    drop_margin: float = 0.1
+    max_distance: float = 0.5
+    success_reward: float = 100.0
+    failure_reward: float = -100.0
+    cost_weight: float = 1.0
+    settle_steps: int = 50
+
+    def __post_init__(self):
+        self._numbers("radius", 2, 0.001, 0.1, rising=True,
+                      allowed="(low, high) metres, 0.001 <= low <= high <= 0.1")
+        self._numbers("mass", 2, 0.001, 10.0, rising=True,
+                      allowed="(low, high) kg, 0.001 <= low <= high <= 10")
+        self._number("drop_height", 0.0, 1.0)
+        self._numbers("position_noise", 3, 0.0, 0.5,
+                      allowed="(x, y, z) metres, each from 0 to 0.5")
+        self._number("hold_time", 0.0, 60.0)
+        self._number("drop_margin", 0.0, 2.0)
+        self._number("max_distance", 0.0, 5.0)
+        self._number("success_reward")
+        self._number("failure_reward")
+        self._number("cost_weight", 0.0)
+        self._int("settle_steps", 0, 10_000)
+
+
 class Catch(Task):
     name = "catch"
     n_agents_range = (1, 1)
     default_n_agents = 1
     default_max_steps = 800
+    Options = CatchOptions
 
-    def option_defaults(self) -> dict:
-        return {"radius": (0.005, 0.025), "mass": (0.05, 0.5), "drop_height": 0.09,
-                "position_noise": (0.01, 0.01, 0.08), "hold_time": 1.0, "drop_margin": 0.1,
-                "max_distance": 0.5, "success_reward": 100.0, "failure_reward": -100.0,
-                "cost_weight": 1.0, "settle_steps": 50}
-
-    def agent_defaults(self, i):
+    def agent_defaults(self, i, settings):
         tables = load_body("five_fingers")
         return {"hands": "five_fingers", "actuation": "muscle", "posture": "standing",
                 "vestibular": False, "expressions": False,
@@ -81,8 +114,8 @@ class Catch(Task):
                           base="fixed", actuated=joints, gaze_joints=GAZE_JOINTS)
 
     def props(self):
-        hi = float(self.options["radius"][1])
-        return [Prop("ball", "sphere", (hi,), PARKED, float(self.options["mass"][1]),
+        o = self.options
+        return [Prop("ball", "sphere", (o.radius[1],), PARKED, o.mass[1],
                      (0.95, 0.55, 0.15, 1.0))]
 
     def task_spaces(self, env, i):
@@ -132,20 +165,19 @@ class Catch(Task):
     def reset(self, env, rng):
         if getattr(self, "_world", None) is not env.world:
             self._bind(env)
-        w = env.world
-        m, d = w.model, w.data
+        d = env.world.data
         o = self.options
         d.qpos[self._wrist_q] = self._wrist_start
         self.place_ball(env, PARKED)
-        settle(env, int(o["settle_steps"]), gravity=False)
-        r = rng.uniform(*o["radius"])
-        self.set_ball(env, r, rng.uniform(*o["mass"]))
+        settle(env, o.settle_steps, gravity=False)
+        r = rng.uniform(*o.radius)
+        self.set_ball(env, r, rng.uniform(*o.mass))
         palm = d.site_xpos[self._palm].copy()
-        noise = rng.uniform(-1.0, 1.0, 3) * np.asarray(o["position_noise"], float)
-        height = r + self._half_thickness + float(o["drop_height"])
+        noise = rng.uniform(-1.0, 1.0, 3) * np.asarray(o.position_noise)
+        height = r + self._half_thickness + o.drop_height
         self.place_ball(env, palm + np.array([0.0, 0.0, height]) + noise)
         self._held = 0
-        self._hold_steps = max(1, int(round(float(o["hold_time"]) / env.dt)))
+        self._hold_steps = max(1, int(round(o.hold_time / env.dt)))
         self._success = self._dropped = False
         self._n_touch = 0
         self._size = np.array([self._radius], np.float32)
@@ -175,15 +207,15 @@ class Catch(Task):
         self._held = self._held + 1 if in_hand else 0
         ball = d.xpos[self._ball_body]
         palm = d.site_xpos[self._palm]
-        self._dropped = bool(ball[2] < palm[2] - float(o["drop_margin"])
-                             or np.linalg.norm(ball - palm) > float(o["max_distance"]))
+        self._dropped = bool(ball[2] < palm[2] - o.drop_margin
+                             or np.linalg.norm(ball - palm) > o.max_distance)
         self._success = not self._dropped and self._held >= self._hold_steps
         if self._dropped:
-            return np.array([float(o["failure_reward"])])
+            return np.array([o.failure_reward])
         if self._success:
-            return np.array([float(o["success_reward"])])
+            return np.array([o.success_reward])
         cost = env.actuation[0].weighted_cost(env.controls[0])
-        return np.array([self._n_touch - float(o["cost_weight"]) * cost])
+        return np.array([self._n_touch - o.cost_weight * cost])
 
     def terminations(self, env):
         return (np.array([self._success or self._dropped]),

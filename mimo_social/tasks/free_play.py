@@ -20,20 +20,31 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+from ..core.task import Task, TaskOptions
 from ..core.world import Prop
-from ..core.task import Task
+
+
+@dataclass(frozen=True)
+class FreePlayOptions(TaskOptions):
+    """``props``: a ball and a cube lie between the infants."""
+
+    task = "free_play"
+    props: bool = False
+
+    def __post_init__(self):
+        self._bool("props")
 
 
 class FreePlay(Task):
     name = "free_play"
     default_n_agents = 2
     default_max_steps = 1000
-
-    def option_defaults(self) -> dict:
-        return {"props": False}
+    Options = FreePlayOptions
 
     def props(self):
-        if not self.options["props"]:
+        if not self.options.props:
             return []
         return [Prop("ball", "sphere", (0.04,), (0.08, 0.12, 0.04), 0.1, (0.9, 0.25, 0.2, 1)),
                 Prop("cube", "box", (0.03, 0.03, 0.03), (-0.08, -0.12, 0.03), 0.1,

@@ -23,15 +23,19 @@ arm sinks under gravity and the ball falls (a failure) within half a second.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import mujoco
 import numpy as np
 
+from ..body.joint_groups import GAZE_JOINTS, held_posture, right_arm_joints
 from ..body.tables import load_body
-from ..partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
+from ..core.kinematics import Gaze, hand_geoms
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
-from ..util.checks import check_number
-from ..core.task import (GAZE_JOINTS, Gaze, Task, geoms_touching, hand_geoms,
-                         held_posture, parts_outside, right_arm_joints)
+from ..partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
+from ..util.checks import ConfigError
+from .common import geoms_touching, parts_outside
 
 RECEIVER, GIVER = 0, 1
 PARKED = (0.2, 1.5, 0.5)             # where the ball is built (the reset moves it to the palm)
@@ -45,8 +49,54 @@ def arms_only_touch(tables) -> dict:
             "exclude": parts_outside(tables, ("right_upper_arm", "left_upper_arm"))}
 
 
-def _check_number(name, value, lo, hi):
-    return check_number("handover", f"task option {name}", value, lo, hi)
+@dataclass(frozen=True)
+class HandoverOptions(TaskOptions):
+    """Distance (m), ball radius (m) and mass (kg), hold time (s), receiver segments needed,
+    drop height (m), rewards, giver settling time (s), receiver arm noise (deg), the giver's
+    offer target (m from its right shoulder: forward, left, up), and whether success ends the
+    episode and a drop is charged the remaining steps."""
+
+    task = "handover"
+    distance: float = 0.34
+    ball_radius: float = 0.03
+    ball_mass: float = 0.03
+    hold_time: float = 0.3
+    min_parts: int = 2
+    drop_height: float = 0.25
+    success_reward: float = 10.0
+    failure_reward: float = -1.0
+    settle_time: float = 0.3
+    arm_noise: float = 10.0
+    offer_target: tuple[float, float, float] | None = OFFER_TARGET
+    end_on_success: bool = True
+    charge_remaining: bool = True
+
+    def __post_init__(self):
+        self._number("distance", 0.3, 0.8)
+        self._number("ball_radius", 0.015, 0.045)
+        self._number("ball_mass", 0.005, 0.3)
+        self._number("hold_time", 0.0, 5.0)
+        self._int("min_parts", 1, 10)
+        self._number("drop_height", 0.0, 0.5)
+        self._number("success_reward", -1e6, 1e6)
+        self._number("failure_reward", -1e6, 1e6)
+        self._number("settle_time", 0.0, 2.0)
+        self._number("arm_noise", 0.0, 45.0)
+        self._bool("end_on_success")
+        self._bool("charge_remaining")
+        t = self.offer_target
+        if t is not None:
+            arr = np.zeros(0)
+            if not isinstance(t, (str, bytes)):
+                try:
+                    arr = np.asarray(t, dtype=float)
+                except (TypeError, ValueError):
+                    pass
+            if arr.shape != (3,) or not np.isfinite(arr).all() or np.linalg.norm(arr) > 0.5:
+                raise ConfigError(f"handover: task option offer_target={t!r} not allowed; "
+                                  "allowed: None or (forward, left, up) in metres from the "
+                                  "giver's right shoulder, within 0.5 m")
+            self._put("offer_target", tuple(float(x) for x in arr))
 
 
 class Handover(Task):
@@ -54,42 +104,10 @@ class Handover(Task):
     n_agents_range = (2, 2)
     default_n_agents = 2
     default_max_steps = 600
-
-    def option_defaults(self) -> dict:
-        return {"distance": 0.34, "ball_radius": 0.03, "ball_mass": 0.03, "hold_time": 0.3,
-                "min_parts": 2, "drop_height": 0.25, "success_reward": 10.0,
-                "failure_reward": -1.0, "settle_time": 0.3, "arm_noise": 10.0,
-                "offer_target": OFFER_TARGET, "end_on_success": True,
-                "charge_remaining": True}
-
-    LIMITS = {"distance": (0.3, 0.8), "ball_radius": (0.015, 0.045), "ball_mass": (0.005, 0.3),
-              "hold_time": (0.0, 5.0), "min_parts": (1, 10), "drop_height": (0.0, 0.5),
-              "success_reward": (-1e6, 1e6), "failure_reward": (-1e6, 1e6),
-              "settle_time": (0.0, 2.0), "arm_noise": (0.0, 45.0)}
-
-    def __init__(self, n_agents: int, **options):
-        super().__init__(n_agents, **options)
-        o = self.options
-        for k, (lo, hi) in self.LIMITS.items():
-            o[k] = _check_number(k, o[k], lo, hi)
-        if o["min_parts"] != int(o["min_parts"]):
-            raise ValueError(f"handover: task option min_parts={o['min_parts']!r}; allowed: an "
-                             "integer 1 to 10")
-        o["min_parts"] = int(o["min_parts"])
-        for key in ("end_on_success", "charge_remaining"):
-            if not isinstance(o[key], bool):
-                raise ValueError(f"handover: task option {key}={o[key]!r}; allowed: True or False")
-        t = o["offer_target"]
-        if t is not None:
-            arr = np.asarray(t, dtype=float) if not isinstance(t, str) else np.zeros(0)
-            if arr.shape != (3,) or not np.isfinite(arr).all() or np.linalg.norm(arr) > 0.5:
-                raise ValueError(f"handover: task option offer_target={t!r}; allowed: None or "
-                                 "(forward, left, up) in metres from the giver's right "
-                                 "shoulder, within 0.5 m")
-            o["offer_target"] = tuple(float(x) for x in arr)
+    Options = HandoverOptions
 
     # -- building ------------------------------------------------------------------------------
-    def agent_defaults(self, i):
+    def agent_defaults(self, i, settings):
         return {"hands": "five_fingers", "posture": "standing", "vestibular": False,
                 "expressions": False, "touch": arms_only_touch(load_body("five_fingers"))}
 
@@ -100,7 +118,7 @@ class Handover(Task):
         if config.posture != "standing":
             raise ValueError(f"handover: infant_{i}: posture={config.posture!r} not allowed; "
                              "the task places both infants standing (hip fixed)")
-        dist = float(self.options["distance"])
+        dist = self.options.distance
         pos = (0.0, 0.0) if i == RECEIVER else (dist, 0.0)
         facing = (dist, 0.0) if i == RECEIVER else (0.0, 0.0)
         tables = load_body(config.hands)
@@ -113,7 +131,7 @@ class Handover(Task):
 
     def props(self):
         o = self.options
-        return [Prop("ball", "sphere", (o["ball_radius"],), PARKED, o["ball_mass"],
+        return [Prop("ball", "sphere", (o.ball_radius,), PARKED, o.ball_mass,
                      (0.95, 0.55, 0.15, 1.0))]
 
     # -- index tables (once per world) ---------------------------------------------------------
@@ -133,7 +151,7 @@ class Handover(Task):
         r = w.agents[RECEIVER]
         self._tip = int(r.fingertip_sites[0])
         self._receiver_palm = int(r.palm_sites[0])
-        self._offer = HandOffer(target=self.options["offer_target"], release=None)
+        self._offer = HandOffer(target=self.options.offer_target, release=None)
         self._giver_palm = int(w.agents[GIVER].palm_sites[0])
         self._fingers = [self._finger_tables(w, i) for i in (RECEIVER, GIVER)]
         self._hand_body = [int(m.site_bodyid[w.agents[i].palm_sites[0]]) for i in (0, 1)]
@@ -168,7 +186,7 @@ class Handover(Task):
         d = w.data
         R = d.xmat[self._hand_body[i]].reshape(3, 3)
         normal = -R[:, 1]  # the right palm faces the hand's -y
-        r = float(self.options["ball_radius"])
+        r = self.options.ball_radius
         return (d.site_xpos[w.agents[i].palm_sites[0]]
                 + (self._half_thickness + r + 0.001) * normal + BALL_TOWARD_FINGERS * R[:, 2])
 
@@ -197,15 +215,15 @@ class Handover(Task):
         r = w.agents[RECEIVER]
         # the receiver's arm: the hanging posture, shifted at random
         k = r.actuated_joint_idx[:7]
-        noise = np.deg2rad(float(o["arm_noise"])) * rng.uniform(-1.0, 1.0, len(k))
+        noise = np.deg2rad(o.arm_noise) * rng.uniform(-1.0, 1.0, len(k))
         d.qpos[r.qpos_adr[k]] = np.clip(d.qpos[r.qpos_adr[k]] + noise, r.joint_range[k, 0],
                                         r.joint_range[k, 1])
         mujoco.mj_kinematics(m, d)
         # the giver: arm in the offer posture, the ball in its palm, fingers curled onto it
-        self.put_ball_in_hand(env, GIVER, o["offer_target"])
+        self.put_ball_in_hand(env, GIVER, o.offer_target)
         self._settle(env)
         self._held = 0
-        self._hold_steps = max(1, int(round(float(o["hold_time"]) / env.dt)))
+        self._hold_steps = max(1, int(round(o.hold_time / env.dt)))
         self._success = self._dropped = False
         self._holder = "giver"
         self._parts = 0
@@ -235,7 +253,7 @@ class Handover(Task):
         ``settle_time`` (the receiver is still); time restarts at 0."""
         w = env.world
         m, d = w.model, w.data
-        n = int(round(float(self.options["settle_time"]) / env.dt))
+        n = int(round(self.options.settle_time / env.dt))
         offer = self._offer
         giver = env.possible_agents[GIVER]
         offer.reset(env, giver, np.random.default_rng(0))
@@ -274,23 +292,23 @@ class Handover(Task):
         o = self.options
         self._parts, giver_holds = self._contacts(d)
         ball = d.xpos[self._ball_body]
-        self._dropped = bool(ball[2] < o["drop_height"])
-        receiver_holds = self._parts >= o["min_parts"] and not giver_holds
+        self._dropped = bool(ball[2] < o.drop_height)
+        receiver_holds = self._parts >= o.min_parts and not giver_holds
         self._holder = "giver" if giver_holds else "receiver" if receiver_holds else "none"
         self._held = self._held + 1 if receiver_holds and not self._dropped else 0
         self._success = self._held >= self._hold_steps
         self._distance = float(np.linalg.norm(d.site_xpos[self._tip] - ball))
         r = -self._distance
         if self._success:
-            r += o["success_reward"]
+            r += o.success_reward
         if self._dropped:
-            r += o["failure_reward"]
-            if o["charge_remaining"]:  # the rest of the episode at this distance: drops never pay
+            r += o.failure_reward
+            if o.charge_remaining:  # the rest of the episode at this distance: drops never pay
                 r -= self._distance * max(0, env.max_steps - env.steps)
         return np.array([r, r])
 
     def terminations(self, env):
-        done = self._dropped or (self._success and self.options["end_on_success"])
+        done = self._dropped or (self._success and self.options.end_on_success)
         info = {"is_success": self._success, "holder": self._holder, "dropped": self._dropped,
                 "receiver_parts": self._parts, "held_steps": self._held,
                 "distance": self._distance}

@@ -26,48 +26,32 @@ what ends the episode is what both infants perceive. The skin must cover the rig
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Sequence
 
 import mujoco
 import numpy as np
 
-from ..body.tables import HAND_VERSIONS, load_body, subtree
-from ..util.checks import ConfigError, check_bool, check_number
+from ..body.joint_groups import GAZE_JOINTS, held_posture, right_arm_joints
+from ..body.tables import HAND_VERSIONS, load_body
+from ..core.kinematics import Gaze, hand_geoms
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup
-from ..core.task import (GAZE_JOINTS, ContactProbe, Gaze, Task, face_to_face, hand_geoms,
-                         held_posture, right_arm_joints)
+from ..util.checks import ConfigError
+from .common import (
+    HAND_TOUCH_DENSITY,
+    ContactProbe,
+    face_to_face,
+    hands_setting,
+    require_skin,
+    right_hand_parts,
+    touch_only_on,
+)
 
 # 0.35 m: the right hands meet with the arms forward, half stretched; at 0.45 m (the first
 # version's distance) only the outstretched fingers meet, and PPO takes many times longer
 DISTANCE = 0.35
 DISTANCE_RANGE = (0.25, 0.6)
-# a tenth of the published point density: the right hand's skin is 232 points (25 on the palm
-# part, 207 on the fingers) for the mitten body, 1 float each (normal force)
-HAND_TOUCH_DENSITY = 0.1
-
-
-# -- skin helpers (shared with the social touch task) ------------------------------------------
-def skin_parts(tables) -> tuple[str, ...]:
-    """Every body part that has geoms, in table order (the parts a skin may cover)."""
-    parts: list[str] = []
-    for g in tables.geoms:
-        if g.body not in parts:
-            parts.append(g.body)
-    return tuple(parts)
-
-
-def right_hand_parts(tables) -> tuple[str, ...]:
-    """The right hand's body parts: ``right_hand`` and every part below it (the mitten's
-    fingers, or the five fingers' segments)."""
-    return tuple(subtree(tables, "right_hand"))
-
-
-def touch_only_on(tables, parts: Sequence[str], density: float = HAND_TOUCH_DENSITY,
-                  normal_only: bool = True) -> dict:
-    """A ``touch`` setting whose skin covers only ``parts`` (every other part is excluded)."""
-    keep = set(parts)
-    return {"density": float(density), "normal_only": bool(normal_only),
-            "exclude": tuple(p for p in skin_parts(tables) if p not in keep)}
 
 
 def hand_touch(hands: str = "mitten", density: float = HAND_TOUCH_DENSITY,
@@ -80,33 +64,6 @@ def hand_touch(hands: str = "mitten", density: float = HAND_TOUCH_DENSITY,
         raise ConfigError(f"hands={hands!r} not allowed; allowed: {list(HAND_VERSIONS)}")
     tables = load_body(hands)
     return touch_only_on(tables, right_hand_parts(tables), density, normal_only)
-
-
-def hands_of(n_agents: int, settings: Mapping[str, Any]) -> list[str]:
-    """Each agent's hand version as the env will resolve it from its keyword arguments
-    (``hands=...`` for all, ``per_agent=[{"hands": ...}, ...]``). Malformed values fall back to
-    ``"mitten"``: the env itself then raises the error that says what is allowed."""
-    common = settings.get("hands", "mitten")
-    out = [common if common in HAND_VERSIONS else "mitten"] * n_agents
-    per_agent = settings.get("per_agent")
-    if isinstance(per_agent, Sequence) and not isinstance(per_agent, (str, Mapping)) \
-            and len(per_agent) == n_agents:
-        for i, s in enumerate(per_agent):
-            if isinstance(s, Mapping) and s.get("hands") in HAND_VERSIONS:
-                out[i] = s["hands"]
-    return out
-
-
-def require_skin(task: str, agent: str, config, parts: Sequence[str], what: str) -> None:
-    """Raise a :class:`ConfigError` unless ``config.touch`` covers every part of ``parts``."""
-    if config.touch is None:
-        raise ConfigError(f"{task}: {agent} has touch=False, but the task senses {what} through "
-                          f"the skin; turn touch on (the default covers {list(parts)}, "
-                          "touch=True the whole body)")
-    missing = [p for p in parts if p in config.touch.exclude]
-    if missing:
-        raise ConfigError(f"{task}: {agent}'s touch excludes {missing}, but the task senses "
-                          f"{what} through the skin there; remove them from touch 'exclude'")
 
 
 class SkinSource:
@@ -136,31 +93,36 @@ class SkinSource:
 START_TRIES = 50   # random start postures tried until the hands touch nothing
 
 
+@dataclass(frozen=True)
+class HighFiveOptions(TaskOptions):
+    """Bonus for the felt high five, whether it ends the episode, the distance between the
+    infants (m) and the spread of the random start postures (fraction of each joint's range)."""
+
+    task = "high_five"
+    touch_bonus: float = 100.0
+    end_on_touch: bool = True
+    distance: float = DISTANCE
+    start_spread: float = 0.3
+
+    def __post_init__(self):
+        self._number("touch_bonus")
+        self._bool("end_on_touch")
+        self._number("distance", *DISTANCE_RANGE)
+        self._number("start_spread", 0.0, 1.0)
+
+
 class HighFive(Task):
     name = "high_five"
     n_agents_range = (2, 2)
     default_n_agents = 2
     default_max_steps = 500
+    Options = HighFiveOptions
 
-    def __init__(self, n_agents: int, **options):
-        super().__init__(n_agents, **options)
-        o = self.options
-        o["touch_bonus"] = check_number(self.name, "touch_bonus", o["touch_bonus"])
-        o["end_on_touch"] = check_bool(self.name, "end_on_touch", o["end_on_touch"])
-        o["distance"] = check_number(self.name, "distance", o["distance"], *DISTANCE_RANGE)
-        o["start_spread"] = check_number(self.name, "start_spread", o["start_spread"], 0.0, 1.0)
-        # the hand version of each agent, for the default skin; set by ``high_five_v0``
-        self.agent_hands: list[str] = ["mitten"] * self.n_agents
-
-    def option_defaults(self) -> dict:
-        return {"touch_bonus": 100.0, "end_on_touch": True, "distance": DISTANCE,
-                "start_spread": 0.3}
-
-    def agent_defaults(self, i):
-        return {"posture": "standing", "touch": hand_touch(self.agent_hands[i])}
+    def agent_defaults(self, i, settings):
+        return {"posture": "standing", "touch": hand_touch(hands_setting(settings))}
 
     def setup(self, i, config):
-        dist = float(self.options["distance"])
+        dist = self.options.distance
         pos, facing = face_to_face(i, dist)
         tables = load_body(config.hands)
         require_skin(self.name, f"infant_{i}", config, right_hand_parts(tables),
@@ -196,7 +158,7 @@ class HighFive(Task):
         if getattr(self, "_world", None) is not env.world:
             self._bind(env)
         m, d = env.world.model, env.world.data
-        spread = self.options["start_spread"]
+        spread = self.options.start_spread
         for _ in range(START_TRIES):  # each arm in its own random posture, the hands touching nothing
             for q, v, mid, lo, hi in self._arms:
                 u = rng.uniform(-0.5, 0.5, len(q))
@@ -224,12 +186,12 @@ class HighFive(Task):
         dist = float(np.linalg.norm(p[0] - p[1]))
         self._felt = [bool(f(d)) for f in self._feels]
         self._touching = self._felt[0] and self._felt[1] and self._hands_meet(d)
-        r = -dist + (self.options["touch_bonus"] if self._touching else 0.0)
+        r = -dist + (self.options.touch_bonus if self._touching else 0.0)
         self._distance = dist
         return np.array([r, r])
 
     def terminations(self, env):
-        done = self._touching and self.options["end_on_touch"]
+        done = self._touching and self.options.end_on_touch
         infos = [{"is_success": self._touching, "hands_touching": self._touching,
                   "hand_feels_partner": self._felt[i], "hand_distance": self._distance}
                  for i in range(2)]

@@ -27,13 +27,16 @@ attention (return / 500 is the success rate); a learner trained from scratch may
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from ..body.joint_groups import GAZE_JOINTS, held_posture
 from ..body.postures import POSTURES
 from ..body.tables import load_body
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
-from ..core.task import GAZE_JOINTS, Task, face_to_face, held_posture
-from ..util.checks import check_number
+from .common import face_to_face
 
 DISTANCE = 0.7
 EYE_SIZE = 96
@@ -42,10 +45,6 @@ TOYS = (("sphere", (0.9, 0.15, 0.15, 1.0)), ("box", (0.15, 0.35, 0.9, 1.0)),
         ("sphere", (0.95, 0.85, 0.1, 1.0)), ("box", (0.15, 0.7, 0.2, 1.0)))
 SIDE = (0.25, 0.45)          # toys this far (m) off the line between the infants
 MAX_TRIES = 500
-
-
-def _number(name, value, lo, hi):
-    return check_number("joint_attention", name, value, lo, hi)
 
 
 class GazeRays:
@@ -85,38 +84,49 @@ class GazeRays:
         return np.where(hit, best, -1), angle
 
 
+@dataclass(frozen=True)
+class JointAttentionOptions(TaskOptions):
+    """Distance between the infants (m), number of toys, the gaze margin around a toy (deg),
+    the shaping weight, the toys' least angular separation (deg), head support, and whether
+    ``infant_1`` is a scripted partner (no eyes, no reward)."""
+
+    task = "joint_attention"
+    distance: float = DISTANCE
+    n_toys: int = len(TOYS)
+    margin_deg: float = 5.0
+    shaping: float = 0.0
+    min_separation_deg: float = 25.0
+    head_support: bool = True
+    scripted_partner: bool = False
+
+    def __post_init__(self):
+        self._number("distance", 0.6, 1.5)
+        self._int("n_toys", 2, len(TOYS))
+        self._number("margin_deg", 0.0, 30.0)
+        self._number("shaping", 0.0, 100.0)
+        self._number("min_separation_deg", 0.0, 35.0)
+        self._bool("head_support")
+        self._bool("scripted_partner")
+
+
 class JointAttention(Task):
     name = "joint_attention"
     n_agents_range = (2, 2)
     default_n_agents = 2
     default_max_steps = 500
+    Options = JointAttentionOptions
 
-    def option_defaults(self) -> dict:
-        return {"distance": DISTANCE, "n_toys": len(TOYS), "margin_deg": 5.0, "shaping": 0.0,
-                "min_separation_deg": 25.0, "head_support": True, "scripted_partner": False}
-
-    def __init__(self, n_agents: int, **options):
-        super().__init__(n_agents, **options)
-        o = self.options
-        _number("distance", o["distance"], 0.6, 1.5)
-        _number("margin_deg", o["margin_deg"], 0.0, 30.0)
-        _number("shaping", o["shaping"], 0.0, 100.0)
-        _number("min_separation_deg", o["min_separation_deg"], 0.0, 35.0)
-        n = o["n_toys"]
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 2 <= n <= len(TOYS):
-            raise ValueError(f"joint_attention: n_toys={n!r}; allowed: an integer 2 to {len(TOYS)}")
-        for key in ("scripted_partner", "head_support"):
-            if not isinstance(o[key], bool):
-                raise ValueError(f"joint_attention: {key}={o[key]!r}; allowed: True or False")
+    def __init__(self, n_agents: int, options=None, /, **values):
+        super().__init__(n_agents, options, **values)
         self.toy_bodies: np.ndarray | None = None   # body ids of the toys, set at the first reset
 
-    def agent_defaults(self, i):
-        scripted = i == 1 and self.options["scripted_partner"]
+    def agent_defaults(self, i, settings):
+        scripted = i == 1 and self.options.scripted_partner
         return {"posture": "sitting", "expressions": False, "vestibular": False,
                 "vision": False if scripted else {"width": EYE_SIZE, "height": EYE_SIZE}}
 
     def setup(self, i, config):
-        dist = float(self.options["distance"])
+        dist = self.options.distance
         pos, facing = face_to_face(i, dist)
         tables = load_body(config.hands)
         frozen = held_posture(tables, keep=GAZE_JOINTS, angles=POSTURES["sitting"]["joints"])
@@ -125,7 +135,7 @@ class JointAttention(Task):
 
     def props(self):
         out = []
-        for k in range(self.options["n_toys"]):
+        for k in range(self.options.n_toys):
             shape, rgba = TOYS[k]
             size = (TOY_SIZE,) if shape == "sphere" else (TOY_SIZE * 0.85,) * 3
             out.append(Prop(f"toy_{k}", shape, size, (0.35, 1.0 + 0.2 * k, TOY_SIZE), 0.05, rgba))
@@ -136,12 +146,12 @@ class JointAttention(Task):
         w = env.world
         d = w.data
         if self.toy_bodies is None:
-            n = self.options["n_toys"]
+            n = self.options.n_toys
             self.toy_bodies = np.array([w.prop_bodies[f"toy_{k}"] for k in range(n)], np.intp)
             self._toy_qpos = [w.prop_qpos[f"toy_{k}"] for k in range(n)]
-            self._rays = GazeRays(w, self.toy_bodies, TOY_SIZE, self.options["margin_deg"])
+            self._rays = GazeRays(w, self.toy_bodies, TOY_SIZE, self.options.margin_deg)
             self._heads = np.array([d.site_xpos[a.head_site] for a in w.agents])
-            self._weights = np.array([1.0, 0.0 if self.options["scripted_partner"] else 1.0])
+            self._weights = np.array([1.0, 0.0 if self.options.scripted_partner else 1.0])
             self._head_dofs = np.concatenate([a.dof_adr[a.actuated_joint_idx] for a in w.agents])
         for k, xy in enumerate(self._place_toys(rng)):
             q = self._toy_qpos[k]
@@ -154,9 +164,9 @@ class JointAttention(Task):
     def _place_toys(self, rng) -> list[np.ndarray]:
         """Toy positions (x, y): beside the pair (left and right alternate, so both sides hold
         toys), each at least ``min_separation_deg`` from the others seen from either head."""
-        dist = float(self.options["distance"])
-        sep = np.deg2rad(self.options["min_separation_deg"])
-        n = self.options["n_toys"]
+        dist = self.options.distance
+        sep = np.deg2rad(self.options.min_separation_deg)
+        n = self.options.n_toys
         for _ in range(MAX_TRIES):   # whole layouts: an early toy may leave no room for a later
             first_side = rng.choice([-1.0, 1.0])
             placed: list[np.ndarray] = []
@@ -187,7 +197,7 @@ class JointAttention(Task):
         """Head support: the head and eye joints' generalised gravity (and Coriolis) force of
         the last physics step is applied to them, as neck tone would, so a zero action holds
         the head where it is (springs and damping still pull it toward rest)."""
-        if self.options["head_support"]:
+        if self.options.head_support:
             d = env.world.data
             d.qfrc_applied[self._head_dofs] = d.qfrc_bias[self._head_dofs]
 
@@ -196,7 +206,7 @@ class JointAttention(Task):
         self._looked, self._angle = looked, angle
         self._joint = bool(looked[0] >= 0 and looked[0] == looked[1])
         r = np.full(2, float(self._joint))
-        shaping = self.options["shaping"]
+        shaping = self.options.shaping
         if shaping:
             for i in range(2):
                 other = looked[1 - i]

@@ -23,14 +23,33 @@ ms): the best reactive policy loses one step per change of the partner's face.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from ..body.joint_groups import GAZE_JOINTS, held_posture
 from ..body.tables import load_body
+from ..core.kinematics import Gaze
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup
-from ..core.task import GAZE_JOINTS, Gaze, Task, face_to_face, held_posture
+from .common import face_to_face
 
 DISTANCE = 0.3
 EYE_SIZE = 64
+
+
+@dataclass(frozen=True)
+class MirrorOptions(TaskOptions):
+    """Distance between the faces (m, from 0.22: closer and the faces touch) and whether
+    ``infant_1`` is a scripted partner (no eyes, no reward)."""
+
+    task = "mirror"
+    distance: float = DISTANCE
+    scripted_partner: bool = False
+
+    def __post_init__(self):
+        self._number("distance", 0.22, 2.0)
+        self._bool("scripted_partner")
 
 
 class Mirror(Task):
@@ -38,27 +57,15 @@ class Mirror(Task):
     n_agents_range = (2, 2)
     default_n_agents = 2
     default_max_steps = 500
+    Options = MirrorOptions
 
-    def option_defaults(self) -> dict:
-        return {"distance": DISTANCE, "scripted_partner": False}
-
-    def __init__(self, n_agents: int, **options):
-        super().__init__(n_agents, **options)
-        d = self.options["distance"]
-        if isinstance(d, bool) or not isinstance(d, (int, float)) or not 0.22 <= d <= 2.0:
-            raise ValueError(f"mirror: distance={d!r}; allowed: a number of metres from 0.22 "
-                             "(closer and the faces touch) to 2.0")
-        if not isinstance(self.options["scripted_partner"], bool):
-            raise ValueError(f"mirror: scripted_partner={self.options['scripted_partner']!r}; "
-                             "allowed: True or False")
-
-    def agent_defaults(self, i):
-        scripted = i == 1 and self.options["scripted_partner"]
+    def agent_defaults(self, i, settings):
+        scripted = i == 1 and self.options.scripted_partner
         return {"posture": "standing", "expressions": True, "vestibular": False,
                 "vision": False if scripted else {"width": EYE_SIZE, "height": EYE_SIZE}}
 
     def setup(self, i, config):
-        dist = float(self.options["distance"])
+        dist = self.options.distance
         pos, facing = face_to_face(i, dist)
         tables = load_body(config.hands)
         frozen = held_posture(tables, keep=GAZE_JOINTS,
@@ -71,7 +78,7 @@ class Mirror(Task):
             w = env.world
             self._gaze = [Gaze(w, i) for i in range(2)]
             self._faces = [int(w.agents[i].head_site) for i in range(2)]
-            self._weights = np.array([1.0, 0.0 if self.options["scripted_partner"] else 1.0])
+            self._weights = np.array([1.0, 0.0 if self.options.scripted_partner else 1.0])
         self._match = False
         self.before_physics(env)
 

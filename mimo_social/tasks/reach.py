@@ -19,18 +19,35 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import mujoco
 import numpy as np
 
+from ..body.joint_groups import GAZE_JOINTS, held_posture, right_arm_joints
 from ..body.tables import load_body
+from ..core.kinematics import Gaze, hand_geoms
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
-from ..core.task import (GAZE_JOINTS, ContactProbe, Gaze, Task, hand_geoms, held_posture,
-                         right_arm_joints)
+from .common import ContactProbe
 
 BALL_RADIUS = 0.025
 N_START_POSTURES = 10
 CLEARANCE = 0.02  # m between the ball and the body at the start
 MAX_PLACEMENT_TRIES = 50
+
+
+@dataclass(frozen=True)
+class ReachOptions(TaskOptions):
+    """Reward on reaching the ball, and how far (m) the ball must move to count as reached."""
+
+    task = "reach"
+    success_reward: float = 100.0
+    moved_threshold: float = 0.01
+
+    def __post_init__(self):
+        self._number("success_reward")
+        self._number("moved_threshold", 0.0, 1.0)
 
 
 class Reach(Task):
@@ -40,10 +57,9 @@ class Reach(Task):
     default_max_steps = 1000
     physics_overrides = {"gravity": (0.0, 0.0, 0.0)}
 
-    def option_defaults(self) -> dict:
-        return {"success_reward": 100.0, "moved_threshold": 0.01}
+    Options = ReachOptions
 
-    def agent_defaults(self, i):
+    def agent_defaults(self, i, settings):
         return {"posture": "standing", "vestibular": False, "expressions": False}
 
     def setup(self, i, config):
@@ -112,11 +128,11 @@ class Reach(Task):
         w = env.world
         d = w.data
         moved = np.linalg.norm(d.xpos[self._ball_body] - self._ball_start)
-        self._touched = self._touch_ball(d) or moved > self.options["moved_threshold"]
+        self._touched = self._touch_ball(d) or moved > self.options.moved_threshold
         dist = np.linalg.norm(d.site_xpos[w.agents[0].fingertip_sites[0]]
                               - d.xpos[w.prop_bodies["ball"]])
         self._dist = dist
-        return np.array([self.options["success_reward"] if self._touched else -dist])
+        return np.array([self.options.success_reward if self._touched else -dist])
 
     def terminations(self, env):
         return (np.array([self._touched]),

@@ -27,25 +27,19 @@ lap so that the rest is within reach.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from ..body.tables import load_body
+from ..body.joint_groups import held_posture, right_arm_joints
+from ..body.tables import load_body, subtree
+from ..core.kinematics import hand_geoms, reach_sites
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup
-from ..core.task import Task, hand_geoms, held_posture, right_arm_joints
+from .common import CROSS_LEGGED_DEG, skin_parts
 
-CROSS_LEGGED_DEG = {
-    "right_hip_flexion": -120.0, "left_hip_flexion": -120.0,
-    "right_hip_abduction": -51.0, "left_hip_abduction": -51.0,
-    "right_hip_rotation": 40.0, "left_hip_rotation": 40.0,
-    "right_knee": -130.0, "left_knee": -130.0,
-    "right_ankle_flexion": 20.0, "left_ankle_flexion": 20.0,
-    # the left hand rests on the lap, within the right hand's reach
-    "left_shoulder_horizontal": 52.0, "left_shoulder_abduction": 41.0,
-    "left_shoulder_rotation": 0.0, "left_elbow": -64.0,
-    "lower_trunk_bend": 30.0,
-}
 # the right arm at the start: raised to the side, elbow bent a little, touching nothing
 ARM_START_DEG = {"right_shoulder_abduction": 45.0, "right_shoulder_horizontal": 20.0,
                  "right_elbow": -30.0}
@@ -56,14 +50,27 @@ UNREACHABLE = ("left_toes",)
 
 def default_targets(tables) -> tuple[str, ...]:
     """Every body part with geoms except the right arm's own parts and the eyes."""
-    from ..body.tables import subtree
     arm = set(subtree(tables, "right_upper_arm"))
-    with_geoms = []
-    for g in tables.geoms:
-        if g.body not in with_geoms:
-            with_geoms.append(g.body)
-    return tuple(b for b in with_geoms if b not in arm and b not in UNREACHABLE
+    return tuple(b for b in skin_parts(tables) if b not in arm and b not in UNREACHABLE
                  and not b.endswith(EXCLUDED_SUFFIXES))
+
+
+@dataclass(frozen=True)
+class SelfBodyOptions(TaskOptions):
+    """The target parts (None: :func:`default_targets`), one fixed target (None: drawn each
+    episode), the reward on touching it and the reward of a step that touches nothing."""
+
+    task = "selfbody"
+    targets: tuple[str, ...] | None = None
+    target: str | None = None
+    success_reward: float = 500.0
+    miss_reward: float = -1.0
+
+    def __post_init__(self):
+        self._names("targets", "body part names")
+        self._name("target", "a body part name from targets")
+        self._number("success_reward")
+        self._number("miss_reward")
 
 
 class SelfBody(Task):
@@ -73,10 +80,9 @@ class SelfBody(Task):
     default_max_steps = 500
     physics_overrides = {"frame_skip": 1}
 
-    def option_defaults(self) -> dict:
-        return {"targets": None, "target": None, "success_reward": 500.0, "miss_reward": -1.0}
+    Options = SelfBodyOptions
 
-    def agent_defaults(self, i):
+    def agent_defaults(self, i, settings):
         return {"posture": "sitting", "vestibular": False, "expressions": False,
                 "touch": {"density": 0.25, "normal_only": True}}
 
@@ -84,14 +90,14 @@ class SelfBody(Task):
         tables = load_body(config.hands)
         arm = right_arm_joints(tables)
         frozen = held_posture(tables, keep=arm, angles=CROSS_LEGGED_DEG)
-        targets = self.options["targets"]
+        targets = self.options.targets
         targets = tuple(targets) if targets is not None else default_targets(tables)
         parts = {g.body for g in tables.geoms}
         unknown = [t for t in targets if t not in parts]
         if unknown or not targets:
             raise ValueError(f"selfbody: targets {unknown or list(targets)} not allowed; body parts "
                              f"of the {config.hands} body: {sorted(parts)}")
-        fixed = self.options["target"]
+        fixed = self.options.target
         if fixed is not None and fixed not in targets:
             raise ValueError(f"selfbody: target={fixed!r} not allowed; one of {list(targets)}")
         self.targets = targets
@@ -128,7 +134,7 @@ class SelfBody(Task):
             self._bind(env)
         d = env.world.data
         d.qpos[self._arm_qpos] = self._arm_start
-        fixed = self.options["target"]
+        fixed = self.options.target
         self._target = (self.targets.index(fixed) if fixed is not None
                         else int(rng.integers(len(self.targets))))
         self._onehot = np.zeros(len(self.targets), np.float32)
@@ -166,12 +172,12 @@ class SelfBody(Task):
         self._success = bool(np.any(bodies == target))
         if self._success:
             self._distance = 0.0
-            return np.array([float(self.options["success_reward"])])
+            return np.array([self.options.success_reward])
         if len(bodies):
             self._distance = float(np.min(np.linalg.norm(pos - d.xipos[target], axis=1)))
             return np.array([-self._distance])
         self._distance = None
-        return np.array([float(self.options["miss_reward"])])
+        return np.array([self.options.miss_reward])
 
     def terminations(self, env):
         return (np.array([self._success]),
@@ -183,7 +189,6 @@ class SelfBody(Task):
         """Move the right arm (joint angles, no physics) until the palm centre lies on ``part``'s
         surface nearest to it; returns the remaining distance (m) between the hand and the part
         (negative: penetrating). Used by tests; a policy has to learn this."""
-        from .standup import reach_sites
         w = env.world
         m, d = w.model, w.data
         a = w.agents[0]

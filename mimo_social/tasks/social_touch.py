@@ -27,16 +27,30 @@ zero command, it sags forward under gravity until the heads meet.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from gymnasium import spaces
 
+from ..body.joint_groups import (
+    EYE_GAZE_JOINTS,
+    both_arms_joints,
+    held_posture,
+    right_arm_joints,
+)
 from ..body.tables import load_body, subtree
-from ..util.checks import ConfigError, check_bool, check_number
+from ..core.kinematics import Gaze, hand_geoms
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup
-from ..core.task import EYE_GAZE_JOINTS, Gaze, Task, hand_geoms, held_posture, right_arm_joints
-from .high_five import (require_skin, right_hand_parts, skin_parts,
-                        touch_only_on)
-from .selfbody import CROSS_LEGGED_DEG
+from ..util.checks import ConfigError
+from .common import (
+    CROSS_LEGGED_DEG,
+    hands_setting,
+    require_skin,
+    right_hand_parts,
+    skin_parts,
+    touch_only_on,
+)
 
 TOUCHER, TOUCHED = 0, 1
 DISTANCE = 0.28
@@ -61,9 +75,25 @@ DEFAULT_TARGETS = ("head", "upper_body", "lower_body",
                    "left_upper_leg", "left_lower_leg")
 
 
-def arms_joints(tables) -> tuple[str, ...]:
-    from ..body.tables import arm_joints
-    return arm_joints(tables, "right") + arm_joints(tables, "left")
+@dataclass(frozen=True)
+class SocialTouchOptions(TaskOptions):
+    """The partner's target parts (None: :data:`DEFAULT_TARGETS`), one fixed target (None:
+    drawn each episode), the reward for a felt touch of the target, whether it ends the
+    episode, and the distance between the infants (m)."""
+
+    task = "social_touch"
+    targets: tuple[str, ...] | None = None
+    target: str | None = None
+    success_reward: float = 100.0
+    end_on_touch: bool = True
+    distance: float = DISTANCE
+
+    def __post_init__(self):
+        self._names("targets", "body part names of the partner")
+        self._name("target", "a body part name from targets")
+        self._number("success_reward")
+        self._bool("end_on_touch")
+        self._number("distance", *DISTANCE_RANGE)
 
 
 class SocialTouch(Task):
@@ -72,44 +102,27 @@ class SocialTouch(Task):
     default_n_agents = 2
     default_max_steps = 500
 
-    def __init__(self, n_agents: int = 2, **options):
+    Options = SocialTouchOptions
+
+    def __init__(self, n_agents: int = 2, options=None, /, **values):
         if isinstance(n_agents, (int, np.integer)) and not isinstance(n_agents, bool) \
                 and n_agents != 2:
             raise ConfigError(f"social_touch: n_agents={n_agents!r} not allowed; allowed: 2 to 2 "
                               "(a dyad: the toucher infant_0 and the touched infant_1)")
-        super().__init__(n_agents, **options)
-        o = self.options
-        o["success_reward"] = check_number(self.name, "success_reward", o["success_reward"])
-        o["end_on_touch"] = check_bool(self.name, "end_on_touch", o["end_on_touch"])
-        o["distance"] = check_number(self.name, "distance", o["distance"], *DISTANCE_RANGE)
-        t = o["targets"]
-        if t is not None:
-            if isinstance(t, str) or not all(isinstance(x, str) for x in t) or not len(t) \
-                    or len(set(t)) != len(t):
-                raise ConfigError(f"social_touch: targets={t!r} not allowed; None or a non-empty "
-                                  "list of distinct body part names of the partner")
-            o["targets"] = tuple(t)
-        if o["target"] is not None and not isinstance(o["target"], str):
-            raise ConfigError(f"social_touch: target={o['target']!r} not allowed; None or a body "
-                              "part name from targets")
-        self.agent_hands: list[str] = ["mitten"] * self.n_agents
+        super().__init__(n_agents, options, **values)
         self.targets: tuple[str, ...] = ()
 
-    def option_defaults(self) -> dict:
-        return {"targets": None, "target": None, "success_reward": 100.0, "end_on_touch": True,
-                "distance": DISTANCE}
-
-    def agent_defaults(self, i):
+    def agent_defaults(self, i, settings):
         common = {"posture": "sitting", "vestibular": False, "expressions": False}
         if i == TOUCHER:
-            tables = load_body(self.agent_hands[i])
+            tables = load_body(hands_setting(settings))
             return dict(common, touch=touch_only_on(tables, subtree(tables, "right_upper_arm")))
         return dict(common, touch={"density": 0.25, "normal_only": True})
 
     # -- building ------------------------------------------------------------------------------
     def _resolve_targets(self, tables) -> tuple[str, ...]:
         parts = skin_parts(tables)
-        given = self.options["targets"]
+        given = self.options.targets
         if given is None:
             targets = tuple(p for p in DEFAULT_TARGETS if p in parts)
         else:
@@ -118,14 +131,14 @@ class SocialTouch(Task):
                 raise ConfigError(f"social_touch: targets {bad} are not body parts of the "
                                   f"partner ({tables.hands} body); body parts: {list(parts)}")
             targets = tuple(given)
-        fixed = self.options["target"]
+        fixed = self.options.target
         if fixed is not None and fixed not in targets:
             raise ConfigError(f"social_touch: target={fixed!r} not allowed; one of "
                               f"{list(targets)}")
         return targets
 
     def setup(self, i, config):
-        dist = float(self.options["distance"])
+        dist = self.options.distance
         pos = (0.0, 0.0) if i == TOUCHER else (dist, 0.0)
         facing = (dist, 0.0) if i == TOUCHER else (0.0, 0.0)
         tables = load_body(config.hands)
@@ -136,7 +149,7 @@ class SocialTouch(Task):
                          "the touch it gives")
         else:
             self.targets = self._resolve_targets(tables)
-            actuated = arms_joints(tables)
+            actuated = both_arms_joints(tables)
             angles = {**SITTING_DEG, "lower_trunk_bend": RECLINE_DEG}
             require_skin(self.name, "infant_1", config, self.targets,
                          "the touch it receives on every target part")
@@ -180,7 +193,7 @@ class SocialTouch(Task):
         if getattr(self, "_world", None) is not env.world:
             self._bind(env)
         env.world.data.qpos[self._arm_qpos] = self._arm_start
-        fixed = self.options["target"]
+        fixed = self.options.target
         self._target = (self.targets.index(fixed) if fixed is not None
                         else int(rng.integers(len(self.targets))))
         self._onehot = np.zeros(len(self.targets), np.float32)
@@ -226,11 +239,11 @@ class SocialTouch(Task):
             self._felt = bool(felt is not None and self._source in felt["agents"])
         self._success = self._felt
         self._distance = float(np.linalg.norm(d.site_xpos[self._fingertip] - d.xipos[target]))
-        r = -self._distance + (self.options["success_reward"] if self._success else 0.0)
+        r = -self._distance + (self.options.success_reward if self._success else 0.0)
         return np.array([r, r])
 
     def terminations(self, env):
-        done = self._success and self.options["end_on_touch"]
+        done = self._success and self.options.end_on_touch
         info = {"target_part": self.target, "is_success": self._success,
                 "touched_parts": self._touched, "target_felt": self._felt,
                 "fingertip_distance": self._distance}

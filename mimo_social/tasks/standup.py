@@ -27,12 +27,17 @@ the buttocks would put the feet 27 cm in front of the hip, beyond the rail.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import mujoco
 import numpy as np
 
+from ..body.joint_groups import held_posture
 from ..body.tables import load_body
+from ..core.kinematics import reach_sites
+from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
-from ..core.task import Task, held_posture
+from .common import settle
 
 TRUNK = ("lower_trunk_lean", "lower_trunk_twist", "lower_trunk_bend")
 ARM = ("shoulder_horizontal", "shoulder_abduction", "shoulder_rotation", "elbow",
@@ -53,26 +58,6 @@ ARM_GUESS_DEG = (90.0, 120.0, 0.0, -20.0)  # shoulder 3, elbow: the arms raised 
 HIP_FLEXION_DEG = -113.0
 KNEE_DEG = -145.0
 WELD_SOLREF = (0.01, 1.0)  # hands and feet: time constant 2 physics steps, critically damped
-
-
-def settle(env, steps: int, gravity: bool = True) -> None:
-    """Run ``steps`` physics steps with the current controls (actuation models that need their
-    per-step update get it), optionally without gravity; ``data.time`` restarts at 0."""
-    w = env.world
-    m, d = w.model, w.data
-    saved = m.opt.gravity.copy()
-    if not gravity:
-        m.opt.gravity[:] = 0.0
-    subs = [a for a in env.actuation if a.needs_substep]
-    try:
-        for _ in range(steps):
-            for act in subs:
-                act.substep(m, d)
-            mujoco.mj_step(m, d)
-    finally:
-        m.opt.gravity[:] = saved
-    d.time = 0.0
-    mujoco.mj_forward(m, d)
 
 
 def lowest_point(model, data, geoms: np.ndarray) -> float:
@@ -97,22 +82,25 @@ def lowest_point(model, data, geoms: np.ndarray) -> float:
     return float(low.min())
 
 
-def reach_sites(model, data, qpos_adr, dof_adr, lo, hi, site: int, target, iters: int = 60):
-    """Damped least squares: move the joints at ``qpos_adr``/``dof_adr`` (limits lo, hi) so that
-    ``site`` comes to ``target`` (world); ``data.qpos`` is changed in place."""
-    jacp = np.zeros((3, model.nv))
-    for _ in range(iters):
-        mujoco.mj_kinematics(model, data)
-        mujoco.mj_comPos(model, data)
-        err = np.asarray(target) - data.site_xpos[site]
-        if np.linalg.norm(err) < 1e-4:
-            break
-        mujoco.mj_jacSite(model, data, jacp, None, site)
-        J = jacp[:, dof_adr]
-        step = J.T @ np.linalg.solve(J @ J.T + 1e-4 * np.eye(3), err)
-        data.qpos[qpos_adr] = np.clip(data.qpos[qpos_adr] + step, lo, hi)
-    mujoco.mj_kinematics(model, data)
-    return float(np.linalg.norm(np.asarray(target) - data.site_xpos[site]))
+@dataclass(frozen=True)
+class StandupOptions(TaskOptions):
+    """Rail height (m), control cost weight, the head's reference height (m; None: its height
+    after settling), the start perturbation (rad) and the settling steps."""
+
+    task = "standup"
+    rail_height: float = RAIL_HEIGHT
+    cost_weight: float = 0.01
+    head_reference: float | None = None
+    perturbation: float = 0.01
+    settle_steps: int = 100
+
+    def __post_init__(self):
+        self._number("rail_height", 0.2, 1.0)
+        self._number("cost_weight", 0.0)
+        if self.head_reference is not None:
+            self._number("head_reference", 0.0, 2.0)
+        self._number("perturbation", 0.0, 0.5)
+        self._int("settle_steps", 0, 10_000)
 
 
 class Standup(Task):
@@ -122,11 +110,9 @@ class Standup(Task):
     default_max_steps = 500
     physics_overrides = {"frame_skip": 1}
 
-    def option_defaults(self) -> dict:
-        return {"rail_height": RAIL_HEIGHT, "cost_weight": 0.01, "head_reference": None,
-                "perturbation": 0.01, "settle_steps": 100}
+    Options = StandupOptions
 
-    def agent_defaults(self, i):
+    def agent_defaults(self, i, settings):
         return {"posture": "sitting", "vestibular": True, "expressions": False}
 
     def setup(self, i, config):
@@ -138,7 +124,7 @@ class Standup(Task):
                           base="free", actuated=actuated)
 
     def props(self):
-        h = float(self.options["rail_height"])
+        h = self.options.rail_height
         wood = (0.72, 0.52, 0.32, 1.0)
         post = h / 2 + RAIL_RADIUS / 2
         return [
@@ -177,7 +163,7 @@ class Standup(Task):
         d.qpos[a.free_qpos + 2] -= drop - 0.002
         mujoco.mj_kinematics(m, d)
         # hands to the rail: shoulder and elbow by damped least squares
-        h = float(self.options["rail_height"])
+        h = self.options.rail_height
         for side, k_site, y in (("right", 0, -GRIP_Y), ("left", 1, GRIP_Y)):
             names = [f"{side}_{j}" for j in ARM[:4]]
             for n, deg in zip(names, ARM_GUESS_DEG):  # arms forward, from where IK starts
@@ -208,11 +194,11 @@ class Standup(Task):
         d.qvel[:] = 0.0
         mujoco.mj_kinematics(m, d)
         w.hold_welds()
-        eps = float(self.options["perturbation"])
+        eps = self.options.perturbation
         d.qpos[self._act_qpos] += rng.uniform(-eps, eps, len(self._act_qpos))
         d.ctrl[:] = 0.0
-        settle(env, int(self.options["settle_steps"]))
-        ref = self.options["head_reference"]
+        settle(env, self.options.settle_steps)
+        ref = self.options.head_reference
         self._ref = float(d.site_xpos[self._head, 2]) if ref is None else float(ref)
         self._height = float(d.site_xpos[self._head, 2])
         self._cost = 0.0
@@ -221,7 +207,7 @@ class Standup(Task):
         d = env.world.data
         self._height = float(d.site_xpos[self._head, 2])
         u = env.controls[0]
-        self._cost = float(self.options["cost_weight"]) * float(np.dot(u, u))
+        self._cost = self.options.cost_weight * float(np.dot(u, u))
         return np.array([self._height - self._ref - self._cost])
 
     def terminations(self, env):
