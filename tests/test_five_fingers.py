@@ -11,7 +11,8 @@ from mimo_social.body.builder import build_infant
 from mimo_social.body.tables import load_body
 from mimo_social.envs import free_play_v0, high_five_v0, reach_v0
 from mimo_social.core.config import AgentConfig, PhysicsConfig
-from mimo_social.core.task import hand_geoms, held_posture
+from mimo_social.body.joint_groups import held_posture
+from mimo_social.core.kinematics import hand_geoms
 from mimo_social.core.world import AgentSetup, Prop, World
 
 FINGERS = ("index", "middle", "ring", "little", "thumb")

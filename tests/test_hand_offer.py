@@ -6,7 +6,7 @@ import pytest
 
 from mimo_social.envs import handover_v0, high_five_v0
 from mimo_social.partners import zero_action
-from mimo_social.core.task import hand_geoms
+from mimo_social.core.kinematics import hand_geoms
 from mimo_social.tasks.handover import OFFER_TARGET
 from mimo_social.partners.hand_offer import HandOffer, offer_posture
 

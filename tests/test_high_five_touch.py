@@ -7,7 +7,7 @@ import pytest
 from mimo_social.envs import high_five_v0
 from mimo_social.core.config import ConfigError
 from mimo_social.tasks.high_five import hand_touch
-from mimo_social.tasks.standup import reach_sites
+from mimo_social.core.kinematics import reach_sites
 from mimo_social.partners import Still
 from mimo_social.partners.hand_offer import HandOffer
 
@@ -196,7 +196,7 @@ def test_two_hand_offers_meeting_in_the_middle_make_a_high_five_at_the_default_d
     infants driven (through their own motors) to hold the right palm at the midpoint between
     them, at shoulder height, feel each other's hand within half a second."""
     env = high_five_v0.parallel_env()
-    mid = (env.task.options["distance"] / 2 + 0.02, 0.105, 0.0)   # from the right shoulder
+    mid = (env.task.options.distance / 2 + 0.02, 0.105, 0.0)   # from the right shoulder
     partners = {a: HandOffer(grip=False, release=None, target=mid) for a in env.possible_agents}
     env.reset(seed=0)
     for a, p in partners.items():
@@ -212,7 +212,7 @@ def test_two_hand_offers_meeting_in_the_middle_make_a_high_five_at_the_default_d
 def test_the_infants_start_apart_and_feel_nothing_of_each_other():
     env = high_five_v0.parallel_env(touch=True)
     _, infos = env.reset(seed=0)
-    assert env.task.options["distance"] == 0.35
+    assert env.task.options.distance == 0.35
     for a in env.possible_agents:
         assert not any(e["agents"] for e in infos[a]["touch"].values())
 

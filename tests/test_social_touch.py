@@ -5,8 +5,7 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import social_touch_v0
-from mimo_social.core.task import hand_geoms
-from mimo_social.tasks.standup import reach_sites
+from mimo_social.core.kinematics import hand_geoms, reach_sites
 from mimo_social.partners import Still
 
 MITTEN_TARGETS = ("head", "upper_body", "lower_body", "left_upper_arm", "left_lower_arm",

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 from pettingzoo.utils.conversions import parallel_to_aec
 
 from ..core.env import MimoParallelEnv
@@ -10,10 +12,19 @@ TASK_ARGS = ("physics", "per_agent", "render_mode", "max_steps", "render_size")
 
 
 def make_parallel(task_cls, n_agents=None, task_options=None, **kwargs) -> MimoParallelEnv:
-    task = task_cls(task_cls.default_n_agents if n_agents is None else n_agents,
-                    **(task_options or {}))
+    """The task (``task_options``: a dict or the task's ``Options`` instance) in a ParallelEnv;
+    ``kwargs``: the env's settings and the agents' settings."""
+    task = task_cls(task_cls.default_n_agents if n_agents is None else n_agents, task_options)
     return MimoParallelEnv(task, **kwargs)
 
 
 def make_aec(task_cls, **kwargs):
     return parallel_to_aec(make_parallel(task_cls, **kwargs))
+
+
+def with_options(task_cls, task_options, **values):
+    """``task_options`` (a dict, the task's ``Options`` or None) with ``values`` set: a dict's
+    own entries win over ``values``; an ``Options`` instance gets them (checked)."""
+    if isinstance(task_options, task_cls.Options):
+        return dataclasses.replace(task_options, **values)
+    return {**values, **(task_options or {})}

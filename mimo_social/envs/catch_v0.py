@@ -5,9 +5,9 @@ returns a :class:`~mimo_social.core.env.MimoParallelEnv` with the one agent ``in
 ``env(...)`` the AEC version. The Gymnasium id is ``mimo_social/Catch-v0``.
 """
 
-from ._factory import make_aec, make_parallel
 from ..tasks import catch as _task
 from ..tasks.catch import Catch
+from ._factory import make_aec, make_parallel
 
 __doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
 

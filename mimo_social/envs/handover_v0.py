@@ -7,8 +7,8 @@ the giver ``infant_1`` is a scripted :class:`~mimo_social.partners.hand_offer.Ha
 offer target follows the ``offer_target`` task option) unless another partner is given.
 """
 
+from ..tasks.handover import Handover
 from ._factory import make_aec, make_parallel
-from ..tasks.handover import OFFER_TARGET, Handover
 
 __all__ = ["parallel_env", "env", "scripted_env", "Handover"]
 
@@ -24,7 +24,7 @@ def env(**kwargs):
 def scripted_env(partner=None, **kwargs):
     from ..partners import ScriptedPartners
     from ..partners.hand_offer import HandOffer
+    penv = parallel_env(**kwargs)
     if partner is None:
-        target = (kwargs.get("task_options") or {}).get("offer_target", OFFER_TARGET)
-        partner = HandOffer(target=target, grip=True, release="on_touch")
-    return ScriptedPartners(parallel_env(**kwargs), {"infant_1": partner})
+        partner = HandOffer(target=penv.task.options.offer_target, grip=True, release="on_touch")
+    return ScriptedPartners(penv, {"infant_1": partner})

@@ -11,26 +11,21 @@ five); ``touch=True`` gives the whole skin, ``touch=hand_touch(density=...)`` th
 another density.
 """
 
-from pettingzoo.utils.conversions import parallel_to_aec
-
-from ..core.env import MimoParallelEnv
 from ..tasks import high_five as _task
-from ..tasks.high_five import HighFive, hand_touch, hands_of
+from ..tasks.high_five import HighFive, hand_touch
+from ._factory import make_aec, make_parallel
 
 __doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
 
 __all__ = ["parallel_env", "env", "scripted_env", "default_partner", "HighFive", "hand_touch"]
 
 
-def parallel_env(n_agents=None, task_options=None, **kwargs) -> MimoParallelEnv:
-    task = HighFive(HighFive.default_n_agents if n_agents is None else n_agents,
-                    **(task_options or {}))
-    task.agent_hands = hands_of(task.n_agents, kwargs)
-    return MimoParallelEnv(task, **kwargs)
+def parallel_env(**kwargs):
+    return make_parallel(HighFive, **kwargs)
 
 
 def env(**kwargs):
-    return parallel_to_aec(parallel_env(**kwargs))
+    return make_aec(HighFive, **kwargs)
 
 
 def default_partner():

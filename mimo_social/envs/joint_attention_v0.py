@@ -9,8 +9,8 @@ one-learner env (``infant_0`` learns) whose partner ``infant_1`` is driven by a 
 ``scripted_partner`` is set: the partner has no eyes and no reward).
 """
 
-from ._factory import make_aec, make_parallel
 from ..tasks.joint_attention import JointAttention
+from ._factory import make_aec, make_parallel, with_options
 
 __all__ = ["parallel_env", "env", "scripted_env", "JointAttention"]
 
@@ -26,6 +26,6 @@ def env(**kwargs):
 def scripted_env(partner=None, **kwargs):
     from ..partners import ScriptedPartners
     from ..partners.gaze import GazeAtTarget
-    options = {"scripted_partner": True, **(kwargs.pop("task_options", None) or {})}
+    options = with_options(JointAttention, kwargs.pop("task_options", None), scripted_partner=True)
     return ScriptedPartners(parallel_env(task_options=options, **kwargs),
                             {"infant_1": partner or GazeAtTarget()})

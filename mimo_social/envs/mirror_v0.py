@@ -9,8 +9,8 @@ a one-learner env (``infant_0`` learns) whose partner ``infant_1`` is driven by 
 is set: the partner has no eyes and no reward).
 """
 
-from ._factory import make_aec, make_parallel
 from ..tasks.mirror import Mirror
+from ._factory import make_aec, make_parallel, with_options
 
 __all__ = ["parallel_env", "env", "scripted_env", "Mirror"]
 
@@ -26,6 +26,6 @@ def env(**kwargs):
 def scripted_env(partner=None, **kwargs):
     from ..partners import ScriptedPartners
     from ..partners.expression import ExpressionShow
-    options = {"scripted_partner": True, **(kwargs.pop("task_options", None) or {})}
+    options = with_options(Mirror, kwargs.pop("task_options", None), scripted_partner=True)
     return ScriptedPartners(parallel_env(task_options=options, **kwargs),
                             {"infant_1": partner or ExpressionShow()})

@@ -4,8 +4,8 @@
 returns a :class:`~mimo_social.core.env.MimoParallelEnv`; ``env(...)`` the AEC version.
 """
 
-from ._factory import make_aec, make_parallel
 from ..tasks.reach import Reach
+from ._factory import make_aec, make_parallel
 
 __all__ = ["parallel_env", "env", "Reach"]
 

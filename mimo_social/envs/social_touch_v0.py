@@ -12,27 +12,21 @@ The toucher's skin covers its right arm by default, the touched infant's its who
 toucher's right hand and the touched infant's target parts keep their skin.
 """
 
-from pettingzoo.utils.conversions import parallel_to_aec
-
-from ..core.env import MimoParallelEnv
 from ..tasks import social_touch as _task
-from ..tasks.high_five import hands_of
 from ..tasks.social_touch import DEFAULT_TARGETS, SocialTouch
+from ._factory import make_aec, make_parallel
 
 __doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
 
 __all__ = ["parallel_env", "env", "scripted_env", "SocialTouch", "DEFAULT_TARGETS"]
 
 
-def parallel_env(n_agents=None, task_options=None, **kwargs) -> MimoParallelEnv:
-    task = SocialTouch(SocialTouch.default_n_agents if n_agents is None else n_agents,
-                       **(task_options or {}))
-    task.agent_hands = hands_of(task.n_agents, kwargs)
-    return MimoParallelEnv(task, **kwargs)
+def parallel_env(**kwargs):
+    return make_parallel(SocialTouch, **kwargs)
 
 
 def env(**kwargs):
-    return parallel_to_aec(parallel_env(**kwargs))
+    return make_aec(SocialTouch, **kwargs)
 
 
 def scripted_env(partner=None, **kwargs):

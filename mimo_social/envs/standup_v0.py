@@ -5,9 +5,9 @@ returns a :class:`~mimo_social.core.env.MimoParallelEnv` with the one agent ``in
 ``env(...)`` the AEC version. The Gymnasium id is ``mimo_social/Standup-v0``.
 """
 
-from ._factory import make_aec, make_parallel
 from ..tasks import standup as _task
 from ..tasks.standup import Standup
+from ._factory import make_aec, make_parallel
 
 __doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
 
