@@ -177,3 +177,25 @@ def test_reach_is_unchanged():
     obs, _ = env.reset(seed=0)
     assert env.action_space(A).shape == (8,) and set(obs[A]) == {"proprioception"}
     env.close()
+
+
+@pytest.mark.parametrize("module, options, match", [
+    (reach_v0, {"success_reward": "abc"}, r"reach: task option success_reward='abc' not allowed"),
+    (catch_v0, {"radius": (0.02, 0.01)}, r"catch: task option radius=.*low <= high"),
+    (standup_v0, {"settle_steps": 2.5}, r"standup: task option settle_steps=2.5.*integer"),
+    (selfbody_v0, {"targets": "head"}, r"selfbody: task option targets='head' not allowed"),
+    (reach_v0, {"reward": 1}, r"unknown task option.*allowed: \['moved_threshold'"),
+])
+def test_task_options_are_checked_when_made(module, options, match):
+    with pytest.raises(ValueError, match=match):
+        module.parallel_env(task_options=options)
+
+
+def test_task_options_as_a_dict_or_as_the_dataclass():
+    from mimo_social.envs import free_play_v0
+    from mimo_social.tasks.reach import Reach, ReachOptions
+    assert Reach.Options is ReachOptions
+    env = reach_v0.parallel_env(task_options=ReachOptions(success_reward=5.0))
+    assert env.task.options == reach_v0.parallel_env(task_options={"success_reward": 5}).task.options
+    with pytest.raises(ValueError, match="props='no'.*True or False"):
+        free_play_v0.parallel_env(task_options={"props": "no"})
