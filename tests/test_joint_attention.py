@@ -6,7 +6,8 @@ from gymnasium import spaces
 
 from mimo_social.envs import joint_attention_v0
 from mimo_social.core.gym_adapter import SingleAgentEnv
-from mimo_social.core.wrappers import FlattenParallel, make_sb3_single
+from mimo_social.core.wrappers import FlattenParallel
+from mimo_social.train.envs import make_sb3_single
 from mimo_social.partners.gaze import GazeAtTarget
 
 STILL = np.zeros(9, np.float32)

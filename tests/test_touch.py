@@ -18,7 +18,8 @@ from mimo_social.body.tables import load_body
 from mimo_social.envs import free_play_v0
 from mimo_social.core.config import ConfigError
 from mimo_social.core.env import MimoParallelEnv
-from mimo_social.core.task import Task, held_posture
+from mimo_social.body.joint_groups import held_posture
+from mimo_social.core.task import Task
 from mimo_social.core.world import AgentSetup, Prop
 from mimo_social.figures import hand_ball_scene
 from mimo_social.senses import skin as skin_module

@@ -28,7 +28,7 @@ from ..expressions.faces import EXPRESSIONS
 from ..render.scene import make_renderer
 from ..senses import SENSES
 from .config import ConfigError, parse_physics, resolve_agents
-from .task import Task
+from .task import Task, agent_user_settings
 from .world import World
 
 __all__ = ["MimoParallelEnv", "TIMING_KEYS"]
@@ -66,7 +66,8 @@ class MimoParallelEnv(ParallelEnv):
         if self.max_steps < 1:
             raise ConfigError(f"max_steps={max_steps}; allowed: a positive integer")
         n = task.n_agents
-        defaults = [task.agent_defaults(i) for i in range(n)]
+        defaults = [task.agent_defaults(i, own) for i, own in
+                    enumerate(agent_user_settings(n, agent_settings, per_agent))]
         self.agent_configs = resolve_agents(n, agent_settings, per_agent, defaults)
         self.physics = parse_physics(physics, task.physics_overrides)
         self.frame_skip = self.physics.frame_skip

@@ -35,8 +35,6 @@ LAYERS = {
 OUTSIDE = {"mimo_social", "mimo_social.obs_norm"}
 MAX_LINES = 600
 
-# The layout is being finished: remove this mark when the graph is clean.
-pytestmark = pytest.mark.xfail(reason="layout in progress", strict=False)
 
 
 def _modules() -> dict[str, Path]:
