@@ -11,7 +11,7 @@ from mimo_social.cli import docs as docs_cli
 from mimo_social.envs import task_docs
 from mimo_social.envs.catalog import CATALOG
 
-DOCS = Path(__file__).resolve().parents[1] / "docs" / "tasks.md"
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "tasks.md"
 
 
 def test_docs_tasks_md_is_generated():

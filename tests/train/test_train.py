@@ -113,7 +113,7 @@ def test_a_run_saved_before_the_layout_still_loads_and_runs(tmp_path, capsys):
     from mimo_social.train.obs_norm import RunningNorm
 
     run = tmp_path / "old"
-    shutil.copytree(Path(__file__).parent / "data" / "pre_layout_reach_run", run)
+    shutil.copytree(Path(__file__).parents[1] / "data" / "pre_layout_reach_run", run)
     config = json.loads((run / "config.json").read_text())
     assert config["algo_kwargs"]["policy_kwargs"]["features_extractor_class"] == \
         "mimo_social.obs_norm.RunningNorm"
