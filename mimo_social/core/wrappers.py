@@ -173,7 +173,8 @@ def flat_action_space(space: spaces.Space) -> spaces.Space:
 # -- the PettingZoo wrapper ---------------------------------------------------------------------
 class ParallelWrapper(ParallelEnv):
     """Base of this package's ParallelEnv wrappers: holds ``env``, and passes ``unwrapped``,
-    ``metadata``, ``render_mode``, ``render``, ``close``, ``state`` and ``state_space`` on to it."""
+    ``metadata``, ``render_mode``, ``render``, ``close``, ``state``, ``state_space`` and every
+    other public attribute it does not define itself on to it."""
 
     def __init__(self, env: ParallelEnv):
         if not isinstance(env, ParallelEnv):
@@ -199,6 +200,16 @@ class ParallelWrapper(ParallelEnv):
     def state_space(self, *args, **kwargs):
         space = self.env.state_space
         return space(*args, **kwargs) if callable(space) else space
+
+    def __getattr__(self, name: str):
+        # only public names, and never before __init__/__setstate__ has set ``env`` (pickling)
+        env = self.__dict__.get("env")
+        if env is None or name.startswith("_"):
+            raise AttributeError(f"{type(self).__name__} has no attribute {name!r}")
+        return getattr(env, name)
+
+    def __str__(self):
+        return f"{type(self).__name__}<{self.env}>"
 
 
 class FlattenParallel(ParallelWrapper):
@@ -246,17 +257,6 @@ class FlattenParallel(ParallelWrapper):
                    for a, act in actions.items()}
         obs, rewards, terminations, truncations, infos = self.env.step(decoded)
         return self._flat_obs(obs), rewards, terminations, truncations, infos
-
-
-    def __getattr__(self, name: str):
-        # only public names, and never before __init__/__setstate__ has set ``env`` (pickling)
-        env = self.__dict__.get("env")
-        if env is None or name.startswith("_"):
-            raise AttributeError(f"{type(self).__name__} has no attribute {name!r}")
-        return getattr(env, name)
-
-    def __str__(self):
-        return f"FlattenParallel<{self.env}>"
 
 
 # -- the Gymnasium side -------------------------------------------------------------------------

@@ -10,7 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from pettingzoo import ParallelEnv
+from ..core.wrappers import ParallelWrapper
 
 from ..util.checks import check_int
 from .recorder import Recorder
@@ -75,7 +75,7 @@ def _main_or_first_worker() -> bool:
             or multiprocessing.current_process().name == FIRST_VEC_WORKER)
 
 
-class RecordingParallelEnv(ParallelEnv):
+class RecordingParallelEnv(ParallelWrapper):
     """A ParallelEnv wrapper that records every ``every_k_episodes``-th episode to its own file.
 
     ``env``: a ``MimoParallelEnv`` (or a wrapper of one that keeps its dict observations and
@@ -99,7 +99,7 @@ class RecordingParallelEnv(ParallelEnv):
                  every_k_episodes: int = 10, *, claim: tuple[str, int] | None = None,
                  **recorder_options):
         _check_episode_options(type(self).__name__, path_pattern, every_k_episodes)
-        self.env = env
+        super().__init__(env)
         self.path_pattern = str(path_pattern)
         self.every_k_episodes = int(every_k_episodes)
         self.recorder_options = dict(recorder_options)
@@ -109,18 +109,12 @@ class RecordingParallelEnv(ParallelEnv):
         self.episode = -1                    # index of the current episode (-1: before a reset)
         self.recorder: Recorder | None = None
         self.paths: list[Path] = []          # the files this wrapper (in this process) wrote
-        self.metadata = dict(getattr(env, "metadata", {}))
-        self.render_mode = getattr(env, "render_mode", None)
         self.possible_agents = list(env.possible_agents)
 
     # the live agents and the spaces are the wrapped env's
     @property
     def agents(self):
         return self.env.agents
-
-    @property
-    def unwrapped(self):
-        return self.env.unwrapped
 
     def observation_space(self, agent):
         return self.env.observation_space(agent)
@@ -162,12 +156,6 @@ class RecordingParallelEnv(ParallelEnv):
             rec, self.recorder = self.recorder, None
             rec.close()
 
-    def render(self):
-        return self.env.render()
-
-    def state(self):
-        return self.env.state()
-
     def close(self):
         self._stop_recording()
         return self.env.close()
@@ -178,15 +166,6 @@ class RecordingParallelEnv(ParallelEnv):
         if self.claim is not None:           # a copy claims its own place at its first reset
             state["rank"], state["chosen"] = None, False
         return state
-
-    def __getattr__(self, name: str):
-        env = self.__dict__.get("env")
-        if env is None or name.startswith("_"):
-            raise AttributeError(f"{type(self).__name__} has no attribute {name!r}")
-        return getattr(env, name)
-
-    def __str__(self):
-        return f"RecordingParallelEnv<{self.env}>"
 
 
 class RecordSubEnv:
