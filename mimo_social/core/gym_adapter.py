@@ -10,6 +10,8 @@ import gymnasium as gym
 
 from .env import MimoParallelEnv
 
+__all__ = ["SingleAgentEnv"]
+
 
 class SingleAgentEnv(gym.Env):
     def __init__(self, env: MimoParallelEnv):

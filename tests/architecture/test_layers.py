@@ -29,10 +29,16 @@ LAYERS = {
     "train": 8, "bench": 8, "experiments": 8, "figures": 8,
     "cli": 9,
 }
-#: modules outside the layers: the package root (chooses the GL backend, registers the ids)
-#: and aliases kept for files saved before the layout (a saved SB3 model names
-#: ``mimo_social.obs_norm.RunningNorm``)
-OUTSIDE = {"mimo_social", "mimo_social.obs_norm"}
+#: modules outside the layers: the package root (chooses the GL backend, registers the ids),
+#: the alias kept for files saved before the layout (a saved SB3 model names
+#: ``mimo_social.obs_norm.RunningNorm``) and the deprecated aliases of the paths the README
+#: documented before the layout (each only re-exports its new module)
+ALIASES = {"mimo_social.replay": "mimo_social.recording",
+           "mimo_social.envs.parallel": "mimo_social.core.env",
+           "mimo_social.envs.single": "mimo_social.core.gym_adapter",
+           "mimo_social.envs.wrappers": "mimo_social.core.wrappers",
+           "mimo_social.envs.vector": "mimo_social.train.vector"}
+OUTSIDE = {"mimo_social", "mimo_social.obs_norm", *ALIASES}
 MAX_LINES = 600
 
 
@@ -195,3 +201,22 @@ def test_tests_mirror_the_package():
     assert folders <= set(LAYERS), f"test folders that are no unit: {sorted(folders - set(LAYERS))}"
     loose = sorted(p.name for p in tests.glob("test_*.py"))
     assert not loose, f"tests outside a unit's folder: {loose}"
+
+
+@pytest.mark.parametrize("old", sorted(ALIASES))
+def test_paths_documented_before_the_layout_still_import(old):
+    import importlib
+    import sys
+
+    sys.modules.pop(old, None)
+    with pytest.warns(DeprecationWarning, match="moved to"):
+        alias = importlib.import_module(old)
+    new = importlib.import_module(ALIASES[old])
+    assert all(getattr(alias, name) is getattr(new, name) for name in new.__all__)
+
+
+def test_a_saved_model_still_finds_running_norm():
+    from mimo_social.obs_norm import RunningNorm
+    from mimo_social.train.obs_norm import RunningNorm as new
+
+    assert RunningNorm is new
