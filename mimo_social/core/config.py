@@ -10,8 +10,6 @@ re-exported here).
 from __future__ import annotations
 
 import dataclasses
-import math
-import numbers
 from dataclasses import dataclass, fields
 from typing import Any, Mapping, Sequence
 
@@ -21,7 +19,7 @@ from ..senses.proprioception import ProprioceptionConfig
 from ..senses.touch import TouchConfig
 from ..senses.vestibular import VestibularConfig
 from ..senses.vision import VisionConfig
-from ..util.checks import ConfigError
+from ..util.checks import ConfigError, check_bool, check_choice, check_number
 
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig", "AgentConfig",
@@ -64,29 +62,17 @@ class AgentConfig:
     strength: float = 1.0
 
     def __post_init__(self):
-        if self.hands not in HAND_VERSIONS:
-            raise ConfigError(f"hands={self.hands!r} not allowed; allowed: {list(HAND_VERSIONS)}")
-        if self.actuation not in ACTUATION_MODELS:
-            raise ConfigError(
-                f"actuation={self.actuation!r} not allowed; allowed: {list(ACTUATION_MODELS)}")
-        if self.posture not in POSTURES:
-            raise ConfigError(f"posture={self.posture!r} not allowed; allowed: {list(POSTURES)}")
-        if not isinstance(self.expressions, bool):
-            raise ConfigError(f"expressions={self.expressions!r}; allowed: True or False")
+        check_choice("", "hands", self.hands, HAND_VERSIONS)
+        check_choice("", "actuation", self.actuation, ACTUATION_MODELS)
+        check_choice("", "posture", self.posture, POSTURES)
+        check_bool("", "expressions", self.expressions)
         for key in ("position", "facing"):
             v = getattr(self, key)
             if v is not None and (len(v) != 2 or not all(abs(float(c)) < 1e3 for c in v)):
                 raise ConfigError(f"{key}={v!r}; expected (x, y) in metres or None")
-        for key, (lo, hi), what in (("scale", SCALE_RANGE, "body size factor"),
-                                    ("strength", STRENGTH_RANGE, "strength factor")):
-            v = getattr(self, key)
-            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
-                raise ConfigError(f"{key}={v!r} not allowed; allowed: a number from {lo:g} to "
-                                  f"{hi:g} ({what})")
-            if not lo <= v <= hi:
-                raise ConfigError(f"{key}={v!r} is out of range; allowed: {lo:g} to {hi:g} "
-                                  f"({what})")
-            object.__setattr__(self, key, float(v))
+        object.__setattr__(self, "scale", check_number("", "scale", self.scale, *SCALE_RANGE))
+        object.__setattr__(self, "strength",
+                           check_number("", "strength", self.strength, *STRENGTH_RANGE))
 
 
 _NO_FIELD = sorted(set(SENSES) - {f.name for f in fields(AgentConfig)})

@@ -54,8 +54,7 @@ copies ``data.xpos``/``data.xquat`` and the motor actions into preallocated buff
 expression change (seen as a change of the head materials' texture), looks for new contacts
 between agents (one lookup of all ``data.contact`` geom pairs in a table of "two different
 agents"), with touch on notes which skin points of all agents feel a force (one pass over the
-skin's force array), and with vision on encodes the eye images as PNG (zlib level 1, ~2 KB and
-~0.1 ms for a 64x64 image). Every ``flush_every_s`` of simulated time the buffer goes out as
+skin's force array), and with vision on encodes the eye images as PNG (zlib level 1). Every ``flush_every_s`` of simulated time the buffer goes out as
 **one** Arrow record batch with the poses of all bodies, the scalars of all agents and their skin
 points (placed in the world and coloured then, for all rows at once), followed by a batch each of
 expression changes, eye images and contact events of that interval (Rerun splits a batch into one

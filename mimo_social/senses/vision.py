@@ -17,11 +17,8 @@ of all agents are tiles of one offscreen buffer of one GL context per process (s
 the process that steps the env and is dropped when the env is pickled, so vector envs in worker
 processes work with the ``spawn`` / ``forkserver`` start methods (not ``fork`` after rendering).
 
-Speed (2 cores, Mesa llvmpipe software rendering; ``mimo-social bench-vision`` measures it, each
-variant of :data:`mimo_social.bench.vision_cost.BENCH_VARIANTS` against the one before): one
-infant's two 64x64 eyes every control step cost ~0.05 real s per simulated s (~0.15 ms an
-image, against ~3.7 ms for a plain ``mujoco.Renderer`` per eye), two 256x256 eyes ~0.2 (~0.5 ms
-an image); images with another infant in view cost ~3x more.
+What it costs: ``mimo-social bench-vision`` (each variant of
+:data:`mimo_social.bench.vision_cost.BENCH_VARIANTS` against the one before) and BENCHMARKS.md.
 
 Helpers: :func:`vision_system` (the system of an env), :func:`eye_images` (an agent's current
 images), :func:`render_now` (re-render after changing the state by hand, e.g. after

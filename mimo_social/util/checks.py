@@ -16,6 +16,11 @@ class ConfigError(ValueError):
     """A configuration key or value that is not allowed."""
 
 
+def _who(owner: str) -> str:
+    """``"owner: "``, or nothing for an empty owner (the caller names it)."""
+    return f"{owner}: " if owner else ""
+
+
 def _range_text(lo, hi, what: str) -> str:
     if lo is None and hi is None:
         return f"any finite {what}"
@@ -29,11 +34,12 @@ def _range_text(lo, hi, what: str) -> str:
 def check_number(owner: str, name: str, value: Any, lo: float | None = None,
                  hi: float | None = None) -> float:
     """``value`` as a float if it is a finite real number (not a bool) in [lo, hi], else a
-    :class:`ConfigError` naming the owner (agent, task, partner), the setting and the range."""
+    :class:`ConfigError` naming the owner (agent, task, partner; an empty owner: the caller
+    names it), the setting and the range."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
             or not math.isfinite(value) or (lo is not None and value < lo) \
             or (hi is not None and value > hi):
-        raise ConfigError(f"{owner}: {name}={value!r} not allowed; allowed: "
+        raise ConfigError(f"{_who(owner)}{name}={value!r} not allowed; allowed: "
                           f"{_range_text(lo, hi, 'a number')}")
     return float(value)
 
@@ -43,7 +49,7 @@ def check_int(owner: str, name: str, value: Any, lo: int | None = None,
     """``value`` as an int if it is an integer (not a bool) in [lo, hi], else a ConfigError."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) \
             or (lo is not None and value < lo) or (hi is not None and value > hi):
-        raise ConfigError(f"{owner}: {name}={value!r} not allowed; allowed: "
+        raise ConfigError(f"{_who(owner)}{name}={value!r} not allowed; allowed: "
                           f"{_range_text(lo, hi, 'an integer')}")
     return int(value)
 
@@ -51,7 +57,7 @@ def check_int(owner: str, name: str, value: Any, lo: int | None = None,
 def check_bool(owner: str, name: str, value: Any) -> bool:
     """``value`` if it is a bool (numpy's too), else a ConfigError (truthy strings are not)."""
     if not isinstance(value, (bool, np.bool_)):
-        raise ConfigError(f"{owner}: {name}={value!r} not allowed; allowed: True or False")
+        raise ConfigError(f"{_who(owner)}{name}={value!r} not allowed; allowed: True or False")
     return bool(value)
 
 
@@ -62,5 +68,5 @@ def check_choice(owner: str, name: str, value: Any, allowed: Sequence) -> Any:
     except TypeError:  # an unhashable value against a set
         ok = False
     if not ok:
-        raise ConfigError(f"{owner}: {name}={value!r} not allowed; allowed: {list(allowed)}")
+        raise ConfigError(f"{_who(owner)}{name}={value!r} not allowed; allowed: {list(allowed)}")
     return value
