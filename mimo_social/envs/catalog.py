@@ -27,7 +27,7 @@ KINDS = ("sandbox", "one-agent", "social")
 class EnvEntry:
     """One env: ``name`` (the task name), ``module`` (its ``<task>_v0`` module), ``gym_id`` (the
     Gymnasium id: the env itself for one agent, the scripted form for a social task), ``kind``
-    (one of :data:`KINDS`) and a one-line ``summary``."""
+    (one of :data:`KINDS`), a one-line ``summary`` and the task's scripted ``controller``."""
 
     name: str
     module: ModuleType
@@ -35,6 +35,9 @@ class EnvEntry:
     kind: str
     summary: str
     gym_defaults: tuple = ()   # keyword arguments the Gymnasium id passes by default
+    #: the scripted controller that solves the task (a Partner class made without arguments),
+    #: for the one-learner env; None where the task has none yet
+    controller: type | None = None
 
     @property
     def module_name(self) -> str:
