@@ -30,11 +30,6 @@ _RESET_MODEL = ("model values the task sets at reset are not in the pickle (Worl
 
 #: (check, env name, form) -> why that check fails for a real bug of the env (strict xfail)
 KNOWN_BUGS: dict[tuple[str, str, str], str] = {
-    ("pickle", "standup", "parallel"):
-        _RESET_MODEL + ": the welds' eq_solref and the crib rail's contype/conaffinity",
-    ("pickle", "catch", "parallel"):
-        _RESET_MODEL + ": the ball's radius and mass drawn at reset (geom_size, body_mass, "
-        "body_inertia)",
     ("pickle", "joint_attention", "parallel"):
         _STALE + " (the task's head gravity compensation reads qfrc_bias before the step)",
     ("pickle", "joint_attention", "scripted"):
