@@ -12,9 +12,10 @@ from . import train
 from . import bench, bench_vision, calibrate, compliance, demo, figure, replay
 from . import docs
 from . import bench_recording
+from . import baselines
 
 SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, bench_vision, figure, docs,
-               bench_recording)
+               bench_recording, baselines)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -14,8 +14,9 @@
 
 ``mimo-social compare --task standup --algos ppo,sac --seeds 3 --steps 50000 --out runs/cmp``
     Trains every algorithm with seeds 0..n-1 (``--jobs`` processes at a time) into
-    ``OUT/<algo>_seed<k>`` and plots them together to ``OUT/compare.png`` / ``OUT/compare.csv``
-    (``--plot-only`` re-plots existing runs).
+    ``OUT/<algo>_seed<k>`` and plots them together, over environment steps and over wall time,
+    to ``OUT/compare.png`` / ``OUT/compare.csv`` (``--plot-only`` re-plots existing runs).
+    ``--steps-per-algo ppo=100000,sac=20000`` gives each algorithm its own budget.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from pathlib import Path
 
 from ..train import (ALGOS, ALL_TASKS, MULTI_TASKS, TASKS, TrainInputError, VideoUnavailable,
                      compare, evaluate, train)
+from ..train.comparison import parse_steps_per_algo
 
 __all__ = ["add_parser"]
 
@@ -42,14 +44,15 @@ def _json_arg(text: str) -> dict:
     return value
 
 
-def _common(p):
+def _common(p, steps_required: bool = True):
     p.add_argument("--task", required=True, choices=sorted(ALL_TASKS),
                    help=f"one-agent: {', '.join(TASKS)}; multi-agent: {', '.join(MULTI_TASKS)}")
     p.add_argument("--mode", default=None, choices=("shared", "independent", "scripted"),
                    help="multi-agent tasks: shared (one policy for all agents, the default), "
                    "independent (one policy per agent) or scripted (one learner, the partner "
                    "scripted)")
-    p.add_argument("--steps", type=int, required=True, help="environment steps to train for")
+    p.add_argument("--steps", type=int, required=steps_required,
+                   help="environment steps to train for")
     p.add_argument("--eval-every", type=int, default=None,
                    help="steps between evaluations (default: steps / 20)")
     p.add_argument("--eval-episodes", type=int, default=5, help="episodes per evaluation")
@@ -126,8 +129,23 @@ def _compare_main(args) -> int:
     return 0
 
 
+def _compare_steps(args, algos):
+    """--steps for every algorithm, overridden per algorithm by --steps-per-algo."""
+    per = parse_steps_per_algo(args.steps_per_algo) if args.steps_per_algo else {}
+    unknown = [a for a in per if a not in algos]
+    if unknown:
+        raise TrainInputError(f"--steps-per-algo names {', '.join(unknown)}, which --algos "
+                              f"({','.join(algos)}) does not compare")
+    missing = [a for a in algos if a not in per]
+    if args.steps is None and missing and not args.plot_only:
+        raise TrainInputError(f"no step budget for {', '.join(missing)}: give --steps (every "
+                              "algorithm) or --steps-per-algo with an entry for each")
+    return {a: per.get(a, 1 if args.steps is None else args.steps) for a in algos}
+
+
 def _compare_run(args, algos):
-    return compare(args.task, algos, args.seeds, args.steps, args.out, jobs=args.jobs,
+    steps = _compare_steps(args, algos)
+    return compare(args.task, algos, args.seeds, steps, args.out, jobs=args.jobs,
                    plot_only=args.plot_only, mode=args.mode, eval_every=args.eval_every,
                    eval_episodes=args.eval_episodes, checkpoint_every=args.checkpoint_every,
                    env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs,
@@ -171,11 +189,19 @@ def add_parser(subparsers) -> None:
 
     p = subparsers.add_parser("compare", help="train several algorithms and seeds, plot them "
                               "together", description="Train each algorithm with several seeds "
-                              "and plot the learning curves together (the paper's Fig. 8).")
-    _common(p)
+                              "and plot the learning curves together over environment steps and "
+                              "over wall time (the paper's Fig. 8). --algo-kwargs may give one "
+                              "object per algorithm: '{\"ppo\": {\"n_steps\": 512}, "
+                              "\"sac\": {}}'.")
+    _common(p, steps_required=False)
+    p.add_argument("--steps-per-algo", default=None, metavar="ALGO=STEPS,...",
+                   help="a step budget per algorithm over --steps, e.g. ppo=100000,sac=20000 "
+                   "(SAC costs about 10x more per step)")
     p.add_argument("--algos", default="ppo,sac", help="comma-separated: ppo,sac")
     p.add_argument("--seeds", type=int, default=3, help="seeds 0 .. n-1 per algorithm")
     p.add_argument("--out", required=True, help="output directory (one sub-directory a run)")
-    p.add_argument("--jobs", type=int, default=1, help="runs at a time (processes)")
+    p.add_argument("--jobs", type=int, default=1, help="runs at a time, each in its own "
+                   "process with torch on one thread (the runs' files are the same as with "
+                   "--jobs 1, apart from wall times)")
     p.add_argument("--plot-only", action="store_true", help="only re-plot existing runs")
     p.set_defaults(func=_compare_main)

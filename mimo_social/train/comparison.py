@@ -1,21 +1,28 @@
 """``compare``: train several algorithms with several seeds and plot them together.
 
-Every algorithm is trained with seeds 0..n-1 (``jobs`` processes at a time) into
-``OUT/<algo>_seed<k>``; :func:`~mimo_social.train.plots.plot_compare` then plots the evaluation
-returns of all runs together (the paper's Fig. 8) to ``OUT/compare.png`` with the numbers in
-``OUT/compare.csv``. ``plot_only`` re-plots existing runs.
+Every algorithm is trained with seeds 0..n-1 into ``OUT/<algo>_seed<k>``;
+:func:`~mimo_social.train.plots.plot_compare` then plots the evaluation returns of all runs
+together (the paper's Fig. 8; over environment steps and over wall time) to ``OUT/compare.png``
+with the numbers in ``OUT/compare.csv``. ``plot_only`` re-plots existing runs.
+
+``jobs``: runs at a time, each in its own process (``spawn`` start method; ``train`` puts each
+process's torch on one thread); a run's files are the same as when the runs go one after another,
+apart from its wall times. ``steps`` may be one budget for every algorithm or one per algorithm
+(``{"ppo": 100_000, "sac": 20_000}``: SAC costs far more per step); ``algo_kwargs`` likewise
+one set for every algorithm or one per algorithm (``{"ppo": {"n_steps": 512}, "sac": {}}``).
 """
 
 from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Any, Mapping
 
 from .plots import plot_compare
 from .runner import train
-from .tasks import ALGOS, check_algo, check_mode, check_task, task_module
+from .tasks import ALGOS, TrainInputError, check_algo, check_mode, check_task, task_module
 
-__all__ = ["compare"]
+__all__ = ["compare", "parse_steps_per_algo"]
 
 
 def _train_quiet(kwargs):
@@ -26,12 +33,60 @@ def _train_quiet(kwargs):
     return kwargs["out"], time.perf_counter() - t0
 
 
-def compare(task: str, algos=ALGOS, seeds: int = 3, steps: int = 50_000,
+def _per_algo(name: str, value, algos: list[str], per_algo: bool) -> dict:
+    """``{algo: value}``: ``value`` itself for every algorithm, or (``per_algo``) its entries."""
+    if not per_algo:
+        return {a: value for a in algos}
+    missing = [a for a in algos if a not in value]
+    if missing:
+        raise TrainInputError(f"{name}: no value for {', '.join(missing)} (given for "
+                              f"{', '.join(value)}); give one for every algorithm compared")
+    return {a: value[a] for a in algos}
+
+
+def _kwargs_per_algo(kwargs: Mapping[str, Any]) -> bool:
+    """Whether ``algo_kwargs`` is keyed by algorithm (``{"ppo": {...}, "sac": {...}}``)."""
+    named = [k for k in kwargs if k in ALGOS]
+    if named and (len(named) < len(kwargs)
+                  or not all(isinstance(kwargs[k], Mapping) for k in named)):
+        raise TrainInputError(f"algo_kwargs {dict(kwargs)}: give either keyword arguments for "
+                              "every algorithm or one object per algorithm, e.g. "
+                              '{"ppo": {"n_steps": 512}, "sac": {"batch_size": 128}}')
+    return bool(named)
+
+
+def parse_steps_per_algo(text: str) -> dict[str, int]:
+    """``"ppo=100000,sac=20000"`` -> ``{"ppo": 100000, "sac": 20000}`` (a TrainInputError
+    saying what is wrong otherwise)."""
+    out = {}
+    for part in (p.strip() for p in text.split(",")):
+        if not part:
+            continue
+        algo, sep, value = part.partition("=")
+        algo = algo.strip()
+        try:
+            check_algo(algo)
+            steps = int(value)
+        except (TrainInputError, ValueError):
+            steps = None
+        if not sep or steps is None or steps < 1:
+            raise TrainInputError(f"steps per algorithm {part!r}: expected ALGO=STEPS with ALGO "
+                                  f"one of {', '.join(ALGOS)} and STEPS a positive integer, e.g. "
+                                  "ppo=100000,sac=20000")
+        out[algo] = steps
+    if not out:
+        raise TrainInputError("steps per algorithm: none given, e.g. ppo=100000,sac=20000")
+    return out
+
+
+def compare(task: str, algos=ALGOS, seeds: int = 3, steps: int | Mapping[str, int] = 50_000,
             out: str | Path = "runs/compare", *, jobs: int = 1, plot_only: bool = False,
-            mode: str | None = None, **train_kwargs) -> Path:
+            mode: str | None = None, algo_kwargs: Mapping[str, Any] | None = None,
+            **train_kwargs) -> Path:
     """Train every algorithm with seeds 0..seeds-1 and plot them together; returns the PNG.
-    Multi-agent tasks train in ``mode``; the plot shows the evaluation return and success rate
-    averaged across agents, ``compare.csv`` has the per-agent columns too."""
+    ``steps`` and ``algo_kwargs``: one for every algorithm or a mapping algo -> its own (see the
+    module docstring). Multi-agent tasks train in ``mode``; the plot shows the evaluation return
+    and success rate averaged across agents, ``compare.csv`` has the per-agent columns too."""
     out = Path(out)
     algos = [check_algo(a) for a in algos]
     check_task(task)
@@ -39,8 +94,14 @@ def compare(task: str, algos=ALGOS, seeds: int = 3, steps: int = 50_000,
     if mode is not None:
         task_module(task)
         train_kwargs["mode"] = mode
-    runs = [dict(task=task, algo=a, steps=steps, seed=s, out=str(out / f"{a}_seed{s}"),
-                 **train_kwargs) for a in algos for s in range(int(seeds))]
+    jobs = int(jobs)
+    if jobs < 1:
+        raise TrainInputError(f"jobs={jobs}; allowed: a positive integer")
+    steps = _per_algo("steps", steps, algos, isinstance(steps, Mapping))
+    algo_kwargs = dict(algo_kwargs or {})
+    kwargs = _per_algo("algo_kwargs", algo_kwargs, algos, _kwargs_per_algo(algo_kwargs))
+    runs = [dict(task=task, algo=a, steps=steps[a], seed=s, out=str(out / f"{a}_seed{s}"),
+                 algo_kwargs=kwargs[a], **train_kwargs) for a in algos for s in range(int(seeds))]
     if not plot_only:
         out.mkdir(parents=True, exist_ok=True)
         if jobs <= 1:

@@ -5,7 +5,8 @@
     and the success rate where the task reports one; one line per agent for multi-agent runs.
 ``plot_compare(out)``
     ``compare.png`` / ``compare.csv`` of every ``<algo>_seed<k>`` run below ``out`` (the paper's
-    Fig. 8: each algorithm's mean over seeds with the min-max band, PPO red, SAC blue).
+    Fig. 8: over environment steps and over wall time side by side; each algorithm's mean over
+    seeds with the min-max band and a thin line per seed, PPO red, SAC blue).
 """
 
 from __future__ import annotations
@@ -120,8 +121,35 @@ def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> P
     return path
 
 
+def _wall_unit(seconds: float) -> tuple[str, float]:
+    """The unit of a wall-time axis that ends at ``seconds``: (name, seconds per unit)."""
+    if seconds < 120:
+        return "s", 1.0
+    if seconds < 2 * 3600:
+        return "min", 60.0
+    return "h", 3600.0
+
+
+def _curves(ax, runs, xkey: str, xscale: float, key: str, scale: float, color, label: str):
+    """One algorithm on one axis: a thin line per seed, the mean over seeds (on the union of the
+    runs' x values up to the shortest run's end) and the min-max band."""
+    for _, p in runs:
+        ax.plot(p[xkey] / xscale, p[key] * scale, color=color, alpha=0.3, lw=0.8)
+    end = min(p[xkey][-1] for _, p in runs)
+    grid = np.unique(np.concatenate([p[xkey][p[xkey] <= end] for _, p in runs]))
+    ys = np.array([np.interp(grid, p[xkey], p[key]) for _, p in runs]) * scale
+    ax.plot(grid / xscale, np.nanmean(ys, axis=0), color=color, lw=2, label=label)
+    ax.fill_between(grid / xscale, np.nanmin(ys, axis=0), np.nanmax(ys, axis=0), color=color,
+                    alpha=0.15, lw=0)
+
+
 def plot_compare(out: str | Path, task: str | None = None) -> Path:
-    """``compare.png`` / ``compare.csv`` from every ``<algo>_seed<k>`` run below ``out``."""
+    """``compare.png`` / ``compare.csv`` from every ``<algo>_seed<k>`` run below ``out``.
+
+    The figure has the evaluation return (and, where the task reports one, the success rate)
+    against environment steps (left) and against each run's wall time (right; left out when a
+    run's ``progress.csv`` has no wall times): per algorithm a thin line per seed, the mean over
+    seeds and the min-max band."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -135,50 +163,49 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
         by_algo.setdefault(config["algo"], []).append((config, read_progress(run / "progress.csv")))
     if not by_algo:
         raise FileNotFoundError(f"no runs with a progress.csv below {out}")
-    has_success = any(np.isfinite(p["eval_success_rate"]).any()
-                      for runs in by_algo.values() for _, p in runs)
-    fig, axes = plt.subplots(1, 2 if has_success else 1, figsize=(11 if has_success else 6.5, 4),
+    all_runs = [p for runs in by_algo.values() for _, p in runs]
+    has_success = any(np.isfinite(p["eval_success_rate"]).any() for p in all_runs)
+    has_wall = all("wall_time_s" in p and np.isfinite(p["wall_time_s"]).all() for p in all_runs)
+    xaxes = [("timesteps", 1.0, "environment steps")]
+    if has_wall:
+        unit, secs = _wall_unit(max(p["wall_time_s"][-1] for p in all_runs))
+        xaxes.append(("wall_time_s", secs, f"wall time ({unit})"))
+    ys = [("eval_return_mean", 1.0, "episode return")]
+    if has_success:
+        ys.append(("eval_success_rate", 100.0, "success (%)"))
+    fig, axes = plt.subplots(len(ys), len(xaxes), figsize=(5.5 * len(xaxes), 4 * len(ys)),
                              squeeze=False)
     rows = []
     fields = ["algo", "seed", *PROGRESS_FIELDS]
-    for runs in by_algo.values():
-        for _, p in runs:
-            fields += [k for k in p if k not in fields]
+    for p in all_runs:
+        fields += [k for k in p if k not in fields]
     for algo, runs in sorted(by_algo.items()):
         color = COLORS.get(algo, None)
-        end = min(p["timesteps"][-1] for _, p in runs)
-        grid = np.unique(np.concatenate([p["timesteps"][p["timesteps"] <= end] for _, p in runs]))
-        for key, ax, scale in (("eval_return_mean", axes[0, 0], 1.0),
-                               ("eval_success_rate", axes[0, 1] if has_success else None, 100.0)):
-            if ax is None:
-                continue
-            ys = np.array([np.interp(grid, p["timesteps"], p[key]) for _, p in runs]) * scale
-            for y in ys:
-                ax.plot(grid, y, color=color, alpha=0.25, lw=0.8)
-            ax.plot(grid, np.nanmean(ys, axis=0), color=color, lw=2,
-                    label=f"{algo.upper()} ({len(runs)} seeds)")
-            ax.fill_between(grid, np.nanmin(ys, axis=0), np.nanmax(ys, axis=0), color=color,
-                            alpha=0.15, lw=0)
+        for i, (key, scale, _) in enumerate(ys):
+            for j, (xkey, xscale, _) in enumerate(xaxes):
+                _curves(axes[i, j], runs, xkey, xscale, key, scale, color,
+                        f"{algo.upper()} ({len(runs)} seeds)")
         for config, p in runs:
-            for i in range(len(p["timesteps"])):
+            for k in range(len(p["timesteps"])):
                 rows.append({"algo": algo, "seed": config["seed"],
-                             **{k: p[k][i] for k in p}})
+                             **{name: p[name][k] for name in p}})
     first = next(iter(by_algo.values()))[0][0]
     task = task or first["task"]
     if first.get("mode"):
         task = f"{task} ({first['mode']}, mean over agents)"
     fig.suptitle(task)
-    axes[0, 0].set_title("evaluation return (mean over seeds, min-max band)", fontsize=10)
-    axes[0, 0].set_xlabel("environment steps")
-    axes[0, 0].set_ylabel("episode return")
+    for i, (key, _, ylabel) in enumerate(ys):
+        what = "evaluation return" if key == "eval_return_mean" else "evaluation success rate"
+        for j, (_, _, xlabel) in enumerate(xaxes):
+            ax = axes[i, j]
+            ax.set_title(f"{what} (mean over seeds, min-max band)" if (i, j) == (0, 0)
+                         else what, fontsize=10)
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(ylabel)
+            ax.grid(alpha=0.3)
+            if key == "eval_success_rate":
+                ax.set_ylim(-5, 105)
     axes[0, 0].legend(loc="best", fontsize=8)
-    axes[0, 0].grid(alpha=0.3)
-    if has_success:
-        axes[0, 1].set_title("evaluation success rate", fontsize=10)
-        axes[0, 1].set_xlabel("environment steps")
-        axes[0, 1].set_ylabel("success (%)")
-        axes[0, 1].set_ylim(-5, 105)
-        axes[0, 1].grid(alpha=0.3)
     fig.tight_layout()
     png = out / "compare.png"
     fig.savefig(png, dpi=110)
@@ -189,4 +216,3 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
         for r in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
     return png
-
