@@ -7,7 +7,10 @@
 | controls | the torque becomes the agent's controls ``u = tau / T_max``, clipped to [-1, 1] |
 | acts through | the agent's own motors only (no state writes, no model edits); it reads the state (joint angles, velocities, Jacobians) |
 
-Spring-damper motors only (the standup task's actuation).
+Spring-damper motors only (the standup task's actuation); both hand versions. Measured
+(``python tests/tasks/test_standup.py 20``): 20/20 seeded episodes succeed (the head 22.8 cm up
+and held; it passes 20 cm after 0.58 s), return 226.6; with the start perturbation 10 times
+the task's (``task_options={"perturbation": 0.1}``) 10/10, the head 21.3-22.8 cm up.
 """
 
 from __future__ import annotations
