@@ -196,7 +196,7 @@ def add_parser(subparsers) -> None:
     _common(p, steps_required=False)
     p.add_argument("--steps-per-algo", default=None, metavar="ALGO=STEPS,...",
                    help="a step budget per algorithm over --steps, e.g. ppo=100000,sac=20000 "
-                   "(SAC costs about 10x more per step)")
+                   "(SAC costs far more per step than PPO)")
     p.add_argument("--algos", default="ppo,sac", help="comma-separated: ppo,sac")
     p.add_argument("--seeds", type=int, default=3, help="seeds 0 .. n-1 per algorithm")
     p.add_argument("--out", required=True, help="output directory (one sub-directory a run)")
