@@ -1,24 +1,26 @@
-"""Catch (paper Sec. VI-A): a ball falls onto the infant's open right hand; grasp it and hold it.
+"""Catch (paper Sec. VI-A, "Catching Objects"): a ball falls onto the infant's open right hand; grasp it and hold it.
 
 | | |
 |---|---|
 | agents | 1 (`infant_0`), five-fingered hands, muscle actuation |
-| body | standing, hip fixed; the right arm held stretched forward (shoulder 92, 44, -99 deg, elbow -30 deg), palm up; the thumb held at its rest angles; everything else held except the right wrist and fingers; head and eyes fixate the ball (set each control step) |
-| scene | a ball: radius U(0.5, 2.5) cm, mass U(0.05, 0.5) kg, dropped from 9 cm (+-8 cm) above the palm surface, +-1 cm sideways |
-| reset | the wrist turned palm up (rotation -65 deg); 50 physics steps without gravity and without the ball settle the hand; then the ball is placed, at rest |
+| body | standing, hip fixed; the right arm held stretched forward (shoulder 92, 44, -99 deg, elbow -30 deg), palm up; the thumb held at its rest angles (to the side); everything else held except the right wrist and fingers; head and eyes fixate the ball (set each control step) |
+| scene | a ball: radius U(0.5, 2.5) cm, mass U(0.05, 0.5) kg, dropped from 9 cm (+-8 cm) above the palm surface, +-1 cm sideways (drawn each episode) |
+| reset | the wrist turned palm up (rotation -65 deg); 50 physics steps without gravity and without the ball settle the hand; then the muscles are set to hold the hand there against gravity (activations and controls: the agonists' static activations, 0 to 2.5 % here, see :func:`~mimo_social.partners.controllers.catch.torque_controls`; the learner's first action then keeps or changes them); then the ball is placed, at rest |
 | action | 40 muscle controls in [0, 1]: a negative and a positive muscle for each of the right wrist's 3 axes and the 17 finger joints other than the thumb's (with `actuation="spring_damper"`: 20 motors in [-1, 1]) |
-| observation | `proprioception` (196), `touch` (1702: the right arm's and hand's skin only, at the published spacing; the normal force only, 1 float a point), `ball_size` (1: radius, m) |
-| reward | `-100` when the ball falls more than 10 cm below the palm centre or goes more than 0.5 m from it; `+100` once the hand has touched the ball for 1 s without a break; otherwise `N_c - c_w(a)`: the number of the infant's body parts touching the ball minus the weighted muscle cost (paper eq. for muscles; `cost_weight` scales it) |
-| success | the hand has touched the ball for 1 s without a break (`is_success`) |
-| termination | on success (held 1 s) or failure (dropped); truncation at 800 steps |
-| infos | `is_success`, `dropped`, `parts_touching` (N_c), `held_steps`, `ball_radius`, `ball_mass` |
+| observation | `proprioception` (196, the muscles' activations included), `touch` (1702: the right arm's and hand's skin only, at the published spacing; the normal force only, 1 float a point), `ball_size` (1: radius, m) |
+| reward | `-100` (`failure_reward`) when the ball falls more than 10 cm below the palm centre or goes more than 0.5 m from it; on success `+100 + 1 x` the steps left (this one included; `success_reward`, `contact_reward`, `pay_remaining`); otherwise `1 - c_w(a)`: `contact_reward` (1) while any part of the infant touches the ball, 0 when none does, minus the weighted muscle cost (paper eq. for muscles; `cost_weight` 1) |
+| success | the right hand has touched the ball for 1 s (100 steps) without a break (`is_success`) |
+| termination | on success (held 1 s) or failure (dropped); truncation at 800 steps; `env.dt` 0.01 s (2 physics steps of 5 ms) |
+| infos | `is_success`, `dropped`, `parts_touching` (the paper's N_c: the infant's body parts touching the ball), `held_steps`, `ball_radius`, `ball_mass` |
 | privileged cues | the task points the head and eyes at the ball every control step (its position reaches the learner as its own head and eye angles); `ball_size` gives the ball's radius directly |
-| baselines | PPO, 3 seeds, 31k steps each (1.4-2.6 min a run): evaluation return -87 -> -52 / -62 / -76 (the ball kept 50-64 steps instead of ~50), no success (`mimo-social compare --task catch --algos ppo --seeds 3 --steps 30000 --out runs/catch --jobs 2 --eval-every 3000 --eval-episodes 5 --checkpoint-every 0`). SAC, 3 seeds, 5k steps each (7-14 min a run): noisy, -90 .. +240 on 5 episodes, occasional successes (up to 2 of 5), final -52 / -78 / -88 (`mimo-social compare --task catch --algos sac --seeds 3 --steps 5000 --out runs/catch --jobs 2 --eval-every 500 --eval-episodes 5 --checkpoint-every 0`) |
-| sources | the MIMo paper (Mattern et al.), Sec. VI-A: the catching demo |
-| version history | v0: first version, with the paper's other one-agent demos (stand up, self-body touch) |
+| differences from the paper | (1) the paper's text pays `N_c`, the number of primitives touching the ball, each step; the published code pays +1 a step in contact: we pay +1 (the code), because `N_c` made holding without finishing the optimum (summed `N_c` of the controller holding the ball a whole episode without the success: 3,613, against 424 + 100 for its catches; seeds 0-19). (2) the paper pays +100 on success; we add what the best continuation could still collect (1 a step left), so succeeding beats every non-catching continuation by 100 minus the muscle cost (at most 0.025 a step) -- without it, holding 99 steps, letting go and catching again would pay ~800 against ~200 for a success; `pay_remaining=False` gives the paper's +100. (3) the paper does not say how the episode starts; at zero activation the wrist sags (measured by a reviewer: 74 deg in 0.6 s) and the ball rolls off before a finger can close, so the episode starts with the muscles holding the hand (the reset row). (4) the arm's angles (92, 44, -99, -30 deg) differ from the published (97, 46, -92, -23) by up to 7 deg; kept from v0 (the palm faces up with the wrist at -65 deg), not re-measured against the published posture |
+| baselines | seeds 0-19, the policies of `tests/tasks/test_catch.py` (`pytest tests/tasks/test_catch.py -m 'slow or not slow'`, ~15 s): the scripted :class:`~mimo_social.partners.controllers.catch.CatchController` (a cupped palm held by PD through the muscles, fingers closing on touch) succeeds in 20 of 20, return 882 +- 8 (seeds 0-99: 99 of 100); uniform random controls each step 0 of 20, return -85 (0 of 100); smooth random actions (`core.random_actions`, seeds 2000-2019) 1 of 20, -33; zero action 0 of 20, -91 (0 of 100); keeping the start controls 0 of 20, -87 (0 of 100); holding the ball all episode without the success (the controller with `hold_time` 9 s) 782 +- 8; the controller under the paper's +100 alone (`pay_remaining=False`) 201. Trained PPO/SAC: not yet measured for this version |
+| sources | the MIMo paper (Mattern et al.), Sec. VI-A: the catching demo; the published task's settings (`mimo-figures.md`, MIMoCatch-v0) |
+| version history | v0: first version, with the paper's other one-agent demos (stand up, self-body touch); v0, issue 14: reward +1 a step in contact (not `N_c`), success pays the steps left, the episode starts with the muscles holding the hand, scripted controller |
 
 `c_w(a) = sum(a_i^2 fmax_i) / (N sum fmax_i)` is at most `1/N` = 0.025 here; the published code
-scaled it by 40 (`task_options={"cost_weight": 40}`).
+scaled it by 40 (`task_options={"cost_weight": 40}`). Succeeding is the return optimum while
+`cost_weight x 0.025 x 800 < success_reward`, i.e. `cost_weight` < 5.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from ..body.tables import load_body, subtree
 from ..core.kinematics import Gaze, hand_geoms
 from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
+from ..partners.controllers.catch import torque_controls
 from .common import geoms_touching, parts_outside, settle
 
 ARM_DEG = {"right_shoulder_horizontal": 92.0, "right_shoulder_abduction": 44.0,
@@ -58,7 +61,9 @@ def touch_exclude(tables) -> tuple[str, ...]:
 @dataclass(frozen=True)
 class CatchOptions(TaskOptions):
     """Ball radius and mass ranges (drawn each episode), drop height above the palm and position
-    noise (m), hold time (s), failure margins (m), rewards, muscle cost weight, settling steps."""
+    noise (m), hold time (s), failure margins (m), rewards (``pay_remaining``: the success also
+    pays ``contact_reward`` for each step left), muscle cost weight, settling steps, and whether
+    the muscles start holding the hand (``hold_start``)."""
 
     task = "catch"
     radius: tuple[float, float] = (0.005, 0.025)
@@ -70,6 +75,9 @@ class CatchOptions(TaskOptions):
     max_distance: float = 0.5
     success_reward: float = 100.0
     failure_reward: float = -100.0
+    contact_reward: float = 1.0
+    pay_remaining: bool = True
+    hold_start: bool = True
     cost_weight: float = 1.0
     settle_steps: int = 50
 
@@ -86,6 +94,9 @@ class CatchOptions(TaskOptions):
         self._number("max_distance", 0.0, 5.0)
         self._number("success_reward")
         self._number("failure_reward")
+        self._number("contact_reward", 0.0)
+        self._bool("pay_remaining")
+        self._bool("hold_start")
         self._number("cost_weight", 0.0)
         self._int("settle_steps", 0, 10_000)
 
@@ -158,6 +169,23 @@ class Catch(Task):
         m.body_inertia[b] = 0.4 * mass * radius * radius
         self._radius, self._mass = float(radius), float(mass)
 
+    def hold_hand(self, env) -> None:
+        """Set the agent's controls (and, for muscles, their activations) to those that hold
+        the wrist and fingers where they are against gravity and the joints' springs (static:
+        :func:`~mimo_social.partners.controllers.catch.torque_controls` of MuJoCo's bias force)."""
+        w = env.world
+        m, d = w.model, w.data
+        a = w.agents[0]
+        act = env.actuation[0]
+        mujoco.mj_forward(m, d)
+        jk = a.actuated_joint_idx
+        dadr = a.dof_adr[jk]
+        u = torque_controls(act, d.qpos[a.qpos_adr[jk]], d.qfrc_bias[dadr] - d.qfrc_spring[dadr])
+        env.controls[0][:] = u
+        act.apply(m, d, env.controls[0])
+        if hasattr(act, "activation"):
+            act.activation[:] = u.reshape(act.activation.shape)
+
     def place_ball(self, env, position) -> None:
         """Put the ball at a world position, at rest."""
         env.world.place_prop("ball", position)
@@ -170,6 +198,8 @@ class Catch(Task):
         d.qpos[self._wrist_q] = self._wrist_start
         self.place_ball(env, PARKED)
         settle(env, o.settle_steps, gravity=False)
+        if o.hold_start:
+            self.hold_hand(env)
         r = rng.uniform(*o.radius)
         self.set_ball(env, r, rng.uniform(*o.mass))
         palm = d.site_xpos[self._palm].copy()
@@ -177,7 +207,7 @@ class Catch(Task):
         height = r + self._half_thickness + o.drop_height
         self.place_ball(env, palm + np.array([0.0, 0.0, height]) + noise)
         self._held = 0
-        self._hold_steps = max(1, int(round(o.hold_time / env.dt)))
+        self._hold_steps = max(1, round(o.hold_time / env.dt))
         self._success = self._dropped = False
         self._n_touch = 0
         self._size = np.array([self._radius], np.float32)
@@ -185,6 +215,9 @@ class Catch(Task):
 
     def before_physics(self, env):
         w = env.world
+        if w.model.geom_size[self._ball_geom, 0] != self._radius:
+            # a fresh model (an unpickled env is rebuilt from its recipe): the ball drawn at reset
+            self.set_ball(env, self._radius, self._mass)
         self._gaze(w.model, w.data, "body", self._ball_body)
 
     def observe(self, env, i):
@@ -213,9 +246,11 @@ class Catch(Task):
         if self._dropped:
             return np.array([o.failure_reward])
         if self._success:
-            return np.array([o.success_reward])
+            left = env.max_steps - env.steps + 1 if o.pay_remaining else 0
+            return np.array([o.success_reward + o.contact_reward * max(left, 0)])
         cost = env.actuation[0].weighted_cost(env.controls[0])
-        return np.array([self._n_touch - o.cost_weight * cost])
+        touch = o.contact_reward if self._n_touch else 0.0
+        return np.array([touch - o.cost_weight * cost])
 
     def terminations(self, env):
         return (np.array([self._success or self._dropped]),
