@@ -1,0 +1,101 @@
+"""Self-body touch (paper Sec. "Self-body knowledge"): the table's constants, the reward, the
+scripted controller, and what random, zero and parking policies score."""
+
+import numpy as np
+import pytest
+
+from mimo_social.envs import selfbody_v0
+from mimo_social.partners.controllers.selfbody import SelfBodyController
+from mimo_social.tasks import selfbody as task
+
+A = "infant_0"
+
+
+def _episode(policy, seed, **kw):
+    env = selfbody_v0.parallel_env(**kw)
+    obs, _ = env.reset(seed=seed)
+    space = env.action_space(A)
+    space.seed(seed)
+    if isinstance(policy, SelfBodyController):
+        policy.reset(env, A, np.random.default_rng(seed))
+    ret, ok = 0.0, False
+    while env.agents:
+        a = policy.act(env, A, obs[A]) if isinstance(policy, SelfBodyController) \
+            else policy(space)
+        obs, r, _, _, info = env.step({A: a})
+        ret += float(r[A])
+        ok = info[A]["is_success"]
+    env.close()
+    return ok, ret
+
+
+def test_constants_equal_the_table():
+    env = selfbody_v0.parallel_env()
+    assert env.dt == pytest.approx(0.005) and env.frame_skip == task.FRAME_SKIP == 1
+    assert env.max_steps == task.MAX_STEPS == 500
+    o = env.task.options
+    assert (o.success_reward, o.miss_reward, o.other_touch_cost) == (500.0, -1.0, 0.0)
+    for row in ("| physics | one physics step (5 ms)", "truncation at 500 steps", "`+500`",
+                "`-1`"):
+        assert row in task.__doc__
+    # the targets: the body's primitives (geoms), not the right arm's own nor the eyes
+    assert len(env.task.targets) == 28 and "left_shin" in env.task.targets
+    assert not any(t.startswith("right_") and ("arm" in t or "palm" in t or "finger" in t)
+                   for t in env.task.targets)
+    assert env.observation_space(A)["target"].shape == (28,)
+    env.close()
+
+
+def test_touching_the_target_primitive_pays_500_and_ends():
+    env = selfbody_v0.parallel_env(task_options={"target": "right_upper_leg"})
+    env.reset(seed=0)
+    assert env.task.place_hand_on(env, "right_upper_leg") <= 0.0
+    _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
+    assert rew[A] == 500.0 and term[A] and infos[A]["is_success"]
+    assert infos[A]["target_part"] == "right_upper_leg"
+    env.close()
+
+
+def test_another_primitive_costs_its_distance_and_no_touch_minus_one():
+    env = selfbody_v0.parallel_env(task_options={"target": "head"})
+    env.reset(seed=0)
+    _, rew, _, _, infos = env.step({A: np.zeros(8, np.float32)})
+    assert rew[A] == -1.0 and infos[A]["touched"] == []
+    assert env.task.place_hand_on(env, "right_upper_leg") <= 0.0
+    _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
+    assert not term[A] and "right_upper_leg" in infos[A]["touched"]
+    assert -1.0 < rew[A] < -0.1 and rew[A] == pytest.approx(-infos[A]["distance"])
+    env.close()
+    cost = selfbody_v0.parallel_env(task_options={"target": "head", "other_touch_cost": 1.0})
+    cost.reset(seed=0)
+    cost.task.place_hand_on(cost, "right_upper_leg")
+    _, rew, _, _, infos = cost.step({A: np.zeros(8, np.float32)})
+    assert rew[A] == pytest.approx(-1.0 - infos[A]["distance"])
+    cost.close()
+
+
+def test_controller_touches_easy_targets_fast():
+    # fast variant: 3 fixed targets (all touched when measured); bound: 2 of 3
+    hits = sum(_episode(SelfBodyController(), 0, task_options={"target": t})[0]
+               for t in ("head", "left_fingers", "right_shin"))
+    assert hits >= 2
+
+
+@pytest.mark.slow
+def test_controller_succeeds_in_80_percent_of_20_episodes_and_parking_scores_less():
+    out = [_episode(SelfBodyController(), s) for s in range(20)]
+    rate = np.mean([ok for ok, _ in out])
+    ret = np.mean([r for _, r in out])
+    assert rate >= 0.8
+    # the hack: park the hand on the thigh whatever the target is
+    park = [_episode(SelfBodyController(target="right_upper_leg"), s) for s in range(20)]
+    park_ret = np.mean([r for ok, r in park])
+    assert park_ret < ret
+
+
+@pytest.mark.parametrize("name, policy", [
+    ("random", lambda space: space.sample()),
+    ("zero", lambda space: np.zeros(8, np.float32))])
+def test_random_and_zero_do_not_succeed(name, policy):
+    out = [_episode(policy, s) for s in range(5)]
+    assert np.mean([ok for ok, _ in out]) <= 0.2
