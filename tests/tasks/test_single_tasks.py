@@ -28,7 +28,7 @@ def test_spaces_of_the_published_tasks():
     assert sb.action_space(A).shape == (8,) and sb.max_steps == 500
     obs = sb.observation_space(A).spaces
     assert set(obs) == {"proprioception", "touch", "target"}
-    assert obs["target"].shape == (len(sb.task.targets),) == (15,)
+    assert obs["target"].shape == (len(sb.task.targets),) == (28,)
     ca = catch_v0.parallel_env()
     assert ca.action_space(A).shape == (40,) and ca.max_steps == 800   # 20 axes x 2 muscles
     assert float(ca.action_space(A).low.min()) == 0.0 and float(ca.action_space(A).high.max()) == 1.0
