@@ -1,4 +1,4 @@
-"""Catch (paper Sec. VI-A, "Catching Objects"): a ball falls onto the infant's open right hand; grasp it and hold it.
+"""Catch (paper Sec. VI-A): a ball falls onto the infant's open right hand; grasp it and hold it.
 
 | | |
 |---|---|
