@@ -135,24 +135,18 @@ class World:
         self.names = [f"infant_{i}" for i in range(len(agents))]
         self._build()
 
-    # -- pickling: rebuild from the recipe (MuJoCo objects are not kept in the pickle) --------
-    _STATE = mujoco.mjtState.mjSTATE_INTEGRATION  # everything mj_step reads, warm start included
-
+    # -- pickling: the recipe rebuilds the index tables; MjData (with its model) travels whole --
     def __getstate__(self):
-        m, d = self.model, self.data
-        full = np.empty(mujoco.mj_stateSize(m, self._STATE))
-        mujoco.mj_getState(m, d, full, self._STATE)
-        return {"recipe": self._recipe, "state": full, "mat_texid": m.mat_texid.copy(),
-                "eq_data": m.eq_data.copy(), "bad_count": self._bad_count}
+        # MjData pickles with its model: every model field a task changed (a ball's size and
+        # mass, weld and contact settings) and every quantity of the last step (qfrc_bias,
+        # contacts, the solver's warm start) travel, so a copy continues exactly.
+        return {"recipe": self._recipe, "data": self.data, "bad_count": self._bad_count}
 
     def __setstate__(self, state):
-        self.__init__(*state["recipe"])
-        mujoco.mj_setState(self.model, self.data, state["state"], self._STATE)
-        self.model.mat_texid[:] = state["mat_texid"]
-        if "eq_data" in state:
-            self.model.eq_data[:] = state["eq_data"]
+        self.__init__(*state["recipe"])   # the index tables, faces and spec of the recipe
+        self.data = state["data"]
+        self.model = self.data.model
         self._bad_count = state["bad_count"]
-        mujoco.mj_forward(self.model, self.data)
 
     # -- building ------------------------------------------------------------------------------
     def _build(self):

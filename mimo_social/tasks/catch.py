@@ -216,9 +216,6 @@ class Catch(Task):
 
     def before_physics(self, env):
         w = env.world
-        if w.model.geom_size[self._ball_geom, 0] != self._radius:
-            # a fresh model (an unpickled env is rebuilt from its recipe): the ball drawn at reset
-            self.set_ball(env, self._radius, self._mass)
         self._gaze(w.model, w.data, "body", self._ball_body)
 
     def observe(self, env, i):

@@ -135,6 +135,7 @@ class Reach(Task):
         """Hold the ball at a world position for the rest of the episode (for tests and
         demonstrations; kinematics updated, the head and eyes turned to it)."""
         self.ball_position = np.array(position, dtype=float)
+        self._place(env.world.model, env.world.data, self.ball_position)
         self.before_physics(env)
 
     def _in_reach(self, m, d, shoulder, ball) -> bool:
@@ -157,9 +158,6 @@ class Reach(Task):
 
     def before_physics(self, env):
         w = env.world
-        # the ball's place is a model value: set it again every step, so a pickled copy of the
-        # env (which rebuilds the model) holds the ball where this episode put it
-        w.model.body_pos[self._ball_body] = self.ball_position
         self._gaze(w.model, w.data, "body", self._ball_body)
 
     def rewards(self, env):

@@ -226,19 +226,13 @@ class Standup(Task):
         self._hold_steps = max(1, round(self.options.success_hold / env.dt))
 
     def _model_settings(self, env):
-        """The model values the task sets (a pickled world rebuilds its model from the spec, so
-        they are checked before every step and made again when missing)."""
+        """The model values the task sets at reset (a pickled env carries them: its MjData
+        travels with its model)."""
         m = env.world.model
         # the rail only shows where the hands hold on (they are welded to it): it takes no
         # contacts, so the gripping hands never fight it
         m.geom_contype[self._rail] = m.geom_conaffinity[self._rail] = 0
         m.eq_solref[env.world.welds[:, 0]] = WELD_SOLREF  # stiffer than MuJoCo's default 0.02 s
-
-    def before_physics(self, env):
-        m = env.world.model
-        if m.geom_contype[self._rail] != 0 or m.eq_solref[env.world.welds[0, 0], 0] \
-                != WELD_SOLREF[0]:
-            self._model_settings(env)
 
     def rewards(self, env):
         d = env.world.data

@@ -20,25 +20,10 @@ from mimo_social.envs.catalog import CATALOG
 
 SHORT = 30   # max_steps of the API checks: a few episodes end within their cycles
 
-# Why a pickled copy steps on differently (real bugs of the envs, found by test_pickle_mid_episode):
-_STALE = ("the env steps with mj_step + mj_kinematics, so the qfrc_bias / qfrc_spring the next "
-          "step reads are those of the state before the last integration; World.__setstate__ "
-          "runs mj_forward, which recomputes them at the current state, so the copy's next "
-          "control differs")
-_RESET_MODEL = ("model values the task sets at reset are not in the pickle (World.__setstate__ "
-                "rebuilds the model and restores only mat_texid and eq_data)")
-
-#: (check, env name, form) -> why that check fails for a real bug of the env (strict xfail)
-KNOWN_BUGS: dict[tuple[str, str, str], str] = {
-    ("pickle", "joint_attention", "parallel"):
-        _STALE + " (the task's head gravity compensation reads qfrc_bias before the step)",
-    ("pickle", "joint_attention", "scripted"):
-        _STALE + " (the task's head gravity compensation reads qfrc_bias before the step)",
-    ("pickle", "high_five", "scripted"):
-        _STALE + " (its scripted partner, a HandOffer, compensates qfrc_bias / qfrc_spring)",
-    ("pickle", "handover", "scripted"):
-        _STALE + " (HandOffer's PD controller compensates qfrc_bias / qfrc_spring)",
-}
+#: (check, env name, form) -> why that check fails for a real bug of the env (strict xfail);
+#: empty now: the pickled copies of standup, catch, joint attention and the HandOffer partner
+#: stepped on differently until World pickled its MjData (with its model) whole
+KNOWN_BUGS: dict[tuple[str, str, str], str] = {}
 
 
 def _cases(check, entries=CATALOG, forms=("parallel",)):
