@@ -52,7 +52,7 @@ def test_touching_the_target_primitive_pays_500_and_ends():
     assert env.task.place_hand_on(env, "right_upper_leg") <= 0.0
     _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
     assert rew[A] == 500.0 and term[A] and infos[A]["is_success"]
-    assert infos[A]["target_part"] == "right_upper_leg"
+    assert infos[A]["target_part"] == "right_upper_leg" and env.agents == []
     env.close()
 
 
@@ -99,3 +99,16 @@ def test_controller_succeeds_in_80_percent_of_20_episodes_and_parking_scores_les
 def test_random_and_zero_do_not_succeed(name, policy):
     out = [_episode(policy, s) for s in range(5)]
     assert np.mean([ok for ok, _ in out]) <= 0.2
+
+
+def test_the_target_is_drawn_per_episode_and_shown_one_hot():
+    env = selfbody_v0.parallel_env()
+    seen = set()
+    for s in range(12):
+        obs, _ = env.reset(seed=s)
+        assert obs[A]["target"].sum() == 1.0
+        k = int(np.argmax(obs[A]["target"]))
+        assert env.task.targets[k] == env.task.target
+        seen.add(k)
+    assert len(seen) >= 5
+    env.close()
