@@ -44,44 +44,6 @@ def test_spaces_of_the_published_tasks():
 # -- standup: tests/tasks/test_standup.py -----------------------------------------------
 
 
-# -- selfbody ---------------------------------------------------------------------------------
-def test_selfbody_touching_the_target_ends_with_500():
-    env = selfbody_v0.parallel_env(task_options={"target": "right_upper_leg"})
-    obs, _ = env.reset(seed=0)
-    k = env.task.targets.index("right_upper_leg")
-    assert obs[A]["target"][k] == 1.0 and obs[A]["target"].sum() == 1.0
-    _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
-    assert rew[A] == -1.0 and not term[A] and infos[A]["touched"] == []   # starts touching nothing
-    gap = env.task.place_hand_on(env, "right_upper_leg")
-    assert gap <= 0.0
-    _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
-    assert rew[A] == 500.0 and term[A] and infos[A]["is_success"]
-    assert "right_upper_leg" in infos[A]["touched"]
-    assert env.agents == []
-    env.close()
-
-
-def test_selfbody_touching_another_part_costs_the_distance_to_the_target():
-    env = selfbody_v0.parallel_env(task_options={"target": "head"})
-    env.reset(seed=0)
-    assert env.task.place_hand_on(env, "right_upper_leg") <= 0.0
-    _, rew, term, _, infos = env.step({A: np.zeros(8, np.float32)})
-    assert not term[A] and not infos[A]["is_success"]
-    assert "right_upper_leg" in infos[A]["touched"] and "head" not in infos[A]["touched"]
-    assert -1.0 < rew[A] < -0.1 and rew[A] == pytest.approx(-infos[A]["distance"])
-    env.close()
-
-
-def test_selfbody_samples_the_target_per_episode():
-    env = selfbody_v0.parallel_env()
-    seen = set()
-    for s in range(12):
-        obs, _ = env.reset(seed=s)
-        seen.add(int(np.argmax(obs[A]["target"])))
-    assert len(seen) >= 5
-    env.close()
-
-
 def test_reach_is_unchanged():
     env = reach_v0.parallel_env()
     obs, _ = env.reset(seed=0)
