@@ -1,4 +1,4 @@
-"""Self-body touch (paper Sec. VI-A "Self-body knowledge"): a cross-legged infant touches a named primitive of its own body.
+"""Self-body touch (paper Sec. VI-A): a cross-legged infant touches a primitive of its own body.
 
 | | |
 |---|---|
