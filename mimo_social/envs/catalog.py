@@ -13,6 +13,8 @@ from dataclasses import dataclass
 from types import ModuleType
 
 from ..core.gym_adapter import SingleAgentEnv
+from ..partners.controllers import (CatchController, ReachController, SelfBodyController,
+                                    StandupController)
 from . import (catch_v0, free_play_v0, handover_v0, high_five_v0, joint_attention_v0, mirror_v0,
                reach_v0, selfbody_v0, social_touch_v0, standup_v0)
 
@@ -67,13 +69,17 @@ CATALOG: tuple[EnvEntry, ...] = (
     EnvEntry("free_play", free_play_v0, "mimo_social/FreePlay-v0", "sandbox",
              "infants (1-8) on the floor, optional props, no goal", (("n_agents", 1),)),
     EnvEntry("reach", reach_v0, "mimo_social/Reach-v0", "one-agent",
-             "reach a ball in front of the body with the right hand"),
+             "reach a ball in front of the body with the right hand",
+             controller=ReachController),
     EnvEntry("standup", standup_v0, "mimo_social/Standup-v0", "one-agent",
-             "stand up from a crouch holding a crib rail"),
+             "stand up from a crouch holding a crib rail",
+             controller=StandupController),
     EnvEntry("selfbody", selfbody_v0, "mimo_social/SelfBody-v0", "one-agent",
-             "touch a named part of one's own body"),
+             "touch a named primitive of one's own body with the right hand",
+             controller=SelfBodyController),
     EnvEntry("catch", catch_v0, "mimo_social/Catch-v0", "one-agent",
-             "catch a falling ball and hold it"),
+             "catch a falling ball and hold it",
+             controller=CatchController),
     EnvEntry("high_five", high_five_v0, "mimo_social/HighFive-v0", "social",
              "two infants meet with their right hands"),
     EnvEntry("mirror", mirror_v0, "mimo_social/Mirror-v0", "social",

@@ -42,7 +42,9 @@ def test_overview_reads_the_task_classes():
     table = task_docs.overview_table()
     assert "| `mimo_social.envs.standup_v0` |" in table
     standup = next(line for line in table.splitlines() if "standup_v0" in line)
-    assert "5 ms (`frame_skip=1`)" in standup and "500 steps (2.5 s)" in standup
+    assert "| 10 ms |" in standup and "500 steps (5 s)" in standup
+    selfbody = next(line for line in table.splitlines() if "selfbody_v0" in line)
+    assert "5 ms (`frame_skip=1`)" in selfbody and "500 steps (2.5 s)" in selfbody
     free_play = next(line for line in table.splitlines() if "free_play_v0" in line)
     assert "1-8 (default 2; Gymnasium id: 1)" in free_play
 

@@ -6,3 +6,10 @@ space, exactly as a learner would (no ``qpos`` writes). The catalogue names each
 controller (``entry.controller``); ``mimo-social baselines TASK`` measures it beside random,
 zero-action and trained policies.
 """
+
+from .catch import CatchController
+from .reach import ReachController
+from .selfbody import SelfBodyController
+from .standup import StandupController
+
+__all__ = ["CatchController", "ReachController", "SelfBodyController", "StandupController"]
