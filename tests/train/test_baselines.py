@@ -39,20 +39,20 @@ def test_cli_prints_the_table_with_a_row_per_policy_and_writes_markdown_and_json
     out = capsys.readouterr().out
     assert "reach: 2 episodes per policy, seeds 4..5" in out
     assert "| policy | episodes | success | return | length | steps to success |" in out
-    for row in ("| random | 2 |", "| zero | 2 |", "| reach_ppo_s0 (PPO) | 2 |"):
+    for row in ("| random | 2 |", "| zero | 2 |", "| scripted (ReachController) | 2 |",
+                "| reach_ppo_s0 (PPO) | 2 |"):
         assert row in out, row
     assert md.read_text() in out
     res = json.loads(js.read_text())
     assert res["seeds"] == [4, 5] and res["env_kwargs"] == SHORT   # the run's env kwargs
-    assert [p["policy"] for p in res["policies"]] == ["random", "zero", "reach_ppo_s0 (PPO)"]
+    assert [p["policy"] for p in res["policies"]] == ["random", "zero",
+                                                     "scripted (ReachController)",
+                                                     "reach_ppo_s0 (PPO)"]
     for p in res["policies"]:
         assert p["episodes"] == 2 and len(p["returns"]) == 2
         assert all(n <= SHORT["max_steps"] for n in p["lengths"])
-    trained = res["policies"][2]
+    trained = res["policies"][3]
     assert trained["kind"] == "trained" and trained["model"].endswith("model.zip")
-    # the controller is named by the catalogue; a task without one says so
-    if entry("reach").controller is None:
-        assert "no scripted controller" in out
 
 
 def test_random_and_zero_rows_are_deterministic_under_the_seed(run):
