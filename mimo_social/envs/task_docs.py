@@ -99,20 +99,19 @@ in `OUT/compare.csv`; runs of different lengths (e.g. `--algos sac --steps 15000
 
 ## How the baselines were measured
 
-On the shared 2-core development machine, no GPU (other jobs running at the same time; several
-runs two at a time, so wall times are upper bounds). SB3 defaults unless stated; returns are of
-deterministic evaluation episodes. Random baselines sample every action uniformly from the action
-space each step. Success alone can say little (a random policy reaches the ball in most reach
-episodes): the number of steps to success says how well a policy does. The social tasks'
-training runs are collected in `docs/social/README.md`.
+The four paper tasks: `mimo-social baselines TASK --episodes 30 --seed 1000 --run ...` (random,
+zero action, the scripted controller and every trained run on the same 30 seeded episodes) and
+the paper's Fig. 8 from `mimo-social compare` (PPO and SAC, 3 seeds each, SB3 defaults, curves
+over environment steps and over wall time): the tables, figures, budgets and commands are in
+`docs/baselines.md`. Baselines rows above that name `tests/tasks/...` were measured by those
+test files (run them as shown). The machine: the 2-core development machine, no GPU; runs two
+at a time, so wall times are upper bounds. The social tasks' training runs are collected in
+`docs/social/README.md`.
 
-![Reach, PPO seed 0: evaluation return and success rate](training/reach_ppo_seed0.png)
-
-Stand-up and catch, run with `mimo-social compare` (PPO: 3 seeds; SAC: the one stand-up seed
-that fitted the time, 9k steps, taking large controls as in its baselines row):
-
-![Stand-up: PPO (3 seeds) and SAC (1 seed)](training/standup_compare.png)
-![Catch: PPO (3 seeds)](training/catch_compare.png)
+![Reach: PPO and SAC, 3 seeds each](training/fig8_reach.png)
+![Self-body touch: PPO and SAC, 3 seeds each](training/fig8_selfbody.png)
+![Stand-up: PPO and SAC, 3 seeds each](training/fig8_standup.png)
+![Catch: PPO and SAC, 3 seeds each](training/fig8_catch.png)
 """
 
 
