@@ -16,7 +16,7 @@ from gymnasium import spaces
 if TYPE_CHECKING:  # pragma: no cover
     from ..core.env import MimoParallelEnv
 
-__all__ = ["Partner", "Still", "zero_action"]
+__all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop"]
 
 
 def zero_action(space: spaces.Space):
@@ -29,6 +29,28 @@ def zero_action(space: spaces.Space):
     if isinstance(space, spaces.Box):
         return np.clip(np.zeros(space.shape, space.dtype), space.low, space.high)
     raise TypeError(f"no resting action for space {space}")
+
+
+def agent_index(env, agent: str) -> int:
+    """The index of ``agent`` in the env (its world's tables are ``env.world.agents[i]``)."""
+    return env.possible_agents.index(agent)
+
+
+def require_motors(who: str, agent: str, tables, joints, why: str) -> None:
+    """A ValueError naming the partner, the agent and the joints it lacks motors on, unless
+    every joint of ``joints`` is actuated in the agent's action (``tables``: its world index
+    tables); ``why`` says what the partner needs them for."""
+    missing = [n for n in joints if n not in tables.actuated_names]
+    if missing:
+        raise ValueError(f"{who}: {agent} does not actuate {missing}; {why}")
+
+
+def require_prop(who: str, world, prop: str) -> int:
+    """The body id of the prop named ``prop``, or a ValueError naming the props of the world."""
+    if prop not in world.prop_bodies:
+        raise ValueError(f"{who}: prop {prop!r} is not in this env; props: "
+                         f"{sorted(world.prop_bodies)}")
+    return world.prop_bodies[prop]
 
 
 class Partner:

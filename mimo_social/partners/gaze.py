@@ -24,7 +24,7 @@ import numpy as np
 from gymnasium import spaces
 
 from ..core.kinematics import LookAt
-from .base import Partner
+from .base import Partner, agent_index, require_motors
 from .expression import hold_range
 
 __all__ = ["GazeAtTarget", "look_angles"]
@@ -99,16 +99,14 @@ class GazeAtTarget(Partner):
 
     def reset(self, env, agent, rng):
         super().reset(env, agent, rng)
-        i = env.possible_agents.index(agent)
+        i = agent_index(env, agent)
         cfg = env.agent_configs[i]
         if cfg.actuation != "spring_damper":
             raise ValueError(f"GazeAtTarget drives torque motors: {agent} has actuation="
                              f"{cfg.actuation!r}; allowed: 'spring_damper'")
         a = env.world.agents[i]
-        missing = [n for n in NEEDED if n not in a.actuated_names]
-        if missing:
-            raise ValueError(f"GazeAtTarget: {agent} has no motor on {missing}; it turns its head "
-                             "and eyes with its own motors (the task must leave them actuated)")
+        require_motors("GazeAtTarget", agent, a, NEEDED, "it turns its head and eyes with its "
+                       "own motors (the task must leave them actuated)")
         self._found = self._resolve_targets(env)
         self._geo = LookAt(env.world, i)
         self._scratch = mujoco.MjData(env.world.model)

@@ -34,7 +34,7 @@ import numpy as np
 from ..body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ..core.kinematics import hand_geoms
 from ..util.checks import check_number
-from .base import Partner, zero_action
+from .base import Partner, agent_index, require_motors, require_prop, zero_action
 
 __all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]
 
@@ -228,14 +228,12 @@ class HandOffer(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = env.possible_agents.index(agent)
+        i = agent_index(env, agent)
         a = w.agents[i]
         self._i = i
         names = list(a.actuated_names)
-        missing = [n for n in ARM if n not in names]
-        if missing:
-            raise ValueError(f"HandOffer: {agent} does not actuate {missing}; it needs the "
-                             "right arm's motors (shoulder, elbow, wrist) in its action")
+        require_motors("HandOffer", agent, a, ARM,
+                       "it needs the right arm's motors (shoulder, elbow, wrist) in its action")
         jk = a.actuated_joint_idx
         self._qadr = a.qpos_adr[jk]
         self._dadr = a.dof_adr[jk]
@@ -270,10 +268,8 @@ class HandOffer(Partner):
         # who may take the object: the hands of every other agent
         self._object_geom = -1
         if self.release == "on_touch":
-            if self.prop not in w.prop_bodies:
-                raise ValueError(f"HandOffer: prop {self.prop!r} is not in this env; props: "
-                                 f"{sorted(w.prop_bodies)}")
-            self._object_geom = int(np.flatnonzero(m.geom_bodyid == w.prop_bodies[self.prop])[0])
+            body = require_prop("HandOffer", w, self.prop)
+            self._object_geom = int(np.flatnonzero(m.geom_bodyid == body)[0])
             self._others = np.zeros(m.ngeom, bool)
             for j in range(len(w.agents)):
                 if j != i:

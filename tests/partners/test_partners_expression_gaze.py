@@ -195,7 +195,7 @@ def test_gaze_at_target_bad_input():
     with pytest.raises(ValueError, match="'teddy' is neither a body nor a site"):
         env.reset(seed=0)
     env = mirror_v0.scripted_env(GazeAtTarget(), vision=False)
-    with pytest.raises(ValueError, match="no toys|no motor"):
+    with pytest.raises(ValueError, match="no toys|does not actuate"):
         env.reset(seed=0)
     env = joint_attention_v0.scripted_env(GazeAtTarget(), vision=False, actuation="muscle")
     with pytest.raises(ValueError, match="spring_damper"):

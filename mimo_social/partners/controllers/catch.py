@@ -23,7 +23,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, zero_action
+from ..base import Partner, agent_index, require_motors, require_prop, zero_action
 
 __all__ = ["CatchController", "palm_cup_angles", "torque_controls"]
 
@@ -119,16 +119,12 @@ class CatchController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = env.possible_agents.index(agent)
+        i = agent_index(env, agent)
         a = w.agents[i]
         names = list(a.actuated_names)
-        missing = [n for n in RIGHT_WRIST if n not in names]
-        if missing:
-            raise ValueError(f"CatchController: {agent} does not actuate {missing}; it needs the "
-                             "right wrist's and fingers' motors in its action (the catch task)")
-        if self.prop not in w.prop_bodies:
-            raise ValueError(f"CatchController: prop {self.prop!r} is not in this env; props: "
-                             f"{sorted(w.prop_bodies)}")
+        require_motors("CatchController", agent, a, RIGHT_WRIST, "it needs the right wrist's "
+                       "and fingers' motors in its action (the catch task)")
+        require_prop("CatchController", w, self.prop)
         jk = a.actuated_joint_idx
         self._qadr, self._dadr = a.qpos_adr[jk], a.dof_adr[jk]
         self._act = env.actuation[i]

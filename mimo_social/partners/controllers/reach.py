@@ -18,7 +18,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import reach_sites
 from ...util.checks import check_number
-from ..base import Partner, zero_action
+from ..base import Partner, agent_index, require_motors, require_prop, zero_action
 
 __all__ = ["ReachController"]
 
@@ -48,16 +48,12 @@ class ReachController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = env.possible_agents.index(agent)
+        i = agent_index(env, agent)
         a = w.agents[i]
         names = list(a.actuated_names)
-        missing = [n for n in ARM if n not in names]
-        if missing:
-            raise ValueError(f"ReachController: {agent} does not actuate {missing}; it needs "
-                             "the right arm's motors (shoulder, elbow, wrist) in its action")
-        if self.prop not in w.prop_bodies:
-            raise ValueError(f"ReachController: prop {self.prop!r} is not in this env; props: "
-                             f"{sorted(w.prop_bodies)}")
+        require_motors("ReachController", agent, a, ARM,
+                       "it needs the right arm's motors (shoulder, elbow, wrist) in its action")
+        require_prop("ReachController", w, self.prop)
         jk = a.actuated_joint_idx
         self._qadr, self._dadr = a.qpos_adr[jk], a.dof_adr[jk]
         lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]

@@ -20,7 +20,7 @@ import numpy as np
 
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, zero_action
+from ..base import Partner, agent_index, zero_action
 
 __all__ = ["RAISE_DEG", "VARIANTS", "SelfBodyController", "touch_posture"]
 
@@ -192,7 +192,7 @@ class SelfBodyController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = env.possible_agents.index(agent)
+        i = agent_index(env, agent)
         a = w.agents[i]
         name = self.target if self.target is not None else getattr(env.task, "target", None)
         if name is None:

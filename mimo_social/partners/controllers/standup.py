@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from ...util.checks import check_number
-from ..base import Partner, zero_action
+from ..base import Partner, agent_index, zero_action
 
 __all__ = ["STAND_DEG", "StandupController"]
 
@@ -67,7 +67,7 @@ class StandupController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = env.possible_agents.index(agent)
+        i = agent_index(env, agent)
         a = w.agents[i]
         self._act = env.actuation[i]
         if self._act.name == "muscle":
