@@ -213,3 +213,10 @@ if __name__ == "__main__":
         g = np.array([r[2] for r in res])
         print(f"{name:11s} success {rate(res):.2f}  return {mean_return(res):7.1f}  "
               f"final head gain {g.mean():+.3f} m  ({time.time() - t:.1f} s)", flush=True)
+
+
+def test_the_controller_says_it_needs_torque_motors():
+    env = standup_v0.parallel_env(actuation="muscle")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="infant_0 has actuation='muscle'; allowed: 'spring_damper'"):
+        StandupController().reset(env, "infant_0", np.random.default_rng(0))

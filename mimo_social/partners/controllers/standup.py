@@ -71,7 +71,8 @@ class StandupController(Partner):
         a = w.agents[i]
         self._act = env.actuation[i]
         if self._act.name == "muscle":
-            raise ValueError("StandupController: spring-damper motors only (actuation='motor')")
+            raise ValueError(f"StandupController: {agent} has actuation='muscle'; allowed: "
+                             "'spring_damper' (it drives torque motors)")
         names = list(a.actuated_names)
         jk = a.actuated_joint_idx
         self._qadr, self._dadr = a.qpos_adr[jk], a.dof_adr[jk]
