@@ -17,7 +17,7 @@
 | privileged cues | none |
 | baselines | 20 seeded episodes each (seeds 0-19; `python tests/tasks/test_standup.py 20`): `StandupController` (push with the feet, pull on the rail, lean toward straight legs; `mimo_social.partners.controllers.standup`) succeeds in 20/20, return 226.6, the head 22.8 cm up; zero action 0/20, return 131.5 (+1.7 cm); uniform random 0/20, return 36.9 (-11.6 cm); hacks: bang-bang (every motor at +-1, switching every 0.25 s) 0/20, return -3.5; all motors +1: 0/20, return 52.5 (+13.2 cm); all -1: 0/20, return 14.9. `mimo-social baselines standup --episodes 30 --seed 1000 --run <6 runs>` (seeds 1000-1029; docs/baselines.md): scripted 100 %, 226.6; zero 0 %, 131.5; random 0 %, 37.1; PPO (SB3 defaults, 100k steps, 3 seeds) 0 / 0 / 100 %, return 192.5 / 200.4 / 210.4; SAC (10k steps, 3 seeds) 0 / 0 / 0 %, 122.7 / 57.3 / 53.5 |
 | sources | the MIMo paper (Mattern et al.), Sec. VI-A: the standing-up demo; the published code's constants (`mimo-figures.md`: reward `head_z - 0.2 - 0.01 sum ctrl^2`, 10 ms control step, U(+-0.01) start noise, 100 settling steps) |
-| version history | v0: first version, with the paper's other one-agent demos (self-body touch, catch) |
+| version history | v0: first version, with the paper's other one-agent demos (self-body touch, catch); v0, issue 14: 10 ms control step (was 5 ms, 2.5 s episodes), reward from a 0.2 m reference height, success (head 20 cm up held 1 s) in `is_success`, ankle flexion actuated, scripted controller |
 
 Differences from the published task, and why:
 - start: a low squat (hips and knees bent as far as they go, feet flat, buttocks 8 cm above the
