@@ -35,14 +35,25 @@ LIMIT_SOLIMP = (0.98, 0.99, 0.001, 0.5, 1.0)
 LIMIT_SOLREF = (0.02, 1.0)
 
 SKIN_RGBA = (0.94, 0.78, 0.67, 1.0)
-EYE_RGBA = (0.12, 0.08, 0.05, 1.0)
+SCLERA_RGBA = (0.97, 0.96, 0.93, 1.0)
+IRIS_RGBA = (0.36, 0.24, 0.13, 1.0)
+PUPIL_RGBA = (0.04, 0.03, 0.03, 1.0)
+# The visible eyeball (in eye radii r, along the eye's +x, its line of sight): the eye sphere is
+# the white sclera; the iris is a lens-shaped ellipsoid (centre 0.85 r, semi-axes 0.5 r across,
+# 0.19 r deep) whose front bulges out of the sphere as a disc of radius ~0.48 r (a human iris:
+# ~12 of ~24 mm); the pupil a thin disc of radius 0.22 r just on the iris's front. Both are
+# visual only (no contact, no mass, no touch). The eye camera sits just in front of the pupil
+# (EYE_CAMERA_X r), so an eye never sees its own eyeball, iris or pupil.
+IRIS = (0.85, 0.5, 0.19)          # centre x, radius across, half depth (eye radii)
+PUPIL = (1.035, 0.22, 0.012)      # centre x, radius, half thickness (eye radii)
+EYE_CAMERA_X = 1.06
 DEFAULT_CLOTHES_RGBA = (0.35, 0.55, 0.85, 1.0)
 # Segments shown in skin colour (and every segment of the hands below them); the rest wear the
 # agent's clothes colour.
 SKIN_SEGMENTS = {"head", "right_hand", "left_hand", "right_fingers", "left_fingers",
                  "right_lower_arm", "left_lower_arm"}
 EYE_FOVY_DEG = 60.0
-HIDDEN_GROUP = 3  # geom group not drawn by default renderers
+HIDDEN_GROUP = 3  # geom group not drawn by default renderers (no geom of the body uses it now)
 
 
 def axis_angle_quat(axis, angle: float) -> np.ndarray:
@@ -206,9 +217,9 @@ def build_infant(
 
 def _add_geoms(body, segment: str, tables: BodyTables, clothes_rgba, skin) -> None:
     rgba = SKIN_RGBA if segment in skin else clothes_rgba
-    group = 0
-    if segment.endswith("_eye"):  # the face texture draws the visible eyes (with their lids)
-        rgba, group = EYE_RGBA, HIDDEN_GROUP
+    eye = segment.endswith("_eye")
+    if eye:  # the eye sphere is the white of the eye; the iris and pupil are added below
+        rgba = SCLERA_RGBA
     for g in tables.geoms:
         if g.body != segment:
             continue
@@ -220,8 +231,28 @@ def _add_geoms(body, segment: str, tables: BodyTables, clothes_rgba, skin) -> No
         body.add_geom(
             name=g.name, type=gtype, size=size, pos=g.pos, quat=_AXIS_QUATS[g.axis],
             mass=g.mass, friction=g.friction or GEOM_FRICTION, condim=g.condim,
-            solimp=GEOM_SOLIMP, solref=GEOM_SOLREF, rgba=rgba, group=group,
+            solimp=GEOM_SOLIMP, solref=GEOM_SOLREF, rgba=rgba, group=0,
         )
+        if eye:
+            _add_iris_pupil(body, g.name, float(g.size[0]), np.asarray(g.pos, float),
+                            g.friction or GEOM_FRICTION)
+
+
+def _add_iris_pupil(body, eye: str, r: float, centre: np.ndarray, friction) -> None:
+    """The iris and pupil of eye sphere ``eye`` (radius ``r``): visual only, they turn with the
+    eye's joints. No contact (contype = conaffinity = 0), no mass: the body's mass and
+    inertia are those of the tables (the friction, unused, is the eye's, so it scales alike)."""
+    x = centre  # in the eye's frame, whose +x is the line of sight
+    visual = dict(contype=0, conaffinity=0, mass=0.0, density=0.0, group=0,
+                  quat=_AXIS_QUATS["x"], friction=friction)
+    cx, across, depth = IRIS
+    body.add_geom(name=f"{eye}_iris", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID,
+                  size=[across * r, across * r, depth * r], pos=x + [cx * r, 0.0, 0.0],
+                  rgba=IRIS_RGBA, **visual)
+    cx, radius, half = PUPIL
+    body.add_geom(name=f"{eye}_pupil", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                  size=[radius * r, half * r, 0.0], pos=x + [cx * r, 0.0, 0.0],
+                  rgba=PUPIL_RGBA, **visual)
 
 
 def _add_sites_cameras_sensors(spec, bodies, tables: BodyTables) -> None:
@@ -232,8 +263,12 @@ def _add_sites_cameras_sensors(spec, bodies, tables: BodyTables) -> None:
     for side in ("right", "left"):
         # Eye camera: MuJoCo cameras look along their local -z with +y up; the eye looks
         # along its local +x with +z up.
+        # It sits on the line of sight just in front of the pupil (the eye sphere's centre + its
+        # radius x EYE_CAMERA_X), so the own eyeball, iris and pupil are behind it.
+        g = next(g for g in tables.geoms if g.body == f"{side}_eye")
         bodies[f"{side}_eye"].add_camera(
-            name=f"{side}_eye", pos=[0, 0, 0], fovy=EYE_FOVY_DEG,
+            name=f"{side}_eye", pos=np.asarray(g.pos, float) + [EYE_CAMERA_X * g.size[0], 0, 0],
+            fovy=EYE_FOVY_DEG,
             quat=quat_mul(axis_angle_quat((0, 0, 1), -np.pi / 2),
                           axis_angle_quat((1, 0, 0), np.pi / 2)),
         )

@@ -9,6 +9,12 @@ plain skin colour and the image can be wrapped onto the front of a sphere head.
 
 The seven expressions follow Ekman's basic emotions plus neutral; their index in
 :data:`EXPRESSIONS` is the expression id used by the environments.
+
+On a head the eyes are the body's own eyeballs (white sclera, iris and pupil that turn with the
+eye joints; :mod:`mimo_social.body.builder`), which bulge out of the head over the eyes painted
+here: what others see of an expression is its brows, mouth, cheeks and marks (tears, wrinkles,
+frown lines) and the lash lines drawn around each eyeball. The painted eyes (wide for surprise
+and fear, lidded for sadness, anger and disgust) show in the flat face images (recordings).
 """
 
 from __future__ import annotations
@@ -44,20 +50,21 @@ _SPECS = {
     "happy": dict(brow=(0.33, 0.32, 0.05, 0.13), eye=(0.13, 0.12, None, (-0.035, 2.5), 0.085, 0.01),
                   mouth=("open", 0.23, -0.34, (-0.05, -0.05), 0.22, 2.0, 1.0, "tongue"),
                   cheek=(-0.17, 0.10, 0.85), marks=()),
-    "sad": dict(brow=(0.38, 0.23, -0.01, 0.13), eye=(0.13, 0.12, (0.08, 0.0), None, 0.085, -0.03),
-                mouth=("line", 0.14, -0.44, -0.08, 0.022), cheek=_CHEEK, marks=("tears",)),
+    "sad": dict(brow=(0.41, 0.22, -0.01, 0.13), eye=(0.13, 0.12, (0.08, 0.0), None, 0.085, -0.03),
+                mouth=("line", 0.15, -0.44, -0.13, 0.026), cheek=_CHEEK, marks=("tears",)),
     "surprised": dict(brow=(0.42, 0.41, 0.07, 0.13), eye=(0.14, 0.16, None, None, 0.07, 0.0),
                       mouth=("open", 0.10, -0.43, (0.12, 0.12), 0.12, 2.0, 0.5, ""), cheek=_CHEEK, marks=()),
     "disgusted": dict(brow=(0.19, 0.25, 0.0, 0.12), eye=(0.13, 0.12, (0.03, 0.05), (-0.06, 0.8), 0.08, 0.0),
                       mouth=("open", 0.17, -0.43, (0.02, 0.12), 0.05, 2.0, 0.7, "teeth"),
                       cheek=_CHEEK, marks=("nose_wrinkles",)),
-    "angry": dict(brow=(0.15, 0.32, -0.01, 0.11), eye=(0.13, 0.12, (-0.01, 0.08), None, 0.085, 0.0),
-                  mouth=("line", 0.13, -0.43, -0.02, 0.03), cheek=_CHEEK, marks=("frown_lines",)),
+    "angry": dict(brow=(0.13, 0.33, -0.01, 0.11), eye=(0.13, 0.12, (-0.01, 0.08), None, 0.085, 0.0),
+                  mouth=("line", 0.14, -0.43, -0.05, 0.036), cheek=_CHEEK, marks=("frown_lines",)),
     "scared": dict(brow=(0.41, 0.31, 0.0, 0.08), eye=(0.14, 0.16, None, None, 0.065, 0.0),
                    mouth=("open", 0.22, -0.43, (0.05, 0.05), 0.08, 4.0, 0.5, "teeth"),
                    cheek=_CHEEK, marks=()),
 }
 _EYE_X, _EYE_Y, _BROW_OUTER_X = 0.31, 0.05, 0.47
+_LASH_RADIUS = 0.145  # just outside an eyeball's outline on a head (drawing units)
 _FEATURE_EXTENT = 0.7  # features lie within |x|, |y| < 0.6; outside the central 70 % is plain skin
 # The drawing's own coordinates are scaled and shifted onto the image so that its eyes land at
 # (+-0.377, 0.137): where the head's eye spheres sit when the image is projected onto the head
@@ -133,6 +140,16 @@ def _draw_eyes(paint, X, y, spec):
     paint(eye & (np.hypot(X - (ix - 0.3 * r_iris), y - (iy + 0.35 * r_iris)) < 0.28 * r_iris), "sclera")
 
 
+def _draw_lash_lines(paint, X, y):
+    """A dark line around each eyeball where it meets the skin, thicker above (the lashes). The
+    eyeballs (:mod:`mimo_social.body.builder`) bulge out of the head over the painted eyes,
+    ``_LASH_RADIUS`` around their centres on this image; the line frames them."""
+    dx, dy = X - _EYE_X, y - _EYE_Y
+    d = np.hypot(dx, dy)
+    up = np.clip(dy / (d + 1e-9), 0.0, 1.0)          # 1 straight above the eye, 0 below its middle
+    paint((d >= _LASH_RADIUS) & (d < _LASH_RADIUS + 0.012 + 0.022 * up), "line")
+
+
 def _draw_brows(paint, X, y, spec):
     """Both brows as tapered strokes, thick at the inner end."""
     yi, yo, arch, x0 = spec
@@ -201,7 +218,7 @@ def _render(index: int, size: int) -> np.ndarray:
     paint(np.ones_like(r), "blush", np.clip(1.0 - r**2, 0.0, 1.0) * cheek_alpha)
     marks = spec["marks"]
     if "tears" in marks:  # one under each eye
-        paint(_ellipse_sdf(X, y, 0.38, -0.15, 0.025, 0.04) < 0, "tear")
+        paint(_ellipse_sdf(X, y, 0.38, -0.17, 0.03, 0.05) < 0, "tear")
     nose_y = -0.14 if "nose_wrinkles" in marks else -0.16
     paint(_ellipse_sdf(x, y, 0.0, nose_y, 0.065, 0.04) < 0, "nose")
     paint(_ellipse_sdf(X, y, 0.028, nose_y - 0.012, 0.014, 0.01) < 0, "line", 0.6)  # nostrils
@@ -211,6 +228,7 @@ def _render(index: int, size: int) -> np.ndarray:
     if "frown_lines" in marks:  # two short vertical creases between the brows
         paint((np.abs(X - 0.035) < 0.007) & (np.abs(y - 0.16) < 0.035), "line", 0.6)
     _draw_eyes(paint, X, y, spec["eye"])
+    _draw_lash_lines(paint, X, y)
     _draw_brows(paint, X, y, spec["brow"])
     _draw_mouth(paint, x, y, spec["mouth"])
     out[lo:size - lo, lo:size - lo] = np.clip(np.rint(img), 0, 255)

@@ -121,8 +121,8 @@ def test_every_body_of_every_agent_has_one_pose_row_per_logged_step(env, episode
                 assert [s for s, _, _ in r] == list(range(N_STEPS + 1)), (path, component)
                 times = np.array([t for _, t, _ in r])
                 np.testing.assert_allclose(times, np.arange(N_STEPS + 1) * dt_ns, atol=1000)
-        # the eye spheres (group 3) are hidden: no body entity for them
-        assert f"/world/{agent}/right_eye" not in data
+        # the eyeballs are drawn (they show where each agent looks): a body entity each
+        assert f"/world/{agent}/right_eye" in data
     for prop in ("ball", "cube"):
         assert len(rows(data, f"/world/props/{prop}", "Transform3D:translation")) == N_STEPS + 1
     assert rows(data, "/world/scene/floor", "Boxes3D:half_sizes")
