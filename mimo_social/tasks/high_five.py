@@ -103,12 +103,16 @@ class HighFiveOptions(TaskOptions):
     end_on_touch: bool = True
     distance: float = DISTANCE
     start_spread: float = 0.3
+    assisted_gaze: bool = False
+    shaping: bool = True
 
     def __post_init__(self):
         self._number("touch_bonus")
         self._bool("end_on_touch")
         self._number("distance", *DISTANCE_RANGE)
         self._number("start_spread", 0.0, 1.0)
+        self._bool("assisted_gaze")
+        self._bool("shaping")
 
 
 class HighFive(Task):
@@ -128,16 +132,15 @@ class HighFive(Task):
         require_skin(self.name, f"infant_{i}", config, right_hand_parts(tables),
                      "the high five (the right hands meeting)")
         arm = right_arm_joints(tables)
-        frozen = held_posture(tables, keep=arm + GAZE_JOINTS,
-                              angles={"right_knee": -5, "left_knee": -5})
+        gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
+        frozen = held_posture(tables, keep=arm + gaze, angles={"right_knee": -5, "left_knee": -5})
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
-                          frozen=frozen, base="fixed", actuated=arm,
-                          gaze_joints=GAZE_JOINTS)
+                          frozen=frozen, base="fixed", actuated=arm, gaze_joints=gaze)
 
     def _bind(self, env):
         w = env.world
         self._world = w
-        self._gaze = [Gaze(w, i) for i in range(2)]
+        self._gaze = [Gaze(w, i) for i in range(2)] if self.options.assisted_gaze else []
         self._palms = np.array([w.agents[i].palm_sites[0] for i in range(2)], dtype=np.intp)
         hands = [hand_geoms(w, i) for i in range(2)]
         self._hands_meet = ContactProbe(w.model.ngeom, hands[0], hands[1])
@@ -176,9 +179,10 @@ class HighFive(Task):
         self.before_physics(env)
 
     def before_physics(self, env):
-        m, d = env.world.model, env.world.data
-        for i in range(2):
-            self._gaze[i](m, d, "site", self._palms[1 - i])
+        if self._gaze:   # assisted gaze: head and eyes on the partner's right hand
+            m, d = env.world.model, env.world.data
+            for i in range(2):
+                self._gaze[i](m, d, "site", self._palms[1 - i])
 
     def rewards(self, env):
         d = env.world.data
@@ -186,7 +190,8 @@ class HighFive(Task):
         dist = float(np.linalg.norm(p[0] - p[1]))
         self._felt = [bool(f(d)) for f in self._feels]
         self._touching = self._felt[0] and self._felt[1] and self._hands_meet(d)
-        r = -dist + (self.options.touch_bonus if self._touching else 0.0)
+        r = (-dist if self.options.shaping else 0.0) \
+            + (self.options.touch_bonus if self._touching else 0.0)
         self._distance = dist
         return np.array([r, r])
 

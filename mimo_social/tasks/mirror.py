@@ -1,28 +1,32 @@
-"""Mirror: two infants face to face; the learner copies the face its partner shows.
+"""Mirror: two infants face to face; the follower copies the face its partner shows.
 
 | | |
 |---|---|
 | agents | 2: `infant_0` (the learner) and `infant_1` (the partner: scripted, e.g. `ExpressionShow`, or a second learner) |
-| body | standing, hip fixed in the world, every joint held except head and eyes; the task points each head and both eyes at the partner's face every control step (as in reach) |
+| body | standing, hip fixed in the world, every joint held; head and eyes held at rest, looking straight ahead: the partner's face (at the same height, `distance` away) is in the middle of both eye images without any aiming. With `assisted_gaze` the head and eyes are free joints that the task points at the partner's face every control step (the first version) |
 | scene | the two infants `distance` (0.3 m) apart, face to face: the partner's face fills about a third of each 64x64 eye image (see docs/social/mirror_views.png) |
-| reset | both faces neutral, heads and eyes on the partner's face; nothing random in the task (a scripted partner draws its faces and how long it shows them) |
-| action | `Dict(motors=Box(0,), expression=Discrete(7))`: the expression is the action (no motor is free; the empty motor Box flattens to nothing in `FlattenParallel` / `make_sb3_single`, which leave 7 expression logits) |
-| observation | `eye_left`, `eye_right` (64x64x3 RGB; the only way the partner's face reaches the learner), `proprioception` (36: its own joints, the head and eye angles); never the partner's expression |
-| reward | +1 on a step where the agent's expression equals its partner's, else 0; with `scripted_partner` (set by `scripted_env`) only `infant_0` is rewarded and `infant_1` has no eyes |
-| success | `is_success` = `match`: the two expressions are equal on this step |
+| reset | both faces neutral; two learners with `roles="leader"` (default): one of them, drawn at random (seeded), is the episode's leader; nothing else random in the task (a scripted partner draws its faces and how long it shows them) |
+| action | `Dict(motors=Box(0,), expression=Discrete(7))`: the expression is the action (no motor is free; the empty motor Box flattens to nothing in `FlattenParallel` / `make_sb3_single`, which leave 7 expression logits). The leader's expression action is ignored: its face is set by the task (below) |
+| observation | `eye_left`, `eye_right` (64x64x3 RGB; the only way the partner's face reaches the learner), `proprioception` (its own joints: none are free by default, so 0 floats; 36 with `assisted_gaze`: the head and eye angles, constant since neither face moves); never the partner's expression |
+| two learners | `roles="leader"` (default): per episode one agent is the leader, whose face the task's script sets (each face held for a time drawn from `leader_hold_s` (1-2 s), the next one drawn among the other six); only the other agent, the follower, is rewarded. No fixed face can earn more than chance (1/7 of the steps): copying is the only way to the reward. With a shared policy each agent is the follower in about half the episodes (the leader's reward is 0 whatever it does, so its steps carry no gradient in expectation). `roles="free"`: both faces are the agents' own actions and both are rewarded on every match: any shared convention ("always neutral", or any fixed face) earns the full reward without looking; for studying how a convention forms, not mimicry |
+| reward | the follower: +1 on a step where its expression equals its partner's, else 0; the leader 0. With `scripted_partner` (set by `scripted_env`) `infant_0` is the follower and `infant_1` has no eyes; with `roles="free"` both are rewarded on a match |
+| success | per episode: `is_success` becomes True on the step at which the matched steps reach `success_fraction` (0.8) of the episode's `max_steps` (500: 400 steps), i.e. the step from which the episode can no longer fail; the last step's value is the episode's verdict. A reactive copier misses one step per change of the partner's face (about 4 an episode: 99 % matched); chance (1/7 of the steps) never comes near 80 % (random and zero: 0 %) |
 | termination | none; truncation at 500 steps (5 s) |
-| privileged cues | the task points the head and eyes at the partner's face (the learner need not find it); the partner's expression only through the eyes |
-| baselines | random policy (uniform expression, 20 episodes of 500 steps, scripted partner; no command in the package): return 70.4 +- 6.5, success rate 0.141 +- 0.013 (chance: 1/7 = 0.143). PPO with `--normalize-obs`, scripted `ExpressionShow` partner, gamma 0, 32x32 eyes, 2 seeds, 60k env steps (5.7 min): 99.2 % of steps matched (return 496 of 500) at the first evaluation, 10k steps (50 s), for both seeds; on 20 fresh episodes 496.2 +- 0.4 and 496.1 +- 0.4; the 4 missed steps an episode are the one-step lag after each of the partner's changes (`mimo-social train --task mirror --mode scripted --algo ppo --steps 60000 --seed 0 --out runs/mirror_s0 --normalize-obs --algo-kwargs '{"gamma": 0.0}' --env-kwargs '{"per_agent": [{"vision": {"width": 32, "height": 32}}, {}]}'`). Without input normalisation PPO stayed at chance (three variants, 70k-120k steps) |
+| infos | `match` (the faces are equal this step), `matched_steps` (so far this episode), `is_success`, `is_leader` (this agent's face is set by the task this episode) |
+| options | `distance` (0.3 m, 0.22 to 2.0), `scripted_partner` (False), `assisted_gaze` (False), `roles` (`"leader"`, or `"free"`), `leader_hold_s` ((1.0, 2.0) s), `success_fraction` (0.8, 0.01 to 1) |
+| privileged cues | none by default: the partner's face reaches the learner only through its eyes, which look straight ahead at it (the posture). `assisted_gaze` (False): the task points head and eyes at the partner's face; it would leak no expression (the face does not move, so the angles are the same every step and every episode), kept as an option for other `distance` / posture settings. The reward reads both expressions from the world (the reward is no observation) |
+| baselines | 20 episodes of 500 steps, seeds 1000-1019, scripted `ExpressionShow` partner (`docs/social/mirror.md`): random policy (uniform expression) 0 % success, return 71.5 +- 6.4; zero action (always neutral, the hack of the two-learner convention) 0 %, 70.9 +- 17.3; scripted `MirrorController` (copies the partner's face read from the world) 100 %, 495.9 +- 0.5, success secured at step 404 on average. PPO: see `docs/social/mirror.md` |
 | sources | not in the MIMo paper: a social task of this package; rationale (facial mimicry, the correspondence problem) and figures: `docs/social/mirror.md` |
-| version history | v0: first version, with joint attention and the scripted partners `ExpressionShow` and `GazeAtTarget` |
+| version history | v0: first version, with joint attention and the scripted partners `ExpressionShow` and `GazeAtTarget`; v0, issue 15: success per episode (`success_fraction` of the steps matched; it was the step's match, which random met on 14 % of the steps), head and eyes held looking straight ahead (the task's aiming is the `assisted_gaze` option), two learners as leader (face set by the task) and follower by default (`roles`; the old symmetric reward, where "always neutral" earns everything, is `roles="free"`) |
 
-The learner's action and the partner's shown on the same step are compared; the eye images of
-a step show the faces as the previous step left them, so a copy lags the model by one step (10
-ms): the best reactive policy loses one step per change of the partner's face.
+The learner's action and the partner's face shown on the same step are compared; the eye images
+of a step show the faces as the previous step left them, so a copy lags the model by one step
+(10 ms): the best reactive policy loses one step per change of the partner's face.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,24 +36,40 @@ from ..body.tables import load_body
 from ..core.kinematics import Gaze
 from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup
+from ..expressions.faces import EXPRESSIONS
 from .common import face_to_face
 
 DISTANCE = 0.3
 EYE_SIZE = 64
+ROLES = ("leader", "free")
+N_FACES = len(EXPRESSIONS)
 
 
 @dataclass(frozen=True)
 class MirrorOptions(TaskOptions):
-    """Distance between the faces (m, from 0.22: closer and the faces touch) and whether
-    ``infant_1`` is a scripted partner (no eyes, no reward)."""
+    """Distance between the faces (m, from 0.22: closer and the faces touch), whether
+    ``infant_1`` is a scripted partner (no eyes, no reward), whether the task aims head and eyes
+    at the partner's face (``assisted_gaze``), the two learners' roles (``"leader"``: one agent's
+    face is set by the task each episode, only the other is rewarded; ``"free"``: both act and
+    both are rewarded on a match), the leader's hold times (s) and the fraction of the
+    episode's steps that must match for success."""
 
     task = "mirror"
     distance: float = DISTANCE
     scripted_partner: bool = False
+    assisted_gaze: bool = False
+    roles: str = "leader"
+    leader_hold_s: tuple = (1.0, 2.0)
+    success_fraction: float = 0.8
 
     def __post_init__(self):
         self._number("distance", 0.22, 2.0)
         self._bool("scripted_partner")
+        self._bool("assisted_gaze")
+        self._choice("roles", ROLES)
+        self._numbers("leader_hold_s", 2, 0.01, 60.0, rising=True,
+                      allowed="(min, max) seconds, 0.01 <= min <= max <= 60")
+        self._number("success_fraction", 0.01, 1.0)
 
 
 class Mirror(Task):
@@ -68,30 +88,68 @@ class Mirror(Task):
         dist = self.options.distance
         pos, facing = face_to_face(i, dist)
         tables = load_body(config.hands)
-        frozen = held_posture(tables, keep=GAZE_JOINTS,
-                              angles={"right_knee": -5, "left_knee": -5})
+        gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
+        frozen = held_posture(tables, keep=gaze, angles={"right_knee": -5, "left_knee": -5})
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
-                          frozen=frozen, base="fixed", actuated=(), gaze_joints=GAZE_JOINTS)
+                          frozen=frozen, base="fixed", actuated=(), gaze_joints=gaze)
+
+    @property
+    def leading(self) -> bool:
+        """Whether one of two learners leads (its face set by the task) this env."""
+        return self.options.roles == "leader" and not self.options.scripted_partner
 
     def reset(self, env, rng):
-        if not hasattr(self, "_gaze"):
+        if not hasattr(self, "_faces"):
             w = env.world
-            self._gaze = [Gaze(w, i) for i in range(2)]
+            self._gaze = [Gaze(w, i) for i in range(2)] if self.options.assisted_gaze else []
             self._faces = [int(w.agents[i].head_site) for i in range(2)]
-            self._weights = np.array([1.0, 0.0 if self.options.scripted_partner else 1.0])
+        self._rng = rng
+        self._leader = int(rng.integers(2)) if self.leading else -1
+        if self._leader >= 0:
+            self._weights = np.zeros(2)
+            self._weights[1 - self._leader] = 1.0
+        elif self.options.scripted_partner:
+            self._weights = np.array([1.0, 0.0])
+        else:
+            self._weights = np.ones(2)
+        self._shown = None        # the leader's face (the task's script) and its steps left
+        self._left = 0
+        self._need = max(1, math.ceil(self.options.success_fraction * env.max_steps - 1e-9))
         self._match = False
-        self.before_physics(env)
+        self._matched = 0
+        self._aim(env)
+
+    def _aim(self, env):
+        if self._gaze:
+            m, d = env.world.model, env.world.data
+            for i in range(2):
+                self._gaze[i](m, d, "site", self._faces[1 - i])
+
+    def _lead(self, env):
+        """The leader's face: held for a time drawn from ``leader_hold_s``, then another one."""
+        if self._left <= 0:
+            faces = np.arange(N_FACES)
+            if self._shown is not None:
+                faces = faces[faces != self._shown]
+            self._shown = int(self._rng.choice(faces))
+            lo, hi = self.options.leader_hold_s
+            self._left = max(1, int(round(self._rng.uniform(lo, hi) / env.dt)))
+        self._left -= 1
+        env.world.set_expression(self._leader, self._shown)
 
     def before_physics(self, env):
-        m, d = env.world.model, env.world.data
-        for i in range(2):
-            self._gaze[i](m, d, "site", self._faces[1 - i])
+        if self._leader >= 0:
+            self._lead(env)
+        self._aim(env)
 
     def rewards(self, env):
         w = env.world
         self._match = w.expression_of(0) == w.expression_of(1)
+        self._matched += int(self._match)
         return self._weights * float(self._match)
 
     def terminations(self, env):
-        info = {"match": self._match, "is_success": self._match}
-        return np.zeros(2, bool), [dict(info), dict(info)]
+        success = self._matched >= self._need
+        infos = [{"match": self._match, "matched_steps": self._matched, "is_success": success,
+                  "is_leader": i == self._leader} for i in range(2)]
+        return np.zeros(2, bool), infos
