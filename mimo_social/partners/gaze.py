@@ -10,6 +10,14 @@ then tilt, to face the target from the neck; each eye then turns, horizontal the
 look at it from its own centre), computed on a private copy of the state: the partner never writes the world's ``qpos``, so its head turn is physical (it takes
 about 0.3 s) and visible to whoever watches it.
 
+How much of a gaze shift the head makes: ``head_share`` (a share ``s`` in [0, 1], or a range
+``(lo, hi)`` drawn from anew at every shift; ``None``: the task's ``partner_head_share`` range
+where it has one, else 1). The head turns ``s`` of the way (swivel and tilt) and the eyes the
+rest, from where the head then points; the head always makes up what the eyes cannot reach
+(``EYE_REACH_DEG`` from straight ahead). ``s = 1``: the head faces the target and the eyes only
+correct for their offset; ``s = 0``: the eyes turn alone as far as they reach (adults move
+mostly their eyes for small gaze shifts and add the head for large ones).
+
 Targets: by default the task's toys (``env.task.toy_bodies``, a list of body ids), else a list
 of body or site names of the world. ``target`` is the index of the current one. The agent needs
 the spring-damper actuation (the PD law computes torques) and motors on its head and eye joints.
@@ -27,8 +35,9 @@ from ..core.kinematics import LookAt
 from .base import Partner, agent_index, require_motors
 from .expression import hold_range
 
-__all__ = ["GazeAtTarget", "look_angles"]
+__all__ = ["GazeAtTarget", "look_angles", "head_share_range"]
 
+EYE_REACH_DEG = 40.0   # the eyes turn at most this far from straight ahead (their range: 45-47)
 NEEDED = ("head_swivel", "head_tilt", "right_eye_horizontal", "right_eye_vertical",
           "left_eye_horizontal", "left_eye_vertical")
 
@@ -50,17 +59,36 @@ def look_angles(env, agent: str, kind: str, obj: int) -> dict[str, float]:
     return {names[k]: float(v) for k, v in zip(geo.joints, q)}
 
 
+def head_share_range(value, who: str = "GazeAtTarget") -> tuple[float, float] | None:
+    """``None``, a share in [0, 1] or a ``(lo, hi)`` range of shares, as a range (or None)."""
+    if value is None:
+        return None
+    allowed = "None, a number in [0, 1] or a (lo, hi) range with 0 <= lo <= hi <= 1"
+    try:
+        lo, hi = ((float(value),) * 2 if isinstance(value, (int, float, np.number))
+                  and not isinstance(value, bool) else (float(v) for v in value))
+    except (TypeError, ValueError):
+        raise ValueError(f"{who}: head_share={value!r}; allowed: {allowed}") from None
+    if not 0.0 <= lo <= hi <= 1.0:
+        raise ValueError(f"{who}: head_share={value!r}; allowed: {allowed}")
+    return lo, hi
+
+
 class GazeAtTarget(Partner):
     """Looks at one target after another (see the module docstring).
 
     ``targets``: ``None`` (the task's toys, ``env.task.toy_bodies``) or a list of body/site
     names; ``hold_s``: ``(min, max)`` seconds on each target; ``omega`` (rad/s) and ``zeta``:
-    the PD law's natural frequency and damping ratio (per joint, scaled by its inertia).
+    the PD law's natural frequency and damping ratio (per joint, scaled by its inertia);
+    ``head_share``: the share of each turn the head makes (see the module docstring).
+    ``share`` is the current shift's share.
     """
 
     def __init__(self, targets: Sequence[str] | None = None, hold_s=(1.5, 3.0),
-                 omega: float = 15.0, zeta: float = 1.0):
+                 omega: float = 15.0, zeta: float = 1.0, head_share=None):
         self.hold_s = hold_range(hold_s, "GazeAtTarget")
+        self.head_share = head_share_range(head_share)
+        self.share = 1.0
         if targets is not None:
             if isinstance(targets, str) or not isinstance(targets, Sequence) or not targets \
                     or not all(isinstance(t, str) for t in targets):
@@ -129,8 +157,19 @@ class GazeAtTarget(Partner):
         space = env.action_space(agent)
         self._dict = isinstance(space, spaces.Dict)
         self._dt = float(env.dt)
+        task_share = getattr(env.task, "partner_head_share", None)
+        self._shares = self.head_share or head_share_range(task_share, "the task's "
+                                                           "partner_head_share") or (1.0, 1.0)
+        g = self._geo
+        self._head_slots = [k for k in (g.swivel, g.tilt) if k is not None]
+        self._reach = np.deg2rad(EYE_REACH_DEG)
         self.target = int(rng.integers(len(self._found)))
         self._left = self._hold_steps()
+        self._draw_share()
+
+    def _draw_share(self) -> None:
+        lo, hi = self._shares
+        self.share = float(self.rng.uniform(lo, hi)) if hi > lo else lo
 
     def _hold_steps(self) -> int:
         return max(1, int(round(self.rng.uniform(*self.hold_s) / self._dt)))
@@ -143,7 +182,35 @@ class GazeAtTarget(Partner):
         if self.__dict__.get("_scratch") is None:   # dropped when pickled
             self._scratch = mujoco.MjData(w.model)
         q = _angles(self._geo, w.model, w.data, self._scratch, kind, obj)
+        if self.share < 1.0 and self._head_slots:
+            q = self._share_turn(w.model, q, kind, obj)
         return q[self._pick]
+
+    def _share_turn(self, model, q: np.ndarray, kind: str, obj: int) -> np.ndarray:
+        """``q`` (the head facing the target) with the head turned ``share`` of the way and the
+        eyes aimed from there; where an eye would then pass its range, the head turns further
+        (the eyes' reach shrinks by 5-degree steps down to 0: the full head turn)."""
+        g, d = self._geo, self._scratch
+        full = q.copy()
+        eyes = [k for _, _, h, v in g.eyes for k in (h, v) if k is not None]
+        lo, hi = g.lo[eyes] + 1e-3, g.hi[eyes] - 1e-3
+        for reach in np.arange(self._reach, -1e-9, -np.deg2rad(5.0)):
+            q = full.copy()
+            for k in self._head_slots:
+                q[k] = full[k] - np.clip((1.0 - self.share) * full[k], -reach, reach)
+            d.qpos[g.qpos] = q
+            mujoco.mj_kinematics(model, d)
+            target = (d.xpos if kind == "body" else d.site_xpos)[obj]
+            R = d.xmat[g.head_body].reshape(3, 3)
+            for body, sign, horizontal, vertical in g.eyes:
+                v = R.T @ (target - d.xpos[body])
+                if horizontal is not None:
+                    q[horizontal] = sign * np.arctan2(v[1], v[0])
+                if vertical is not None:
+                    q[vertical] = np.arctan2(v[2], np.hypot(v[0], v[1]))
+            if np.all((q[eyes] >= lo) & (q[eyes] <= hi)):
+                break
+        return np.clip(q, g.lo, g.hi)
 
     def act(self, env, agent, observation):
         if self.target is None:
@@ -152,6 +219,7 @@ class GazeAtTarget(Partner):
             others = [k for k in range(len(self._found)) if k != self.target]
             self.target = int(self.rng.choice(others))
             self._left = self._hold_steps()
+            self._draw_share()
         self._left -= 1
         d = env.world.data
         err = self.desired_angles(env) - d.qpos[self._qpos]
@@ -170,4 +238,5 @@ class GazeAtTarget(Partner):
         return state
 
     def __repr__(self) -> str:
-        return f"GazeAtTarget(targets={self.targets}, hold_s={self.hold_s})"
+        return (f"GazeAtTarget(targets={self.targets}, hold_s={self.hold_s}, "
+                f"head_share={self.head_share})")

@@ -1,28 +1,29 @@
-"""Joint attention: the learner follows its partner's gaze to one of several toys.
+"""Joint attention: the learner follows its partner's gaze, read from its eyes, to one of several toys.
 
 | | |
 |---|---|
-| agents | 2: `infant_0` (the learner) and `infant_1` (the partner: scripted, by default `GazeAtTarget`, which turns its head and eyes to one toy after another, or a second learner) |
-| body | sitting, hip fixed in the world, every joint held except the head (swivel, tilt, sideways tilt) and the eyes (horizontal, vertical, torsional), which are motors: each agent turns its own head and eyes; with `head_support` (on) the task cancels gravity on head and eyes (neck tone: a zero action does not let the head drop) |
+| agents | 2: `infant_0` (the learner) and `infant_1` (the partner: scripted, by default `GazeAtTarget`, which looks at one toy after another, or a second learner) |
+| body | sitting, hip fixed in the world, every joint held except the head (swivel, tilt, sideways tilt) and the eyes (horizontal, vertical, torsional), which are motors: each agent turns its own head and eyes; with `head_support` (on) the task cancels gravity on head and eyes (neck tone: a zero action does not let the head drop). The eyeballs (white, iris, pupil) turn with the eye joints and are seen by the other's eyes |
 | scene | the two infants `distance` (0.7 m) apart, face to face; `n_toys` (4) toys on the floor beside them, a red ball, a blue cube, a yellow ball and a green cube (3.5 cm), to the left and right of the pair, 0.25-0.45 m off the line between the infants, each at least `min_separation_deg` (25) from every other as seen from either head |
-| reset | the toys placed at random (seeded), each turned at random about the vertical; heads and eyes at rest, facing the partner |
+| reset | the toys placed at random (seeded), each turned at random about the vertical; heads and eyes at rest, facing the partner; with two learners (`two_learners` "leader") one of them drawn as the leader |
 | action | the 9 head and eye motors (`Box(-1, 1, (9,))`; expressions are off by default) |
-| observation | `eye_left`, `eye_right` (96x96x3 RGB), `proprioception` (54: its own joints, where its head and eyes point); never the partner's target or joint angles |
+| observation | `eye_left`, `eye_right` (96x96x3 RGB), `proprioception` (54: its own joints, where its head and eyes point); with two learners in "leader" mode also `instruction` (`n_toys`: one-hot of the toy the leader is to look at; all zeros for the follower); never the partner's target or joint angles |
+| partner | the scripted `GazeAtTarget` holds each toy 1.5-3 s (then another, never the same twice); per gaze shift its head makes a share of the turn drawn uniformly from `partner_head_share` +- `partner_head_jitter` (0.3 +- 0.3: from 0 to 0.6) and its eyes the rest (the head makes up what the eyes cannot reach, 40 degrees), so that which of the toys on a side it looks at is told by its eyes, its head turn telling mostly the side |
 | gaze | an agent's gaze ray starts between its eyes (the mean of the two eye cameras) along the mean of the two cameras' viewing axes; it *lands on* a toy when the angle to the toy's centre is below the toy's angular radius plus `margin_deg` (5); the nearest such toy is the one looked at |
-| reward | +1 on a step where both agents' gaze lands on the same toy, else 0; with `shaping` > 0, minus `shaping` x the angle (rad) between the agent's gaze ray and the toy the other agent looks at (when it looks at one); with `scripted_partner` (set by `scripted_env`) only `infant_0` is rewarded and `infant_1` has no eyes |
-| success | `is_success`: both look at the same toy this step; infos also `looked_at` (own toy or -1), `target` (the toy the other agent looks at, -1 while it looks at none, e.g. mid-turn), `gaze_error_deg` (angle from the own gaze ray to `target`, -1 without one) |
+| reward | the follower (`infant_0` with a scripted partner): +1 on a step where its gaze lands on the toy the leader's gaze lands on (shared attention), minus `shaping` (0.1) x the angle (rad) between its gaze ray and that toy while the leader looks at one; the leader (two learners, "leader" mode): the same toward its `instruction`; with `two_learners` "shared" both are followers of each other (+1 whenever they look at the same toy). With `scripted_partner` (set by `scripted_env`) only `infant_0` is rewarded and `infant_1` has no eyes |
+| success | per episode: `is_success` says whether, so far, the agent's gaze was on its target on at least `success_share` (0.6) of the steps on which it had one (follower: the steps the leader looked at a toy; leader: every step), after at least 1 s of such steps; the last step's value is the episode's. Infos also `looked_at` (own toy or -1), `target` (the toy it is rewarded for, -1 none, e.g. while the leader turns), `gaze_error_deg` (-1 without a target), `shared` (on target this step), `on_target_fraction`, `leader` |
 | termination | none; truncation at 500 steps (5 s) |
-| options | `distance` (0.6-1.5 m), `n_toys` (2-4), `margin_deg` (0-30), `shaping` (0-100, default 0), `min_separation_deg` (0-35), `head_support` (True), `scripted_partner` (False) |
-| privileged cues | none in the observation (the partner's head turn reaches the learner only through its eyes); with `shaping` > 0 the reward reads the partner's toy from the geometry |
-| baselines | 20 episodes of 500 steps, scripted partner (no command in the package): random policy (uniform motor commands) return 0.0 +- 0.0, success rate 0.000; zero action (keeps looking at the partner) 0; a privileged follower (a `GazeAtTarget` told the partner's current target; not a learner) 0.858 +- 0.028, the ceiling a follower with instant knowledge reaches. PPO, scripted `GazeAtTarget` partner, `shaping` 0.1, 2 seeds, 61k env steps (27-32 min): training return -76 / -66 -> -26 / -31 (mean gaze error to the partner's toy from ~1.5 rad to ~0.5 rad), no step of shared attention in evaluation (`mimo-social compare --task joint_attention --mode scripted --algos ppo --seeds 2 --steps 60000 --out runs/joint_attention --eval-every 5000 --eval-episodes 5 --env-kwargs '{"task_options": {"shaping": 0.1}}'`) |
-| sources | not in the MIMo paper: a social task of this package; rationale (gaze following, 9-18 months) and figures: `docs/social/joint_attention.md` |
-| version history | v0: first version, with mirror and the scripted partners `ExpressionShow` and `GazeAtTarget` |
+| options | `distance` (0.6-1.5 m), `n_toys` (2-4), `margin_deg` (0-30), `shaping` (0-100, default 0.1), `success_share` (0.05-1, 0.6), `partner_head_share` (0-1, 0.3), `partner_head_jitter` (0-0.5, 0.3), `two_learners` ("leader" or "shared"), `min_separation_deg` (0-35), `head_support` (True), `scripted_partner` (False) |
+| privileged cues | none for the follower: the partner's head and eye turns reach it only through its own eyes, and nothing of the partner's target is in its observation; the leader's `instruction` is its own task, not the partner's state. The shaping term reads the partner's toy from the geometry (the reward, not an observation) |
+| two learners | `two_learners` "leader" (default): per episode the task draws a leader, which is rewarded for looking at the toy of its `instruction` (a new toy every 1.5-3 s, never the same twice), and the follower for looking where the leader looks; "both always look at the same toy" earns the leader its instruction's share of the steps only (about 1/`n_toys`) and fails. "shared": the v0 convention, both rewarded for any shared look: "both always look at the red toy" earns the full reward |
+| baselines | see `docs/social/joint_attention.md` (scripted `GazeFollowController`, random, zero, hacks, PPO; commands and machine there) |
+| sources | not in the MIMo paper: a social task of this package; rationale (gaze following from 9-18 months; 18-month-olds follow eye turns alone, Moore & Corkum 1998; eyes matter from 10-12 months, Brooks & Meltzoff 2002, 2005) and figures: `docs/social/joint_attention.md` |
+| version history | v0: first version, with mirror and the scripted partners `ExpressionShow` and `GazeAtTarget`. v0, issue 15: visible eyeballs (the partner's eyes show where it looks); the scripted partner turns mostly its eyes (`partner_head_share`, `partner_head_jitter`); shaping on by default (0.1); per-episode success (`success_share`); two learners: leader and follower (`two_learners`, default "leader"; the old convention as "shared"); scripted follower `GazeFollowController` |
 
-What the learner sees: the eyeballs of this body are hidden in renders (the face texture draws
-the eyes), so only the partner's head turn is visible. `GazeAtTarget` turns the head fully to
-the toy and the eyes only correct the rest: a swivel of 20-75 degrees (median 40) and a tilt of
-15-45 degrees down. `shaping` is off by default: the return then counts the steps of shared
-attention (return / 500 is the success rate); a learner trained from scratch may turn it on.
+What the learner sees: the partner's head turn and its eyeballs (iris and pupil on white), a
+few pixels across at 0.7 m in a 96x96 eye (`docs/social/eyes_partner_gaze.png`). With the
+partner's head making 0-60 % of each turn, the side it looks to shows in its head, the toy on
+that side mostly in its eyes.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from gymnasium import spaces
 
 from ..body.joint_groups import GAZE_JOINTS, held_posture
 from ..body.postures import POSTURES
@@ -45,6 +47,9 @@ TOYS = (("sphere", (0.9, 0.15, 0.15, 1.0)), ("box", (0.15, 0.35, 0.9, 1.0)),
         ("sphere", (0.95, 0.85, 0.1, 1.0)), ("box", (0.15, 0.7, 0.2, 1.0)))
 SIDE = (0.25, 0.45)          # toys this far (m) off the line between the infants
 MAX_TRIES = 500
+INSTRUCTION_HOLD_S = (1.5, 3.0)   # a leader's instruction lasts this long (as GazeAtTarget's holds)
+MIN_TARGET_S = 1.0           # success needs at least this much time with a target
+TWO_LEARNERS = ("leader", "shared")
 
 
 class GazeRays:
@@ -84,17 +89,23 @@ class GazeRays:
         return np.where(hit, best, -1), angle
 
 
+
 @dataclass(frozen=True)
 class JointAttentionOptions(TaskOptions):
     """Distance between the infants (m), number of toys, the gaze margin around a toy (deg),
-    the shaping weight, the toys' least angular separation (deg), head support, and whether
-    ``infant_1`` is a scripted partner (no eyes, no reward)."""
+    the shaping weight, the share of steps on target for success, the scripted partner's head
+    share (mean, jitter), the two-learner convention, the toys' least angular separation (deg),
+    head support, and whether ``infant_1`` is a scripted partner (no eyes, no reward)."""
 
     task = "joint_attention"
     distance: float = DISTANCE
     n_toys: int = len(TOYS)
     margin_deg: float = 5.0
-    shaping: float = 0.0
+    shaping: float = 0.1
+    success_share: float = 0.6
+    partner_head_share: float = 0.3
+    partner_head_jitter: float = 0.3
+    two_learners: str = "leader"
     min_separation_deg: float = 25.0
     head_support: bool = True
     scripted_partner: bool = False
@@ -104,6 +115,10 @@ class JointAttentionOptions(TaskOptions):
         self._int("n_toys", 2, len(TOYS))
         self._number("margin_deg", 0.0, 30.0)
         self._number("shaping", 0.0, 100.0)
+        self._number("success_share", 0.05, 1.0)
+        self._number("partner_head_share", 0.0, 1.0)
+        self._number("partner_head_jitter", 0.0, 0.5)
+        self._choice("two_learners", TWO_LEARNERS)
         self._number("min_separation_deg", 0.0, 35.0)
         self._bool("head_support")
         self._bool("scripted_partner")
@@ -119,6 +134,15 @@ class JointAttention(Task):
     def __init__(self, n_agents: int, options=None, /, **values):
         super().__init__(n_agents, options, **values)
         self.toy_bodies: np.ndarray | None = None   # body ids of the toys, set at the first reset
+        o = self.options
+        #: the range of head shares the scripted partner draws from per gaze shift (read by
+        #: GazeAtTarget when it is not given its own)
+        self.partner_head_share = (max(0.0, o.partner_head_share - o.partner_head_jitter),
+                                   min(1.0, o.partner_head_share + o.partner_head_jitter))
+        # two learners in "leader" mode: a leader (with an instruction) and a follower
+        self._instructed = not o.scripted_partner and o.two_learners == "leader"
+        self.leader = 1          # the scripted partner leads; with two learners, drawn per episode
+        self.instruction = -1    # the toy the leader is told to look at ("leader" mode)
 
     def agent_defaults(self, i, settings):
         scripted = i == 1 and self.options.scripted_partner
@@ -141,6 +165,19 @@ class JointAttention(Task):
             out.append(Prop(f"toy_{k}", shape, size, (0.35, 1.0 + 0.2 * k, TOY_SIZE), 0.05, rgba))
         return out
 
+    def task_spaces(self, env, i):
+        if self._instructed:
+            return {"instruction": spaces.Box(0.0, 1.0, (self.options.n_toys,), np.float32)}
+        return {}
+
+    def observe(self, env, i):
+        if not self._instructed:
+            return {}
+        out = np.zeros(self.options.n_toys, np.float32)
+        if i == self.leader and self.instruction >= 0:
+            out[self.instruction] = 1.0
+        return {"instruction": out}
+
     # -- running -------------------------------------------------------------------------------
     def reset(self, env, rng):
         w = env.world
@@ -153,13 +190,27 @@ class JointAttention(Task):
             self._heads = np.array([d.site_xpos[a.head_site] for a in w.agents])
             self._weights = np.array([1.0, 0.0 if self.options.scripted_partner else 1.0])
             self._head_dofs = np.concatenate([a.dof_adr[a.actuated_joint_idx] for a in w.agents])
+            self._dt = float(env.dt)
         for k, xy in enumerate(self._place_toys(rng)):
             q = self._toy_qpos[k]
             yaw = rng.uniform(-np.pi, np.pi)
             d.qpos[q:q + 7] = (xy[0], xy[1], TOY_SIZE if TOYS[k][0] == "sphere"
                                else 0.85 * TOY_SIZE, np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2))
+        self._rng = rng
+        if self._instructed:
+            self.leader = int(rng.integers(2))
+            self.instruction = int(rng.integers(self.options.n_toys))
+            self._instruction_left = self._instruction_steps()
+        else:
+            self.leader, self.instruction = 1, -1
         self._looked = np.full(2, -1)
+        self._targets = np.full(2, -1)
         self._angle = None
+        self._on = np.zeros(2, np.int64)        # steps on target, per agent
+        self._with = np.zeros(2, np.int64)      # steps with a target, per agent
+
+    def _instruction_steps(self) -> int:
+        return max(1, int(round(self._rng.uniform(*INSTRUCTION_HOLD_S) / self._dt)))
 
     def _place_toys(self, rng) -> list[np.ndarray]:
         """Toy positions (x, y): beside the pair (left and right alternate, so both sides hold
@@ -196,29 +247,46 @@ class JointAttention(Task):
     def before_physics(self, env):
         """Head support: the head and eye joints' generalised gravity (and Coriolis) force of
         the last physics step is applied to them, as neck tone would, so a zero action holds
-        the head where it is (springs and damping still pull it toward rest)."""
+        the head where it is (springs and damping still pull it toward rest). In "leader"
+        mode the leader's instruction moves on to another toy when its time is up."""
         if self.options.head_support:
             d = env.world.data
             d.qfrc_applied[self._head_dofs] = d.qfrc_bias[self._head_dofs]
+        if self._instructed:
+            self._instruction_left -= 1
+            if self._instruction_left <= 0:
+                others = [k for k in range(self.options.n_toys) if k != self.instruction]
+                self.instruction = int(self._rng.choice(others))
+                self._instruction_left = self._instruction_steps()
 
     def rewards(self, env):
         looked, angle = self._rays.looked_at(env.world.data)
         self._looked, self._angle = looked, angle
-        self._joint = bool(looked[0] >= 0 and looked[0] == looked[1])
-        r = np.full(2, float(self._joint))
-        shaping = self.options.shaping
-        if shaping:
-            for i in range(2):
-                other = looked[1 - i]
-                if other >= 0:
-                    r[i] -= shaping * angle[i, other]
+        # each agent's target: the toy the other looks at (the follower; both in "shared"
+        # mode); the leader's instruction ("leader" mode)
+        targets = looked[::-1].copy()
+        if self._instructed:
+            targets[self.leader] = self.instruction
+        self._targets = targets
+        has = targets >= 0
+        on = has & (looked == targets)
+        self._with += has
+        self._on += on
+        self._shared = on
+        err = angle[np.arange(2), np.maximum(targets, 0)]
+        r = on.astype(float) - self.options.shaping * np.where(has, err, 0.0)
         return self._weights * r
 
     def terminations(self, env):
         infos = []
+        enough = self._with * self._dt >= MIN_TARGET_S - 1e-9
+        frac = self._on / np.maximum(self._with, 1)
+        success = enough & (frac >= self.options.success_share)
         for i in range(2):
-            other = int(self._looked[1 - i])
-            err = float(np.rad2deg(self._angle[i, other])) if other >= 0 else -1.0
-            infos.append({"looked_at": int(self._looked[i]), "target": other,
-                          "gaze_error_deg": err, "is_success": self._joint})
+            t = int(self._targets[i])
+            err = float(np.rad2deg(self._angle[i, t])) if t >= 0 else -1.0
+            infos.append({"looked_at": int(self._looked[i]), "target": t,
+                          "gaze_error_deg": err, "shared": bool(self._shared[i]),
+                          "on_target_fraction": float(frac[i]),
+                          "leader": i == self.leader, "is_success": bool(success[i])})
         return np.zeros(2, bool), infos

@@ -125,7 +125,7 @@ def _swivel(env, agent=1):
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_gaze_at_target_looks_at_its_toy_after_one_second(seed):
-    partner = GazeAtTarget(hold_s=(30.0, 30.0))
+    partner = GazeAtTarget(hold_s=(30.0, 30.0), head_share=1.0)
     env = joint_attention_v0.scripted_env(partner, vision=False)
     env.reset(seed=seed)
     start = _swivel(env)
@@ -142,6 +142,46 @@ def test_gaze_at_target_looks_at_its_toy_after_one_second(seed):
     assert abs(np.deg2rad(swivels[-1]) - wanted["head_swivel"]) < np.deg2rad(3.0)
     # ... and physically, through its motors: no jump from one step to the next
     assert np.max(np.abs(np.diff(swivels))) < 6.0
+
+
+@pytest.mark.parametrize("share", [0.0, 0.3])
+def test_gaze_at_target_turns_mostly_its_eyes_with_a_small_head_share(share):
+    """The head makes ``share`` of the turn (more where the eyes cannot reach), the eyes the
+    rest; the gaze lands on the toy all the same."""
+    for seed in (0, 1, 2):
+        partner = GazeAtTarget(hold_s=(30.0, 30.0), head_share=share)
+        env = joint_attention_v0.scripted_env(partner, vision=False)
+        env.reset(seed=seed)
+        for _ in range(100):
+            _, _, _, _, info = env.step({"infant_0": STILL_HEAD})
+        assert _partner_error_deg(env, partner.target) < 3.0
+        assert info["infant_0"]["target"] == partner.target
+        full = np.rad2deg(look_angles(env.unwrapped, "infant_1", "body", int(
+            env.unwrapped.task.toy_bodies[partner.target]))["head_swivel"])
+        turned = _swivel(env)
+        assert np.sign(turned) == np.sign(full)
+        assert share * abs(full) - 3.0 < abs(turned) < abs(full) - 10.0, (seed, turned, full)
+        a = env.unwrapped.world.agents[1]
+        eye = np.rad2deg(env.unwrapped.world.data.qpos[
+            a.qpos_adr[a.joint_names.index("right_eye_horizontal")]])
+        assert abs(eye) > 10.0                                   # the eyes make the rest
+
+
+def test_gaze_at_target_takes_the_tasks_head_share_range_per_shift():
+    partner = GazeAtTarget(hold_s=(0.3, 0.3))
+    env = joint_attention_v0.scripted_env(partner, vision=False, task_options={
+        "partner_head_share": 0.4, "partner_head_jitter": 0.2})
+    env.reset(seed=3)
+    assert env.unwrapped.task.partner_head_share == pytest.approx((0.2, 0.6))
+    shares = {partner.share}
+    for _ in range(300):
+        env.step({"infant_0": STILL_HEAD})
+        shares.add(partner.share)
+    assert len(shares) >= 5 and 0.2 <= min(shares) and max(shares) <= 0.6
+    own = GazeAtTarget(head_share=(0.9, 1.0))
+    env = joint_attention_v0.scripted_env(own, vision=False)
+    env.reset(seed=3)
+    assert 0.9 <= own.share <= 1.0
 
 
 def test_gaze_at_target_switches_targets_at_random_times():
@@ -191,6 +231,9 @@ def test_gaze_at_target_bad_input():
         GazeAtTarget(targets="toy_0")
     with pytest.raises(ValueError, match="omega"):
         GazeAtTarget(omega=-1)
+    for bad in (1.5, -0.1, (0.6, 0.2), "half", True):
+        with pytest.raises(ValueError, match="head_share"):
+            GazeAtTarget(head_share=bad)
     env = joint_attention_v0.scripted_env(GazeAtTarget(targets=["teddy"]), vision=False)
     with pytest.raises(ValueError, match="'teddy' is neither a body nor a site"):
         env.reset(seed=0)
