@@ -2,27 +2,30 @@
 
 | | |
 |---|---|
-| agents | 2: the toucher `infant_0` and the touched infant `infant_1`, sitting cross-legged face to face, `distance` (0.28 m) apart hip to hip, within arm's reach; exactly two (a third raises an error) |
-| body | hips fixed on the floor, legs crossed; the toucher: everything but the right arm held, the trunk bent forward towards the partner (lower trunk 20 deg, the upper trunk coupled), the left arm hanging at its side; the touched infant: everything but both arms held, leaning back a little (6 deg); heads upright; the eyes are set by the task each control step: the toucher's fixate the target part, the touched infant's the toucher's right hand |
+| agents | 2: the toucher `infant_0` and the touched infant `infant_1`, sitting cross-legged face to face, `distance` (0.37 m; 0.35 to 0.40) apart hip to hip: sitting infants at play, arms' length and a lean apart; exactly two (a third raises an error) |
+| body | hips fixed on the floor, legs crossed; the toucher: everything but the right arm and the eyes held, the trunk bent forward towards the partner as far as it goes (lower trunk 30.5 deg, the upper trunk coupled: 61 deg), the head tilted back (-60 deg) to face the partner, the left arm hanging at its side; the touched infant: everything but both arms and the eyes held, leaning back a little (6 deg); the heads stay 8 cm apart (6 cm at 0.35 m) |
 | scene | the floor only: the target is a part of the partner's body |
-| reset | the toucher's right arm starts out to its side, touching nothing; the touched infant's hands rest on its legs; the target part is drawn uniformly from `targets` (task option `target` fixes it) |
+| reset | the toucher's right arm starts out to its side, touching nothing; the touched infant's hands rest on its legs; the target part is drawn uniformly from `targets` with the env's seeded generator (task option `target` fixes it) |
 | action | `infant_0`: the right arm's motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five fingers: 29) in [-1, 1]; `infant_1`: both arms' motors (16; 58), zero in the scripted env (`Still` partner); expressions off by default (`expressions=True` adds them) |
-| observation | both: `proprioception` (toucher 72, touched infant 120; the toucher's eye angles tell where the target is), `touch` (normal force only, 1 float a point): the toucher's skin covers its right arm (upper arm to fingertips, a tenth of the published point density: 242 floats), the touched infant's its whole body (a quarter of the density: 1400); the toucher also gets `target`, one-hot over `targets` (9 for the mitten body) |
-| reward (both) | `-distance(toucher's right fingertips, target part's centre of mass)` (m) per step, `+success_reward` (100) on success |
-| success (`is_success`) | the toucher's right hand (hand or fingers) touches the target part and the touched infant's skin feels it there, with the toucher as the source |
-| termination | both, on success (if `end_on_touch`, default); touching another part does not end the episode; truncation at `max_steps` (500 steps, 5 s) |
-| infos (both) | `target_part`, `is_success`, `touched_parts` (the partner's parts the toucher's right hand touches this step), `target_felt` (the touched infant's skin feels the toucher on the target part), `fingertip_distance` (m), and each agent's own skin record `touch` |
-| options | `targets` (None: :data:`DEFAULT_TARGETS`, those of them in the partner's body), `target` (None), `success_reward` (100.0), `end_on_touch` (True), `distance` (0.28 m, 0.25 to 0.4) |
-| privileged cues | the task points the toucher's eyes at the target part every control step (its eye angles tell where the target is) and gives the target as a one-hot code; the touched infant's eyes follow the toucher's right hand; the touch itself only through the skins |
-| baselines | random policies (uniform actions, 20 episodes, seeds 0-19; no command in the package): `parallel_env()`, both random: return of `infant_0` -16.7 +- 80.7, 11 / 20 successes, 354 steps; `scripted_env()`, random toucher with the `Still` partner: -19.2 +- 73.7, 10 / 20, 371 steps. PPO, scripted `Still` partner, 2 seeds, 61k env steps (4.5-5 min): evaluation success (10 episodes) 0 % -> 20 % / 60 % at the end, mean return -153 -> -43 / +10: not yet better than random (`mimo-social compare --task social_touch --mode scripted --algos ppo --seeds 2 --steps 60000 --out runs/social_touch --eval-every 5000 --eval-episodes 10`) |
-| sources | not in the MIMo paper: a social task of this package, the social version of self-body touch (paper Sec. VI-A); rationale (touch, body-part games) and figures: `docs/social/social_touch.md` |
-| version history | v0: first version, with the skin-sensed high five |
+| observation | both: `proprioception` (toucher 72, touched infant 120), `touch` (normal force only, 1 float a point): the toucher's skin covers its right arm (upper arm to fingertips, a tenth of the published point density: 242 floats), the touched infant's its whole body (a quarter of the density: 1400); the toucher also gets `target`, one-hot over `targets` (7 for the mitten body): the instruction, not the target's location. With `assisted_gaze` off (default) nothing else depends on the target: changing `target` with everything else fixed changes only that one-hot (tested) |
+| reward (both) | shaping (`shaping`, default on): `-distance(toucher's right fingertips, target part's centre of mass)` (m) per step; `+success_reward` (100) on success; a wrong first touch (`end_on_touch`): the rest of the episode's shaping charged at once (`-distance x steps left`), so ending early saves nothing. The best return: touch the target first, as early as possible |
+| success (`is_success`) | decided by the FIRST contact between the toucher's right arm (upper arm to fingertips) and the partner: a success when it includes the toucher's hand on the target part, not with the back of the hand (the contact normal within 120 deg of the palm's normal: palm, finger pads, fingertips and edges count); any other first contact (another part, the forearm, the back of the hand) is a wrong touch and the attempt is over without the bonus; parts touched in the same 10 ms step as the target (a hand resting on a thigh) do not spoil it; `is_success` stays true for the rest of the episode |
+| termination | both, when the first contact decides the attempt (success or wrong touch; `end_on_touch`, default); truncation at `max_steps` (500 steps, 5 s) |
+| infos (both) | `target_part`, `is_success`, `wrong_touch`, `first_touch` (the partner's parts touched at the deciding contact; None before), `touched_parts` (the partner's parts the toucher's right arm touches this step), `target_felt` (the touched infant's skin feels the toucher's hand on the target), `fingertip_distance` (m), and each agent's own skin record `touch` |
+| options | `targets` (None: :data:`DEFAULT_TARGETS`, those of them in the partner's body; only parts of :data:`REACHABLE`: others raise an error), `target` (None), `success_reward` (100.0), `end_on_touch` (True), `distance` (0.37 m, 0.35 to 0.40), `shaping` (True), `assisted_gaze` (False) |
+| privileged cues | `target` one-hot (always: the instruction, the task's "name" of the part; it does not say where the part is); `assisted_gaze` (default False): the task aims the toucher's eyes at the target part every step (its eye angles then tell where the target is) and the touched infant's at the toucher's right palm; off, each looks at the other's face (eye angles set once per reset, the same for every target); the touch itself only through the skins |
+| baselines | scripted env, `Still` partner, 20 episodes (seeds 1000-1019; random / zero: actions seeded by the episode): `SocialTouchController` (mimo_social.partners.controllers.touch) 20 / 20, return 84.9 +- 2.0, 134 steps to success; random 1 / 20 (5 %), -78.6 +- 28.6; zero 0 / 20, -172.4 +- 15.9; hacks: `NearestPartToucher` (the part nearest its hand, whatever the target) 3 / 20, -63.1 +- 73.3; `ArmSweep` (the arm swept across the partner) 0 / 20, -104.1 +- 33.4 (script and PPO: `docs/social/social_touch.md`) |
+| sources | not in the MIMo paper: a social task of this package, the social version of self-body touch (paper Sec. VI-A); rationale (touch, body-part games), distances and figures: `docs/social/social_touch.md` |
+| version history | v0: first version, with the skin-sensed high five; v0, issue 15: success = the first touch is the hand (not its back) on the target, a wrong first touch ends the attempt without the bonus (and is charged the rest of the shaping); 0.37 m apart (0.35-0.40; was 0.28), the toucher leaning in as far as its trunk bends; targets only parts reachable over that range, checked by IK (the head and the mitten's fingers dropped); the task-aimed gaze is the `assisted_gaze` option, off by default (each looks at the other's face); `shaping` option; the scripted toucher `SocialTouchController` and two hack policies |
 
-Targets by default are the partner's parts within the toucher's reach in this pose: head, upper
-and lower trunk, the partner's left arm (upper arm, lower arm, hand and the mitten's fingers: it
-is on the toucher's right) and left thigh and shin; the eyes are never targets. With another
-`distance`, give `targets` reachable there. The toucher's trunk is held bent forward: free, with
-zero command, it sags forward under gravity until the heads meet.
+Targets by default are the partner's parts within reach of the toucher's right hand over the whole
+distance range: upper and lower trunk, the partner's left arm (upper arm, lower arm, hand: it is
+on the toucher's right) and left thigh and shin. For each, a posture of the right arm (found by
+inverse kinematics, :func:`~mimo_social.partners.controllers.touch.reach_posture`) puts the hand
+into the part, touching nothing else of the partner, at 0.35, 0.37 and 0.40 m (tested). The head
+is out of reach at 0.40 m, the far side, the hip and the feet are not offered, and the mitten's
+fingers lie on the thigh: "touch my hand" is `left_hand`. The toucher's trunk is held bent
+forward: free, with zero command, it sags forward under gravity until the heads meet.
 """
 
 from __future__ import annotations
@@ -53,33 +56,48 @@ from .common import (
 )
 
 TOUCHER, TOUCHED = 0, 1
-DISTANCE = 0.28
-DISTANCE_RANGE = (0.25, 0.4)   # closer, the crossed feet meet; farther, little is in reach
+DISTANCE = 0.37
+# sitting infants at play face to face, hip to hip (see docs/social/social_touch.md)
+DISTANCE_RANGE = (0.35, 0.40)
 # cross-legged (the legs of the self-body pose)
 SITTING_DEG = {k: v for k, v in CROSS_LEGGED_DEG.items()
                if "hip" in k or "knee" in k or "ankle" in k}
 # the touched infant leans back a little, so that the leaning toucher's head stays clear of it
 RECLINE_DEG = -6.0
-# the toucher's lower trunk bend (the upper trunk follows, coupled): towards the partner
-LEAN_DEG = 20.0
+# the toucher's lower trunk bend (the upper trunk follows, coupled: 61 deg in all), at the
+# joint's limit: leaning in as far as it goes gives the arm its reach at 0.35-0.40 m
+LEAN_DEG = 30.5
+# the toucher's head tilted back against the lean, so that it faces the partner
+HEAD_TILT_DEG = -60.0
 # the toucher's left arm hangs at its side, out of the way
 SIDE_ARM_DEG = {"left_shoulder_abduction": 15.0, "left_elbow": -10.0}
 # the toucher's right arm at the start: out to its side, elbow a little bent, touching nothing
 ARM_START_DEG = {"right_shoulder_abduction": 45.0, "right_shoulder_horizontal": 0.0,
                  "right_elbow": -30.0}
-# the partner's parts that the toucher's right hand reaches at the default distance: each was
-# touched by at least 20 of 4,000 uniformly random postures of the toucher's right arm; the hip
-# (5) and the eyes (5) were touched by next to none, every other part by none
-DEFAULT_TARGETS = ("head", "upper_body", "lower_body",
-                   "left_upper_arm", "left_lower_arm", "left_hand", "left_fingers",
-                   "left_upper_leg", "left_lower_leg")
+#: the partner's parts that the toucher's right hand reaches over the whole distance range
+#: (0.35-0.40 m): for each, a posture of the right arm found by inverse kinematics puts the hand
+#: into the part, touching nothing else of the partner (tests/tasks/test_social_touch.py); the
+#: head, the hip, the far (right) side and the feet are not offered. ``targets`` may name only
+#: these.
+REACHABLE = ("upper_body", "lower_body", "left_upper_arm", "left_lower_arm", "left_hand",
+             "left_upper_leg", "left_lower_leg")
+#: the targets by default: the reachable parts but the left thigh, where a dropped arm lands
+#: (uniformly random actions touch it first, palm side, in a third of the episodes; it is
+#: offered with ``targets=[...]``)
+DEFAULT_TARGETS = tuple(p for p in REACHABLE if p != "left_upper_leg")
+#: a hand contact is made with the back of the hand (which does not count) when the contact
+#: normal (from the hand into the partner) has a component at or below this along the palm's
+#: normal (-0.5: more than 120 deg from it); palm, finger pads, fingertips and edges count
+BACK_COS = -0.5
 
 
 @dataclass(frozen=True)
 class SocialTouchOptions(TaskOptions):
     """The partner's target parts (None: :data:`DEFAULT_TARGETS`), one fixed target (None:
-    drawn each episode), the reward for a felt touch of the target, whether it ends the
-    episode, and the distance between the infants (m)."""
+    drawn each episode), the reward for touching the target first, whether the first touch ends
+    the episode, the distance between the infants (m), the per-step distance shaping, and
+    whether the task aims the eyes (the toucher's at the target, the touched infant's at the
+    toucher's hand: a privileged cue)."""
 
     task = "social_touch"
     targets: tuple[str, ...] | None = None
@@ -87,13 +105,17 @@ class SocialTouchOptions(TaskOptions):
     success_reward: float = 100.0
     end_on_touch: bool = True
     distance: float = DISTANCE
+    shaping: bool = True
+    assisted_gaze: bool = False
 
     def __post_init__(self):
         self._names("targets", "body part names of the partner")
         self._name("target", "a body part name from targets")
-        self._number("success_reward")
+        self._number("success_reward", 0.0)
         self._bool("end_on_touch")
         self._number("distance", *DISTANCE_RANGE)
+        self._bool("shaping")
+        self._bool("assisted_gaze")
 
 
 class SocialTouch(Task):
@@ -130,6 +152,11 @@ class SocialTouch(Task):
             if bad:
                 raise ConfigError(f"social_touch: targets {bad} are not body parts of the "
                                   f"partner ({tables.hands} body); body parts: {list(parts)}")
+            far = [p for p in given if p not in REACHABLE]
+            if far:
+                raise ConfigError(f"social_touch: targets {far} are out of the toucher's reach "
+                                  f"at {DISTANCE_RANGE[0]}-{DISTANCE_RANGE[1]} m; allowed: "
+                                  f"{[p for p in REACHABLE if p in parts]}")
             targets = tuple(given)
         fixed = self.options.target
         if fixed is not None and fixed not in targets:
@@ -144,7 +171,8 @@ class SocialTouch(Task):
         tables = load_body(config.hands)
         if i == TOUCHER:
             actuated = right_arm_joints(tables)
-            angles = {**SITTING_DEG, **SIDE_ARM_DEG, "lower_trunk_bend": LEAN_DEG}
+            angles = {**SITTING_DEG, **SIDE_ARM_DEG, "lower_trunk_bend": LEAN_DEG,
+                      "head_tilt": HEAD_TILT_DEG}
             require_skin(self.name, "infant_0", config, right_hand_parts(tables),
                          "the touch it gives")
         else:
@@ -168,10 +196,19 @@ class SocialTouch(Task):
         m = w.model
         self._world = w
         toucher, touched = w.agents[TOUCHER], w.agents[TOUCHED]
-        self._touch = env.systems.get("touch")
         self._gaze = [Gaze(w, TOUCHER), Gaze(w, TOUCHED)]
-        self._is_hand = np.zeros(m.ngeom, bool)
-        self._is_hand[hand_geoms(w, TOUCHER, 0)] = True
+        self._eyes = [g.look.qpos for g in self._gaze]
+        self._eye_dofs = np.concatenate([g.look.dof for g in self._gaze])
+        # the toucher's right arm (upper arm to fingertips): 1 = arm, 2 = hand; else 0
+        self._arm = np.zeros(m.ngeom, np.int8)
+        root = m.body(f"{toucher.name}/right_upper_arm").id
+        below = np.zeros(m.nbody, bool)
+        below[root] = True
+        for b in sorted(toucher.body_ids.tolist()):
+            if b != root and below[m.body_parentid[b]]:
+                below[b] = True
+        self._arm[toucher.geom_ids[below[m.geom_bodyid[toucher.geom_ids]]]] = 1
+        self._arm[hand_geoms(w, TOUCHER, 0)] = 2
         # every geom of the touched infant -> its body id; every other geom -> -1
         self._partner_body = np.full(m.ngeom, -1, dtype=np.intp)
         self._partner_body[touched.geom_ids] = m.geom_bodyid[touched.geom_ids]
@@ -182,25 +219,36 @@ class SocialTouch(Task):
                                        dtype=np.intp)
         self._fingertip = int(toucher.fingertip_sites[0])
         self._palm = int(toucher.palm_sites[0])
+        self._head = [int(w.agents[j].head_site) for j in (TOUCHER, TOUCHED)]
         idx = {n: k for k, n in enumerate(toucher.joint_names)}
         ks = [idx[n] for n in ARM_START_DEG if n in idx]
         self._arm_qpos = toucher.qpos_adr[ks]
         self._arm_start = np.clip(np.deg2rad([ARM_START_DEG[toucher.joint_names[k]] for k in ks]),
                                   toucher.joint_range[ks, 0], toucher.joint_range[ks, 1])
         self._source = toucher.name
+        self._touch = env.systems.get("touch")
+        self._geom_body = m.geom_bodyid.copy()
 
     def reset(self, env, rng):
         if getattr(self, "_world", None) is not env.world:
             self._bind(env)
-        env.world.data.qpos[self._arm_qpos] = self._arm_start
+        m, d = env.world.model, env.world.data
+        d.qpos[self._arm_qpos] = self._arm_start
         fixed = self.options.target
         self._target = (self.targets.index(fixed) if fixed is not None
                         else int(rng.integers(len(self.targets))))
         self._onehot = np.zeros(len(self.targets), np.float32)
         self._onehot[self._target] = 1.0
-        self._success = self._felt = False
+        self._success = self._wrong = self._felt = False
+        self._first: list[str] | None = None
         self._touched: list[str] = []
         self._distance = float("nan")
+        if not self.options.assisted_gaze:
+            # each looks at the other's face: the heads are held, so these angles are fixed
+            # for the episode and the same whatever the target
+            for j, g in enumerate(self._gaze):
+                g(m, d, "site", self._head[1 - j])
+            self._held_eyes = [d.qpos[q].copy() for q in self._eyes]
         self.before_physics(env)
 
     @property
@@ -210,42 +258,71 @@ class SocialTouch(Task):
 
     def before_physics(self, env):
         m, d = env.world.model, env.world.data
-        self._gaze[TOUCHER](m, d, "body", self._target_bodies[self._target])
-        self._gaze[TOUCHED](m, d, "site", self._palm)
+        if self.options.assisted_gaze:
+            self._gaze[TOUCHER](m, d, "body", self._target_bodies[self._target])
+            self._gaze[TOUCHED](m, d, "site", self._palm)
+        else:
+            for q, held in zip(self._eyes, self._held_eyes):
+                d.qpos[q] = held
+            d.qvel[self._eye_dofs] = 0.0
 
     def observe(self, env, i):
         return {"target": self._onehot.copy()} if i == TOUCHER else {}
 
-    def _hand_contacts(self, d) -> np.ndarray:
-        """Body ids of the touched infant's parts in contact with the toucher's right hand."""
+    def _arm_contacts(self, d) -> tuple[np.ndarray, np.ndarray]:
+        """The touched infant's parts (body ids) in contact with the toucher's right arm this
+        step, and whether each contact is made by the palm side of the toucher's hand (hand or
+        finger geom, the contact normal into the partner within 90 deg of the palm's normal:
+        the segment's local -y)."""
         n = d.ncon
         if n == 0:
-            return np.empty(0, np.intp)
+            return np.empty(0, np.intp), np.empty(0, bool)
         c = d.contact
         g1, g2 = c.geom1[:n], c.geom2[:n]
-        h1, h2 = self._is_hand[g1], self._is_hand[g2]
-        body = self._partner_body[np.where(h1, g2, g1)]
-        keep = (h1 ^ h2) & (body >= 0) & (c.dist[:n] <= 0.0)
-        return body[keep]
+        a1, a2 = self._arm[g1], self._arm[g2]
+        first = a1 > 0
+        keep = (first ^ (a2 > 0)) & (c.dist[:n] <= 0.0)
+        body = self._partner_body[np.where(first, g2, g1)]
+        keep &= body >= 0
+        if not keep.any():
+            return np.empty(0, np.intp), np.empty(0, bool)
+        mine = np.where(first, g1, g2)[keep]
+        normal = c.frame[:n, :3][keep] * np.where(first[keep], 1.0, -1.0)[:, None]
+        palm = -d.xmat[self._geom_body[mine]].reshape(-1, 3, 3)[:, :, 1]
+        volar = (self._arm[mine] == 2) & (np.einsum("ij,ij->i", normal, palm) > BACK_COS)
+        return body[keep], volar
 
     def rewards(self, env):
         d = env.world.data
         target = self._target_bodies[self._target]
-        bodies = self._hand_contacts(d)
-        self._touched = sorted({self._part_name[int(b)] for b in bodies}) if len(bodies) else []
+        bodies, by_hand = self._arm_contacts(d)
+        self._touched = sorted({self._part_name[int(b)] for b in bodies})
+        hand_on_target = bool(np.any(by_hand & (bodies == target)))
         self._felt = False
-        if np.any(bodies == target):
+        if hand_on_target and self._touch is not None:
             felt = self._touch.touched_by(TOUCHED).get(self.target)
             self._felt = bool(felt is not None and self._source in felt["agents"])
-        self._success = self._felt
         self._distance = float(np.linalg.norm(d.site_xpos[self._fingertip] - d.xipos[target]))
-        r = -self._distance + (self.options.success_reward if self._success else 0.0)
+        r = -self._distance if self.options.shaping else 0.0
+        if self._first is None and len(bodies):
+            # the attempt is decided by the first contact of the arm with the partner
+            self._first = list(self._touched)
+            if hand_on_target:
+                self._success = True
+                r += self.options.success_reward
+            else:
+                self._wrong = True
+                if self.options.end_on_touch and self.options.shaping:
+                    # ending early saves nothing: the rest of the episode's shaping, at the
+                    # current distance, is charged now
+                    r -= self._distance * max(env.max_steps - env.steps, 0)
         return np.array([r, r])
 
     def terminations(self, env):
-        done = self._success and self.options.end_on_touch
+        done = self._first is not None and self.options.end_on_touch
         info = {"target_part": self.target, "is_success": self._success,
-                "touched_parts": self._touched, "target_felt": self._felt,
-                "fingertip_distance": self._distance}
-        return np.array([done, done]), [dict(info, touched_parts=list(self._touched))
-                                         for _ in range(2)]
+                "wrong_touch": self._wrong, "first_touch": self._first,
+                "target_felt": self._felt, "fingertip_distance": self._distance}
+        return np.array([done, done]), [dict(info, touched_parts=list(self._touched),
+                                             first_touch=None if self._first is None
+                                             else list(self._first)) for _ in range(2)]
