@@ -36,6 +36,12 @@ class TaskOptions:
     """
 
     task: ClassVar[str] = "task"
+    #: the options that give a learner a privileged cue: something of its partner or of its
+    #: target that its own senses would not tell it (e.g. ``assisted_gaze``: the task aims the
+    #: learner's head and eyes at the partner's hand, so the hand's place is in its
+    #: proprioception). Each is a bool, off by default; the task table's ``privileged cues`` row
+    #: names each one (tests/conformance/test_privileged.py checks both).
+    privileged: ClassVar[tuple[str, ...]] = ()
 
     @classmethod
     def of(cls, given: "TaskOptions | Mapping[str, Any] | None" = None) -> "TaskOptions":
