@@ -1,21 +1,25 @@
-"""Handover: one infant holds out a ball in its right hand, the other takes it.
+"""Handover: one infant holds out a ball in its right hand, the other takes it into its own.
 
 | | |
 |---|---|
-| agents | 2: `infant_0` the receiver, `infant_1` the giver (scripted :class:`~mimo_social.partners.HandOffer` in `scripted_env`, or a learner); standing face to face, `distance` (0.34 m) apart |
-| body | five-fingered hands (`hands="five_fingers"` is required), spring-damper motors by default (`actuation="muscle"`, for all or per agent, works too); standing, hip fixed in the world; trunk, legs, left arm held; each agent's right arm (shoulder 3, elbow, wrist 3, 22 finger joints) actuated; the receiver's head and eyes fixate the ball, the giver's fixate the receiver's right palm (set by the task every control step) |
+| agents | 2: `infant_0` the receiver, `infant_1` the giver (scripted: :func:`scripted_giver`, a :class:`~mimo_social.partners.HandOffer` with `release="on_hold"`, in `scripted_env`; or a learner); standing face to face, `distance` (0.34 m) hip to hip |
+| body | five-fingered hands (`hands="five_fingers"` is required), spring-damper motors by default (`actuation="muscle"`, for all or per agent, works too); standing, hip fixed in the world; trunk, legs, left arm held; each agent's right arm (shoulder 3, elbow, wrist 3, 22 finger joints) actuated; head and eyes held at rest looking straight ahead (at the partner's face), unless `assisted_gaze` |
 | scene | a ball (radius `ball_radius` 3 cm, mass `ball_mass` 30 g) |
-| reset | the giver's arm is posed in its offer posture (:func:`~mimo_social.partners.hand_offer.offer_posture` for `offer_target` = 18 cm ahead of its right shoulder, 10 cm toward its midline, 8 cm lower; palm up, leaning slightly toward thumb and fingers), the ball laid in its palm, its four fingers curled kinematically until they touch the ball; then for `settle_time` (0.3 s) the giver's own motors hold the arm and the fingers grip gently (the :class:`HandOffer` controller): the episode starts with a physical grasp at rest, no weld. The receiver's right arm starts at a random offset (+-`arm_noise` 10 deg per joint of shoulder, elbow, wrist) from its hanging posture |
+| geometry | the offered ball's centre is 20.1 cm from the receiver's right shoulder (15.7 cm ahead, 11.5 cm toward the midline, 5 cm lower) and 22.1 cm from the giver's; MIMo's straight arm reaches 22.2 cm from the shoulder to the palm centre (27.7 cm to the fingertips); the receiving hand of :class:`~mimo_social.partners.controllers.receive.ReceiveController` (palm up beside the giver's hand) lies 20.2 cm from the shoulder, reached by its inverse kinematics within 1 mm (measured at the default options; tests/partners/test_receive.py) |
+| reset | the giver's arm is posed in its offer posture (:func:`~mimo_social.partners.hand_offer.offer_posture` for `offer_target` = 18 cm ahead of its right shoulder, 10 cm toward its midline, 8 cm lower; palm up, leaning slightly toward thumb and fingers), the ball laid in its palm, its four fingers curled kinematically until they touch the ball; then for `settle_time` (0.3 s) the giver's own motors hold the arm and the fingers grip gently (:class:`HandOffer`): the episode starts with a physical grasp at rest, no weld. The receiver's right arm starts at a random offset (+-`arm_noise` 10 deg per joint of shoulder, elbow, wrist) from its hanging posture |
+| scripted giver | :func:`scripted_giver`: holds the ball still in its upturned palm; when the receiver holds an open right hand next to its own (palm centres within 8 cm, the receiver's palm facing up within 45 deg) for 0.3 s, it tips its palm toward its little-finger side (over 0.5 s; it levels it again if that hand goes away); it lets go (fingers open, the hand withdraws 3 cm back and 8 cm down) only once the receiver's hand holds the ball: >= 2 of its segments touch it and carry >= half its weight (the upward contact force), for 0.2 s. A touch of the back of the hand or a poke by one finger does neither (tests/partners/test_hand_offer.py) |
+| scripted receiver | :class:`~mimo_social.partners.controllers.receive.ReceiveController` (through its own motors, reading the ball's position): holds its hand out open, palm up, beside the giver's, lets the ball roll in and closes the fingers gently. With the scripted giver: 19 / 20 successes (seeds 1000-1019), 20 / 20 (seeds 0-19) |
 | action | per agent: the right-arm motors, 29 (spring-damper, in [-1, 1]) or 58 (muscles, in [0, 1]); plus the expression when `expressions=True` |
-| observation | `proprioception` (210; the head and eye angles tell where the ball / the receiver's hand is), `touch` (3404: the skin of both arms and hands, normal force, 1 float a point); never the partner's joints or the ball's coordinates |
-| reward (both) | `-distance(receiver's right fingertips, ball)` every step; `+success_reward` (10) on success; `failure_reward` (-1) when the ball drops, and (`charge_remaining`, on) minus that step's distance times the steps left in the episode: the per-step shaping is negative, so without this charge ending the episode by knocking the ball down would beat holding still (measured without the charge: two random agents drop it within 0.35 s and score -10, a random receiver with the scripted giver scores -145 over the full episode) |
-| success | the ball touches at least `min_parts` (2) segments of the receiver's right hand (palm, finger segments), no longer touches the giver's hand and is above `drop_height`, continuously for `hold_time` (0.3 s) |
-| termination | both agents, on success or when the ball falls below `drop_height` (0.25 m: well below the hands, near the floor); truncation at `max_steps` (600, 6 s) |
-| infos | `is_success`, `holder` (`"giver"`: the ball touches the giver's hand; `"receiver"`: the receiver's hand in >= `min_parts` segments and not the giver's; `"none"` otherwise), `dropped`, `receiver_parts`, `held_steps`, `distance` |
-| privileged cues | the task points the receiver's head and eyes at the ball and the giver's at the receiver's right palm every control step (their angles tell where those are); the giver's grip and release reach the receiver only through its skin and the ball |
-| baselines | random policies (uniform actions, 20 episodes, reset seeds 0-19; no command in the package): `scripted_env()`, random receiver with the `HandOffer` giver: return -164.2 +- 33.4, 0 / 20 successes, ball dropped 3 / 20, 563 steps; `parallel_env()`, both random: -237.5 +- 64.8, 0 / 20, dropped 20 / 20, 34 steps. PPO receiver, scripted `HandOffer` giver, 2 seeds, 51k env steps (10 min): training return -171 -> -112 / -119 (random receiver: -164 +- 33), evaluation -130 -> -79 / -106; no handover (`mimo-social compare --task handover --mode scripted --algos ppo --seeds 2 --steps 50000 --out runs/handover --eval-every 5000 --eval-episodes 5`) |
-| sources | not in the MIMo paper: a social task of this package; rationale (give and take, 9-18 months) and figures: `docs/social/handover.md` |
-| version history | v0: first version, with the scripted partner `HandOffer` |
+| observation | `proprioception` (174: the agent's own joints; head and eyes are held in the body, at rest; 210 with `assisted_gaze`, whose head and eye angles the task sets), `touch` (3404: the skin of both arms and hands, normal force, 1 float a point); never the partner's joints or the ball's coordinates: before contact the receiver's observation does not change with where the ball is offered (tested) |
+| reward (both) | `shaping` (on): `shaping_scale` (10) x the decrease, this step, of the distance from the receiver's right palm centre to the ball (progress: it sums to 10 x (start - end distance), so hovering earns at most ~2 and leaving gives it back); `+success_reward` (10) on success; `failure_reward` (-10) when the ball drops. Holding the ball is the optimum; dropping it is worse than never trying (zero action: ~0) |
+| success | the ball touches at least `min_parts` (2) segments of the receiver's right hand (palm, finger segments), no longer touches the giver's hand and is above `drop_height`, continuously for `hold_time` (0.3 s); `is_success` in the last step's info is the episode's outcome |
+| termination | both agents, on success (`end_on_success`) or when the ball falls below `drop_height` (0.25 m: well below the hands, near the floor); truncation at `max_steps` (600, 6 s) |
+| infos | `is_success`, `holder` (`"giver"`: the ball touches the giver's hand; `"receiver"`: the receiver's hand in >= `min_parts` segments and not the giver's; `"none"` otherwise), `dropped`, `receiver_parts`, `held_steps`, `distance` (receiver's palm centre to the ball, m) |
+| privileged cues | `assisted_gaze` (False): when on, the task points the receiver's head and eyes at the ball and the giver's at the receiver's right palm every control step (their angles then tell where those are: a leak of the ball's position into proprioception); off, head and eyes stay at rest, looking straight ahead at the partner. The giver's grip and release reach the receiver only through its skin and the ball |
+| two learners | `parallel_env()`: both learn, both get the same reward; the giver must hold its own arm up (with zero actions it sinks and the ball falls within 0.5 s: a failure for both); nothing makes the giver let go but its own fingers |
+| baselines | 20 episodes each, reset seeds 1000-1019, `scripted_env(scripted_giver())` (the receiver acts): scripted `ReceiveController` 19 / 20 successes, return 10.9 +- 4.9, 202 steps (2.0 s) to success; zero action 0 / 20, -0.03 +- 0.04; random (uniform) 0 / 20, -1.8 +- 4.2 (3 drops); hacks: touch the ball (`ReachController(depth=0.02)`) 0 / 20, 1.4 +- 0.1; hold the hand out and leave when the ball comes (`CupAndLeave`) 0 / 20, -9.7 +- 0.2 (20 drops); command: `python -m pytest -m slow tests/partners/test_receive.py` (prints them). PPO: see docs/social/handover.md |
+| sources | not in the MIMo paper: a social task of this package; rationale (give and take, 9-18 months), the release rule and figures: `docs/social/handover.md` |
+| version history | v0: first version, with the scripted partner `HandOffer`; v0, issue 15: the giver hands the ball into an open hand (tips its palm toward it) and lets go only once the receiver's hand carries the ball (was: opened at the first touch of any hand); progress shaping (`shaping`, `shaping_scale`) and `failure_reward` -10 replace the per-step -distance and `charge_remaining`; head and eyes at rest unless `assisted_gaze` (was: always aimed by the task); the scripted receiver `ReceiveController` |
 
 A learning giver starts with the same grasp but holds it only if it acts: with zero actions its
 arm sinks under gravity and the ball falls (a failure) within half a second.
@@ -34,6 +38,8 @@ from ..core.kinematics import Gaze, hand_geoms
 from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from ..partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
+
+__all__ = ["Handover", "HandoverOptions", "scripted_giver", "OFFER_TARGET"]
 from ..util.checks import ConfigError
 from .common import geoms_touching, parts_outside
 
@@ -52,9 +58,9 @@ def arms_only_touch(tables) -> dict:
 @dataclass(frozen=True)
 class HandoverOptions(TaskOptions):
     """Distance (m), ball radius (m) and mass (kg), hold time (s), receiver segments needed,
-    drop height (m), rewards, giver settling time (s), receiver arm noise (deg), the giver's
-    offer target (m from its right shoulder: forward, left, up), and whether success ends the
-    episode and a drop is charged the remaining steps."""
+    drop height (m), rewards, progress shaping and its scale, giver settling time (s), receiver
+    arm noise (deg), the giver's offer target (m from its right shoulder: forward, left, up),
+    whether success ends the episode, and whether the task aims the eyes (a privileged cue)."""
 
     task = "handover"
     distance: float = 0.34
@@ -64,12 +70,14 @@ class HandoverOptions(TaskOptions):
     min_parts: int = 2
     drop_height: float = 0.25
     success_reward: float = 10.0
-    failure_reward: float = -1.0
+    failure_reward: float = -10.0
+    shaping: bool = True
+    shaping_scale: float = 10.0
     settle_time: float = 0.3
     arm_noise: float = 10.0
     offer_target: tuple[float, float, float] | None = OFFER_TARGET
     end_on_success: bool = True
-    charge_remaining: bool = True
+    assisted_gaze: bool = False
 
     def __post_init__(self):
         self._number("distance", 0.3, 0.8)
@@ -80,10 +88,12 @@ class HandoverOptions(TaskOptions):
         self._number("drop_height", 0.0, 0.5)
         self._number("success_reward", -1e6, 1e6)
         self._number("failure_reward", -1e6, 1e6)
+        self._bool("shaping")
+        self._number("shaping_scale", 0.0, 1000.0)
         self._number("settle_time", 0.0, 2.0)
         self._number("arm_noise", 0.0, 45.0)
         self._bool("end_on_success")
-        self._bool("charge_remaining")
+        self._bool("assisted_gaze")
         t = self.offer_target
         if t is not None:
             arr = np.zeros(0)
@@ -97,6 +107,14 @@ class HandoverOptions(TaskOptions):
                                   "allowed: None or (forward, left, up) in metres from the "
                                   "giver's right shoulder, within 0.5 m")
             self._put("offer_target", tuple(float(x) for x in arr))
+
+
+def scripted_giver(options: HandoverOptions | None = None) -> HandOffer:
+    """The handover's scripted giver: :class:`~mimo_social.partners.hand_offer.HandOffer`
+    offering at the options' ``offer_target``, handing the ball over into the receiver's open
+    hand (``release="on_hold"``: it lets go only once that hand carries the ball)."""
+    o = options if options is not None else HandoverOptions()
+    return HandOffer(target=o.offer_target, grip=True, release="on_hold")
 
 
 class Handover(Task):
@@ -123,11 +141,11 @@ class Handover(Task):
         facing = (dist, 0.0) if i == RECEIVER else (0.0, 0.0)
         tables = load_body(config.hands)
         arm = right_arm_joints(tables)
-        frozen = held_posture(tables, keep=arm + GAZE_JOINTS,
-                              angles={"right_knee": -5, "left_knee": -5})
+        gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
+        frozen = held_posture(tables, keep=arm + gaze, angles={"right_knee": -5, "left_knee": -5})
         return AgentSetup(config, position=config.position or pos,
                           facing=config.facing or facing, frozen=frozen, base="fixed",
-                          actuated=arm, gaze_joints=GAZE_JOINTS)
+                          actuated=arm, gaze_joints=gaze)
 
     def props(self):
         o = self.options
@@ -147,9 +165,9 @@ class Handover(Task):
         for i in (RECEIVER, GIVER):
             self._hand_of[hand_geoms(w, i, 0)] = i
         self._geom_body = m.geom_bodyid.astype(np.intp)
-        self._gaze = [Gaze(w, i) for i in (RECEIVER, GIVER)]
+        self._gaze = [Gaze(w, i) for i in (RECEIVER, GIVER)] if self.options.assisted_gaze \
+            else []
         r = w.agents[RECEIVER]
-        self._tip = int(r.fingertip_sites[0])
         self._receiver_palm = int(r.palm_sites[0])
         self._offer = HandOffer(target=self.options.offer_target, release=None)
         self._giver_palm = int(w.agents[GIVER].palm_sites[0])
@@ -227,8 +245,8 @@ class Handover(Task):
         self._success = self._dropped = False
         self._holder = "giver"
         self._parts = 0
-        self._distance = 0.0
         self.before_physics(env)
+        self._distance = self._palm_distance(d)
 
     def _close_fingers(self, env, i: int):
         """Curl each of agent i's four fingers (mcp, pip, dip together, from straight toward
@@ -272,10 +290,17 @@ class Handover(Task):
         mujoco.mj_forward(m, d)
 
     def before_physics(self, env):
+        if not self._gaze:
+            return
         w = env.world
         m, d = w.model, w.data
         self._gaze[RECEIVER](m, d, "body", self._ball_body)
         self._gaze[GIVER](m, d, "site", self._receiver_palm)
+
+    def _palm_distance(self, d) -> float:
+        """Distance (m) from the receiver's right palm centre to the ball's centre."""
+        return float(np.linalg.norm(d.site_xpos[self._receiver_palm]
+                                    - d.xpos[self._ball_body]))
 
     def _contacts(self, d):
         """Segments of the receiver's right hand touching the ball, and whether the giver's
@@ -297,14 +322,13 @@ class Handover(Task):
         self._holder = "giver" if giver_holds else "receiver" if receiver_holds else "none"
         self._held = self._held + 1 if receiver_holds and not self._dropped else 0
         self._success = self._held >= self._hold_steps
-        self._distance = float(np.linalg.norm(d.site_xpos[self._tip] - ball))
-        r = -self._distance
+        distance = self._palm_distance(d)
+        r = o.shaping_scale * (self._distance - distance) if o.shaping else 0.0
+        self._distance = distance
         if self._success:
             r += o.success_reward
         if self._dropped:
             r += o.failure_reward
-            if o.charge_remaining:  # the rest of the episode at this distance: drops never pay
-                r -= self._distance * max(0, env.max_steps - env.steps)
         return np.array([r, r])
 
     def terminations(self, env):

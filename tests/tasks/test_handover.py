@@ -5,11 +5,18 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import handover_v0
-from mimo_social.tasks.handover import OFFER_TARGET
+from mimo_social.tasks.handover import OFFER_TARGET, HandoverOptions, scripted_giver
 from mimo_social.partners import ScriptedPartners, zero_action
 from mimo_social.partners.hand_offer import HandOffer
 
 RECEIVER_TARGET = (0.10, 0.0, -0.12)   # a palm-up hand in front of the receiver, clear of the giver
+
+
+def _scripted(task_options=None, **kwargs):
+    """The scripted env with the handover's scripted giver (``scripted_giver``)."""
+    opts = HandoverOptions(**(task_options or {}))
+    return handover_v0.scripted_env(scripted_giver(opts), task_options=task_options or {},
+                                    **kwargs)
 
 
 def _ball(env):
@@ -37,16 +44,19 @@ def test_reset_seed_draws_the_receivers_arm():
     assert np.abs(q1 - q2).max() > 1e-3
 
 
-def test_scripted_env_exposes_the_receiver():   # check_env: tests/conformance
-    env = handover_v0.scripted_env(max_steps=20)
+def test_scripted_env_exposes_the_receiver_and_the_giver_hands_over_on_hold():
+    env = _scripted(max_steps=20)
     assert env.possible_agents == ["infant_0"]
-    assert isinstance(env.partners["infant_1"], HandOffer)
-    assert env.partners["infant_1"].release == "on_touch"
+    giver = env.partners["infant_1"]
+    assert isinstance(giver, HandOffer) and giver.release == "on_hold" and giver.grip
+    assert giver.target == OFFER_TARGET
+    other = scripted_giver(HandoverOptions(offer_target=(0.17, 0.08, -0.06)))
+    assert other.target == (0.17, 0.08, -0.06)
 
 
 @pytest.mark.parametrize("actuation", ["spring_damper", "muscle"])
 def test_the_ball_stays_in_the_givers_hand_when_the_receiver_is_idle(actuation):
-    env = handover_v0.scripted_env(per_agent=[{}, {"actuation": actuation}])
+    env = _scripted(per_agent=[{}, {"actuation": actuation}])
     obs, _ = env.reset(seed=0)
     inner = env.unwrapped
     w = inner.world
@@ -57,17 +67,25 @@ def test_the_ball_stays_in_the_givers_hand_when_the_receiver_is_idle(actuation):
     assert np.linalg.norm(d.qvel[w.prop_dof["ball"]:][:3]) < 0.05
     start = _ball(env)
     idle = {"infant_0": zero_action(env.action_space("infant_0"))}
-    for _ in range(100):                                            # 1 s
+    before = None
+    total = 0.0
+    for _ in range(200):                                            # 2 s
         _, rew, term, trunc, infos = env.step(idle)
         info = infos["infant_0"]
         assert info["holder"] == "giver" and not info["dropped"] and not info["is_success"]
         assert not term["infant_0"]
+        # progress shaping: 10 x the decrease of the palm-to-ball distance, for both
+        if before is not None:
+            assert rew["infant_0"] == pytest.approx(10.0 * (before - info["distance"]))
+        assert info["partner_rewards"]["infant_1"] == rew["infant_0"]
+        before = info["distance"]
+        total += rew["infant_0"]
+    assert env.partners["infant_1"].tip == 0.0 and not env.partners["infant_1"].released
     assert np.linalg.norm(_ball(env) - start) < 0.02
     assert np.linalg.norm(_ball(env) - d.site_xpos[palm]) < 0.06
-    # the shaping reward is minus the receiver's fingertip distance to the ball, for both
-    tip = d.site_xpos[w.agents[0].fingertip_sites[0]]
-    assert rew["infant_0"] == pytest.approx(-np.linalg.norm(tip - _ball(env)), abs=1e-9)
-    assert info["partner_rewards"]["infant_1"] == rew["infant_0"]
+    assert abs(total) < 0.5                                          # doing nothing earns ~0
+    tip = d.site_xpos[w.agents[0].palm_sites[0]]
+    assert info["distance"] == pytest.approx(np.linalg.norm(tip - _ball(env)), abs=1e-9)
 
 
 def test_receiver_holding_the_ball_alone_is_a_success_for_both():
@@ -91,7 +109,8 @@ def test_receiver_holding_the_ball_alone_is_a_success_for_both():
     assert last["is_success"] and last["holder"] == "receiver"
     assert last["receiver_parts"] >= 2 and last["held_steps"] == hold
     assert term == {"infant_0": True, "infant_1": True}
-    assert rew["infant_0"] == rew["infant_1"] == pytest.approx(10.0 - last["distance"])
+    assert rew["infant_0"] == rew["infant_1"]
+    assert 9.0 < rew["infant_0"] < 11.0                              # + success_reward (10)
     # success needs the hold to last: the steps before it were not successes
     assert not any(s["is_success"] for s in steps[:-1])
     assert sum(s["holder"] == "receiver" for s in steps) >= hold
@@ -118,36 +137,42 @@ def test_one_hand_part_or_a_giver_contact_is_not_a_handover():
     assert infos["infant_0"]["holder"] == "giver"
 
 
-@pytest.mark.parametrize("charge", [True, False])
-def test_a_dropped_ball_ends_the_episode_with_failure(charge):
-    env = handover_v0.scripted_env(task_options={"charge_remaining": charge})
+def test_a_dropped_ball_ends_the_episode_with_failure():
+    env = _scripted()
     env.reset(seed=0)
     inner = env.unwrapped
     inner.task.place_ball(inner, (0.15, 0.6, 0.45))                # away from every hand
     idle = {"infant_0": zero_action(env.action_space("infant_0"))}
+    total = 0.0
     for k in range(100):
         _, rew, term, trunc, infos = env.step(idle)
         info = infos["infant_0"]
+        total += rew["infant_0"]
         if term["infant_0"]:
             break
         assert info["holder"] == "none" and not info["dropped"]
-        assert rew["infant_0"] == pytest.approx(-info["distance"])
     assert info["dropped"] and not info["is_success"]
     assert _ball(env)[2] < 0.25
-    rest = 600 - info["step"] if charge else 0          # the remaining steps, charged
-    assert rew["infant_0"] == pytest.approx(-1.0 - info["distance"] * (1 + rest))
     assert info["partner_rewards"]["infant_1"] == rew["infant_0"]
+    assert rew["infant_0"] < -10.0                                 # failure_reward (-10) ...
+    assert total < -10.0                                           # ... worse than never trying
     assert k < 40                                                  # it falls in well under 0.4 s
 
 
-def test_the_receiver_feels_the_ball_and_its_gaze_follows_it():
-    env = handover_v0.parallel_env()
+@pytest.mark.parametrize("assisted", [False, True])
+def test_the_receiver_feels_the_ball_and_its_gaze_follows_it_only_when_assisted(assisted):
+    env = handover_v0.parallel_env(task_options={"assisted_gaze": assisted})
     obs, _ = env.reset(seed=0)
     assert not obs["infant_0"]["touch"].any()
     w = env.world
     a = w.agents[0]
-    gaze = a.qpos_adr[a.gaze_idx[0]]                                # head swivel
-    before = w.data.qpos[gaze]
+    if not assisted:                          # head and eyes held at rest, in the body itself
+        assert "head_swivel" not in a.joint_names
+        assert env.observation_space("infant_0")["proprioception"].shape == (174,)
+    else:
+        assert env.observation_space("infant_0")["proprioception"].shape == (210,)
+        gaze = a.qpos_adr[a.joint_names.index("head_swivel")]
+        before = w.data.qpos[gaze]
     env.task.put_ball_in_hand(env, 0, RECEIVER_TARGET)
     mujoco.mj_forward(w.model, w.data)
     felt = 0.0
@@ -155,7 +180,36 @@ def test_the_receiver_feels_the_ball_and_its_gaze_follows_it():
         obs, *_ = env.step({ag: zero_action(env.action_space(ag)) for ag in env.agents})
         felt = max(felt, float(obs["infant_0"]["touch"].sum()))
     assert felt > 0                                                  # the ball on its skin
-    assert abs(w.data.qpos[gaze] - before) > 0.05                    # the head turned to it
+    if assisted:
+        assert abs(w.data.qpos[gaze] - before) > 0.05                # the head turned to it
+
+
+def _receiver_obs(offer, assisted, steps=5, seed=3):
+    env = _scripted(task_options={"offer_target": offer, "assisted_gaze": assisted})
+    obs, _ = env.reset(seed=seed)
+    out = [obs["infant_0"]]
+    idle = {"infant_0": zero_action(env.action_space("infant_0"))}
+    for _ in range(steps):
+        obs, _, _, _, infos = env.step(idle)
+        assert infos["infant_0"]["receiver_parts"] == 0              # no contact with the ball
+        out.append(obs["infant_0"])
+    ball = _ball(env)
+    return out, ball
+
+
+def test_where_the_ball_is_offered_does_not_reach_the_receivers_observation():
+    """Only the offer position changes (the task option offer_target): the receiver's
+    observations at reset and over 5 zero-action steps, before any contact, are identical; with
+    the privileged assisted_gaze they are not."""
+    a, ball_a = _receiver_obs(OFFER_TARGET, False)
+    b, ball_b = _receiver_obs((0.15, 0.06, -0.04), False)
+    assert np.linalg.norm(ball_a - ball_b) > 0.03                     # the ball is elsewhere
+    for oa, ob in zip(a, b):
+        for key in oa:
+            np.testing.assert_array_equal(oa[key], ob[key])
+    a, _ = _receiver_obs(OFFER_TARGET, True)
+    b, _ = _receiver_obs((0.15, 0.06, -0.04), True)
+    assert np.abs(a[0]["proprioception"] - b[0]["proprioception"]).max() > 1e-3
 
 
 @pytest.mark.parametrize("kwargs, pattern", [
@@ -165,7 +219,9 @@ def test_the_receiver_feels_the_ball_and_its_gaze_follows_it():
     ({"task_options": {"hold_time": "long"}}, r"hold_time='long'"),
     ({"task_options": {"offer_target": (0, 0)}}, r"offer_target=.*forward, left, up"),
     ({"task_options": {"end_on_success": 1}}, r"end_on_success=1.*True or False"),
-    ({"task_options": {"charge_remaining": "no"}}, r"charge_remaining='no'.*True or False"),
+    ({"task_options": {"shaping": "no"}}, r"shaping='no'.*True or False"),
+    ({"task_options": {"shaping_scale": -1}}, r"shaping_scale=-1.*from 0"),
+    ({"task_options": {"assisted_gaze": 1}}, r"assisted_gaze=1.*True or False"),
     ({"hands": "mitten"}, r"hands='mitten' not allowed.*five_fingers"),
     ({"posture": "sitting"}, r"posture='sitting' not allowed.*standing"),
     ({"n_agents": 3}, r"n_agents=3.*2 to 2"),
@@ -181,4 +237,4 @@ def test_aec_env_runs():
     for agent in env.agent_iter():
         *_, term, trunc, _ = env.last()
         env.step(None if term or trunc else env.action_space(agent).sample())
-    assert isinstance(handover_v0.scripted_env(), ScriptedPartners)
+    assert isinstance(_scripted(), ScriptedPartners)
