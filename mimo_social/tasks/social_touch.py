@@ -59,9 +59,12 @@ TOUCHER, TOUCHED = 0, 1
 DISTANCE = 0.37
 # sitting infants at play face to face, hip to hip (see docs/social/social_touch.md)
 DISTANCE_RANGE = (0.35, 0.40)
-# cross-legged (the legs of the self-body pose)
-SITTING_DEG = {k: v for k, v in CROSS_LEGGED_DEG.items()
-               if "hip" in k or "knee" in k or "ankle" in k}
+# cross-legged (the legs of the self-body pose), the knees bent as far as they go (-145 deg) so
+# that the crossed feet stay clear of the partner's (2 cm at 0.35 m; at -130 deg the toes of the
+# two infants would overlap by 2.4 cm)
+SITTING_DEG = {**{k: v for k, v in CROSS_LEGGED_DEG.items()
+                  if "hip" in k or "knee" in k or "ankle" in k},
+               "right_knee": -145.0, "left_knee": -145.0}
 # the touched infant leans back a little, so that the leaning toucher's head stays clear of it
 RECLINE_DEG = -6.0
 # the toucher's lower trunk bend (the upper trunk follows, coupled: 61 deg in all), at the
@@ -217,6 +220,18 @@ class SocialTouch(Task):
                            for b in np.unique(m.geom_bodyid[touched.geom_ids])}
         self._target_bodies = np.array([m.body(f"{touched.name}/{t}").id for t in self.targets],
                                        dtype=np.intp)
+        # each target's bodies: the part, and for a hand the fingers below it
+        self._target_sets = []
+        for t, b in zip(self.targets, self._target_bodies):
+            inside = np.zeros(m.nbody, bool)
+            inside[b] = True
+            if t.endswith("_hand"):
+                for c in sorted(touched.body_ids.tolist()):
+                    if c != b and inside[m.body_parentid[c]]:
+                        inside[c] = True
+            self._target_sets.append(np.flatnonzero(inside))
+        self._target_names = [[self._part_name[int(b)] for b in ids if int(b) in self._part_name]
+                              for ids in self._target_sets]
         self._fingertip = int(toucher.fingertip_sites[0])
         self._palm = int(toucher.palm_sites[0])
         self._head = [int(w.agents[j].head_site) for j in (TOUCHER, TOUCHED)]
@@ -297,11 +312,12 @@ class SocialTouch(Task):
         target = self._target_bodies[self._target]
         bodies, by_hand = self._arm_contacts(d)
         self._touched = sorted({self._part_name[int(b)] for b in bodies})
-        hand_on_target = bool(np.any(by_hand & (bodies == target)))
+        hand_on_target = bool(np.any(by_hand & np.isin(bodies, self._target_sets[self._target])))
         self._felt = False
         if hand_on_target and self._touch is not None:
-            felt = self._touch.touched_by(TOUCHED).get(self.target)
-            self._felt = bool(felt is not None and self._source in felt["agents"])
+            record = self._touch.touched_by(TOUCHED)
+            self._felt = any(self._source in record[p]["agents"]
+                             for p in self._target_names[self._target] if p in record)
         self._distance = float(np.linalg.norm(d.site_xpos[self._fingertip] - d.xipos[target]))
         r = -self._distance if self.options.shaping else 0.0
         if self._first is None and len(bodies):

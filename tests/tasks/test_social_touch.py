@@ -151,19 +151,33 @@ def test_a_sweep_over_a_wrong_part_then_onto_the_target_is_no_success():
 
 
 def test_the_back_of_the_hand_does_not_count():
-    env = social_touch_v0.parallel_env(task_options={"targets": REACHABLE,
-                                                     "target": "left_upper_leg"})
+    env = social_touch_v0.parallel_env(task_options={"target": "lower_body"})
     env.reset(seed=0)
     # the hand's touching direction turned to its back (the palm's normal turned 180 deg)
-    q, _, _, u = hand_posture(env.world, 0, 1, "left_upper_leg", 0.04, tilt_deg=180.0)
-    q, dist, _, _ = hand_posture(env.world, 0, 1, "left_upper_leg", -0.005, start=q,
+    q, _, _, u = hand_posture(env.world, 0, 1, "lower_body", 0.04, tilt_deg=180.0)
+    q, dist, _, _ = hand_posture(env.world, 0, 1, "lower_body", -0.005, start=q,
                                  direction=u, tilt_deg=180.0, clearance=0.0)
     assert dist < 0.0
     _place(env, q)
     _, r, term, _, info = env.step(_zero(env))
-    assert "left_upper_leg" in info["infant_0"]["first_touch"]
+    assert info["infant_0"]["first_touch"] == ["lower_body"]
     assert info["infant_0"]["wrong_touch"] and not info["infant_0"]["is_success"]
     assert term["infant_0"] and r["infant_0"] < 0.0
+    # the same part touched with the finger pads: a success
+    env.reset(seed=0)
+    _hand_into(env, "lower_body")
+    _, r, _, _, info = env.step(_zero(env))
+    assert info["infant_0"]["is_success"] and r["infant_0"] > 90.0
+
+
+def test_the_hand_includes_its_fingers():
+    env = social_touch_v0.parallel_env(task_options={"target": "left_hand"})
+    env.reset(seed=0)
+    q, dist, worst = reach_posture(env.world, 0, 1, "left_hand")
+    _place(env, q)
+    _, _, _, _, info = env.step(_zero(env))
+    assert info["infant_0"]["is_success"]
+    assert set(info["infant_0"]["first_touch"]) & {"left_hand", "left_fingers"}
 
 
 def _toucher_run(target, assisted, steps=5):

@@ -67,6 +67,9 @@ VARIANTS = (({}, {"side": "front_above"}, {"side": "above"}, {"side": "front"},
                 {}, {"side": "front_outside"}, {"side": "outside_above"},
                 {"side": "front_outside_above"}, {"side": "above"}, {"side": "front_above"},
                 {"side": "front_outside", "lift": 0.08}))
+            + tuple(dict(v, tilt_deg=t) for t in (60.0, 30.0) for v in (
+                {}, {"side": "above"}, {"side": "front_above"}, {"side": "front"},
+                {"side": "front_outside"}))
             + tuple({"seed": s} for s in range(1, 5))
             + tuple({"side": "front_above", "seed": s} for s in range(5, 9)))
 
@@ -100,7 +103,13 @@ class _Geometry:
         except KeyError:
             raise ValueError(f"SocialTouchController: target {part!r} is no body part of "
                              f"{b.name}") from None
-        self.target = np.flatnonzero(m.geom_bodyid == body)
+        inside = np.zeros(m.nbody, bool)
+        inside[body] = True
+        if part.endswith("_hand"):   # a hand includes its fingers (the task's rule)
+            for c in sorted(b.body_ids.tolist()):
+                if c != body and inside[m.body_parentid[c]]:
+                    inside[c] = True
+        self.target = np.flatnonzero(inside[m.geom_bodyid])
         if not len(self.target):
             raise ValueError(f"SocialTouchController: {b.name}'s part {part!r} has no geoms")
         self.target_body = body
@@ -297,7 +306,8 @@ class SocialTouchController(Partner):
 
     ``target``: a body part name of the partner, or ``None`` to read the task's target at each
     reset (``env.task.target``); ``standoff`` (m): the palm's gap to the part before moving in;
-    ``depth`` (m): how far into the part the palm is aimed; ``lift`` (m): where variants raise
+    ``depth`` (m): how far into the part the hand is aimed; ``tilt_deg``: the touching
+    direction, the palm's normal tipped this far towards the fingertips (the finger pads); ``lift`` (m): where variants raise
     the palm above the part first; ``frequency`` (Hz) and ``damping`` (ratio): the PD loop;
     ``tolerance`` (rad) and ``hold_steps``: when a waypoint gives way to the next; ``variants``:
     the plans tried at reset (default :data:`VARIANTS`); ``good_steps``: the first plan that
@@ -306,10 +316,10 @@ class SocialTouchController(Partner):
 
     who = "SocialTouchController"
 
-    def __init__(self, target: str | None = None, standoff: float = 0.05, depth: float = 0.01,
+    def __init__(self, target: str | None = None, standoff: float = 0.05, depth: float = 0.03,
                  lift: float = 0.10, frequency: float = 3.0, damping: float = 1.0,
                  tolerance: float = 0.1, hold_steps: int = 60, variants=None,
-                 good_steps: int = 250):
+                 good_steps: int = 250, tilt_deg: float = TILT_DEG):
         if target is not None and (not isinstance(target, str) or not target):
             raise ValueError(f"{self.who}: target={target!r}; allowed: None or a body part "
                              "name of the partner")
@@ -323,6 +333,7 @@ class SocialTouchController(Partner):
         self.hold_steps = int(check_number(self.who, "hold_steps", hold_steps, 1, 10000))
         self.variants = list(VARIANTS if variants is None else variants)
         self.good_steps = int(check_number(self.who, "good_steps", good_steps, 1, 100000))
+        self.tilt_deg = check_number(self.who, "tilt_deg", tilt_deg, 0.0, 90.0)
 
     def __repr__(self):
         return f"{type(self).__name__}(target={self.target!r})"
@@ -398,10 +409,10 @@ class SocialTouchController(Partner):
 
     def _plan(self, w, lift: float | None = None, standoff: float | None = None,
               seed: int | None = None, side: str | None = None,
-              raise_arm: bool = False) -> list[np.ndarray]:
+              raise_arm: bool = False, tilt_deg: float | None = None) -> list[np.ndarray]:
         """Waypoints: (the hand ``lift`` above its stand-off,) the hand ``standoff`` off the
         part facing it, then 40 % of that, then ``depth`` into it, moving in along one line.
-        ``raise_arm``: first the arm raised to the side (:data:`RAISE_DEG`). ``side`` (a key of :data:`SIDES`): come in along that side's normal to the point of the
+        ``tilt_deg``: another touching direction. ``raise_arm``: first the arm raised to the side (:data:`RAISE_DEG`). ``side`` (a key of :data:`SIDES`): come in along that side's normal to the point of the
         part's surface hit by a ray from that side through its centre; else along the line
         between the hand and the part's nearest point; the IK starts from the current posture
         or from a seeded random one."""
@@ -410,7 +421,8 @@ class SocialTouchController(Partner):
         if seed is not None:
             start = np.random.default_rng(seed).uniform(self._lo, self._hi)
         args = (w, self._i, self._j, self.target_part)
-        kw = {"geometry": self._geo}
+        kw = {"geometry": self._geo,
+              "tilt_deg": self.tilt_deg if tilt_deg is None else tilt_deg}
         if side is None:
             pre, _, _, u = hand_posture(*args, standoff, start=start, **kw)
             near, _, _, _ = hand_posture(*args, 0.4 * standoff, start=pre, direction=u,
@@ -436,8 +448,8 @@ class SocialTouchController(Partner):
             touch = at(-self.depth, near, TOUCH_CLEARANCE)
             up = None
             if lift:
-                up = hand_posture(*args, 0.0, start=pre, direction=u, geometry=self._geo,
-                                  point=surface + n * (r + standoff) + [0.0, 0.0, lift])[0]
+                up = hand_posture(*args, 0.0, start=pre, direction=u,
+                                  point=surface + n * (r + standoff) + [0.0, 0.0, lift], **kw)[0]
         plan = ([up] if up is not None else []) + [pre, near, touch]
         if raise_arm:
             names = list(self._a.actuated_names)
