@@ -173,7 +173,7 @@ def test_the_back_of_the_hand_does_not_count():
 def test_the_hand_includes_its_fingers():
     env = social_touch_v0.parallel_env(task_options={"target": "left_hand"})
     env.reset(seed=0)
-    q, dist, worst = reach_posture(env.world, 0, 1, "left_hand")
+    q, _, _ = reach_posture(env.world, 0, 1, "left_hand")
     _place(env, q)
     _, _, _, _, info = env.step(_zero(env))
     assert info["infant_0"]["is_success"]
