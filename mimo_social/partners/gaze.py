@@ -14,7 +14,8 @@ How much of a gaze shift the head makes: ``head_share`` (a share ``s`` in [0, 1]
 ``(lo, hi)`` drawn from anew at every shift; ``None``: the task's ``partner_head_share`` range
 where it has one, else 1). The head turns ``s`` of the way (swivel and tilt) and the eyes the
 rest, from where the head then points; the head always makes up what the eyes cannot reach
-(``EYE_REACH_DEG`` from straight ahead). ``s = 1``: the head faces the target and the eyes only
+(``EYE_REACH_DEG`` from straight ahead, less where an eye would pass its range: its horizontal
+and vertical turns add up). ``s = 1``: the head faces the target and the eyes only
 correct for their offset; ``s = 0``: the eyes turn alone as far as they reach (adults move
 mostly their eyes for small gaze shifts and add the head for large ones).
 
