@@ -114,22 +114,25 @@ class HighFiveController(Partner):
         arm = offer_posture(env.world, self._i, target=target, palm=self.palm)
         lo, hi = self._lo[self._arm], self._hi[self._arm]
         q = np.clip([arm[n] for n in ARM], lo, hi)
-        s = self._scratch
+        scratch = self._scratch
         m = env.world.model
-        s.qpos[:] = d.qpos
-        s.qpos[self._qadr[self._arm]] = q
-        mujoco.mj_kinematics(m, s)
-        self.palm_residual = float(np.linalg.norm(s.site_xpos[self._palm] - goal))
+        scratch.qpos[:] = d.qpos
+        scratch.qpos[self._qadr[self._arm]] = q
+        mujoco.mj_kinematics(m, scratch)
+        self.palm_residual = float(np.linalg.norm(scratch.site_xpos[self._palm] - goal))
         self.fingertips = self.palm_residual > self.tolerance
         if self.fingertips:   # out of reach with the palm forward: the fingertips onto the palm
-            reach_sites(m, s, self._qadr[self._arm], self._dadr[self._arm], lo, hi,
+            reach_sites(m, scratch, self._qadr[self._arm], self._dadr[self._arm], lo, hi,
                         self._tips, goal, iters=60)
-            q = s.qpos[self._qadr[self._arm]].copy()
+            q = scratch.qpos[self._qadr[self._arm]].copy()
         self.goal = goal
         self.target_angles[self._arm] = q
 
+    def _replan_due(self) -> bool:
+        return self._steps % self.replan_steps == 0
+
     def act(self, env, agent, observation):
-        if self._steps and self._steps % self.replan_steps == 0:
+        if self._steps and self._replan_due():
             self._plan(env)
         self._steps += 1
         d = env.world.data
@@ -170,9 +173,5 @@ class ArmSweep(HighFiveController):
         self.goal = None
         self.target_angles[k] = q
 
-    def act(self, env, agent, observation):
-        self._plan(env)
-        self._steps, steps = 0, self._steps   # the parent re-plans only every few steps
-        action = super().act(env, agent, observation)
-        self._steps = steps + 1
-        return action
+    def _replan_due(self) -> bool:
+        return True   # a new target every step
