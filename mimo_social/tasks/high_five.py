@@ -27,7 +27,7 @@ what ends the episode is what both infants perceive. The skin must cover the rig
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import ClassVar, Sequence
 
 import mujoco
 import numpy as np
@@ -99,6 +99,7 @@ class HighFiveOptions(TaskOptions):
     infants (m) and the spread of the random start postures (fraction of each joint's range)."""
 
     task = "high_five"
+    privileged: ClassVar[tuple[str, ...]] = ("assisted_gaze",)
     touch_bonus: float = 100.0
     end_on_touch: bool = True
     distance: float = DISTANCE

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -55,6 +56,7 @@ class MirrorOptions(TaskOptions):
     episode's steps that must match for success."""
 
     task = "mirror"
+    privileged: ClassVar[tuple[str, ...]] = ("assisted_gaze",)
     distance: float = DISTANCE
     scripted_partner: bool = False
     assisted_gaze: bool = False
