@@ -1,7 +1,6 @@
 """Visible eyes: each eyeball (white sclera, iris, pupil) turns with its eye joints, is seen by
 the other agents' eyes and not by its own, carries no mass, contact or touch of its own."""
 
-import mujoco
 import numpy as np
 import pytest
 

@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 from gymnasium import spaces
 
-from mimo_social.envs import joint_attention_v0
 from mimo_social.core.gym_adapter import SingleAgentEnv
 from mimo_social.core.wrappers import FlattenParallel
-from mimo_social.train.envs import make_sb3_single
+from mimo_social.envs import joint_attention_v0
 from mimo_social.partners.controllers.gaze_follow import GazeFollowController
 from mimo_social.partners.gaze import GazeAtTarget
+from mimo_social.train.envs import make_sb3_single
 
 STILL = np.zeros(9, np.float32)
 SHARED = {"two_learners": "shared"}
@@ -190,7 +190,7 @@ def test_scripted_follower_succeeds_random_zero_and_hacks_do_not():
 
 
 def test_success_needs_the_share_of_steps_and_a_second_of_targets():
-    ret, info = _episode(GazeFollowController(), 1000, task_options={"success_share": 1.0})
+    _, info = _episode(GazeFollowController(), 1000, task_options={"success_share": 1.0})
     assert info["is_success"] is False              # the follower lags each shift a little
     env = joint_attention_v0.scripted_env(vision=False)
     env.reset(seed=1000)
@@ -233,7 +233,7 @@ def test_two_learners_leader_mode_rewards_following_not_a_fixed_toy():
         total = {a: 0.0 for a in env.possible_agents}
         instructions = []
         for _ in range(500):
-            obs, rew, term, trunc, info = env.step({a: g.act(inner, a, None)
+            obs, rew, _, _, info = env.step({a: g.act(inner, a, None)
                                                     for a, g in gazers.items()})
             for a in total:
                 total[a] += rew[a]
@@ -276,24 +276,52 @@ def test_leader_is_rewarded_for_its_instruction():
 
 
 def test_partner_target_only_in_the_eye_images():
-    """The learner keeps still; only where the partner looks differs between two runs: the
-    learner's observation differs only in its eye images (the head and eye turns it sees)."""
-    obs_by_target = []
+    """The learner keeps still; only where the partner looks differs between two runs (its
+    target set right after reset, everything else fixed): the learner's non-image observation
+    is the same at reset and at every step, its eye images differ (the head and eye turns it
+    sees)."""
+    runs = []
     for target in (0, 1):
         partner = GazeAtTarget(hold_s=(99, 99))
         env = joint_attention_v0.scripted_env(partner)
-        env.reset(seed=7)
+        obs, _ = env.reset(seed=7)
         partner.target = target
+        seen = [obs["infant_0"]]
         for _ in range(80):
             obs, _, _, _, info = env.step({"infant_0": STILL})
+            seen.append(obs["infant_0"])
         assert info["infant_0"]["target"] == target
-        obs_by_target.append(obs["infant_0"])
-    a, b = obs_by_target
-    assert set(a) == {"proprioception", "eye_left", "eye_right"}
-    np.testing.assert_array_equal(a["proprioception"], b["proprioception"])
+        runs.append(seen)
+    for a, b in zip(*runs):
+        assert set(a) == {"proprioception", "eye_left", "eye_right"}
+        np.testing.assert_array_equal(a["proprioception"], b["proprioception"])
+    a, b = runs[0][-1], runs[1][-1]
     for eye in ("eye_left", "eye_right"):
         diff = np.abs(a[eye].astype(int) - b[eye].astype(int))
         assert (diff.max(axis=2) > 30).sum() > 40  # dozens of pixels change, not noise
+
+
+def test_leaders_instruction_never_reaches_the_follower():
+    """Two learners: change only the leader's instruction (right after reset): the follower's
+    observation (instruction zeros, proprioception) stays the same; the leader's differs."""
+    runs = []
+    for instruction in (0, 2):
+        env = joint_attention_v0.parallel_env(vision=False)
+        env.reset(seed=8)
+        task = env.unwrapped.task
+        task.instruction = instruction
+        lead = env.possible_agents[task.leader]
+        follower = [a for a in env.possible_agents if a != lead][0]
+        seen = []
+        for _ in range(20):
+            obs, *_ = env.step({a: STILL for a in env.agents})
+            seen.append((obs[follower], obs[lead]))
+        runs.append(seen)
+    for (fa, la), (fb, lb) in zip(*runs):
+        for key in ("proprioception", "instruction"):
+            np.testing.assert_array_equal(fa[key], fb[key])
+        assert not fa["instruction"].any()
+        assert not np.array_equal(la["instruction"], lb["instruction"])
 
 
 def test_flat_wrappers():
@@ -305,7 +333,7 @@ def test_flat_wrappers():
     assert isinstance(single.observation_space, spaces.Box)
     assert single.action_space.shape == (9,)
     obs, _ = single.reset(seed=0)
-    obs, r, *_ = single.step(single.action_space.sample())
+    obs, _, *_ = single.step(single.action_space.sample())
     assert obs.shape == single.observation_space.shape
 
 
