@@ -13,8 +13,9 @@ from dataclasses import dataclass
 from types import ModuleType
 
 from ..core.gym_adapter import SingleAgentEnv
-from ..partners.controllers import (CatchController, ReachController, SelfBodyController,
-                                    StandupController)
+from ..partners.controllers import (CatchController, GazeFollowController, HighFiveController,
+                                    MirrorController, ReachController, ReceiveController,
+                                    SelfBodyController, SocialTouchController, StandupController)
 from . import (catch_v0, free_play_v0, handover_v0, high_five_v0, joint_attention_v0, mirror_v0,
                reach_v0, selfbody_v0, social_touch_v0, standup_v0)
 
@@ -81,15 +82,20 @@ CATALOG: tuple[EnvEntry, ...] = (
              "catch a falling ball and hold it",
              controller=CatchController),
     EnvEntry("high_five", high_five_v0, "mimo_social/HighFive-v0", "social",
-             "two infants meet with their right hands"),
+             "two infants meet with their right hands",
+             controller=HighFiveController),
     EnvEntry("mirror", mirror_v0, "mimo_social/Mirror-v0", "social",
-             "show the partner's facial expression, seen through the eyes"),
+             "show the partner's facial expression, seen through the eyes",
+             controller=MirrorController),
     EnvEntry("joint_attention", joint_attention_v0, "mimo_social/JointAttention-v0", "social",
-             "follow the partner's gaze to one of four toys"),
+             "follow the partner's gaze to one of four toys",
+             controller=GazeFollowController),
     EnvEntry("social_touch", social_touch_v0, "mimo_social/SocialTouch-v0", "social",
-             "touch a named part of the partner's body"),
+             "touch a named part of the partner's body",
+             controller=SocialTouchController),
     EnvEntry("handover", handover_v0, "mimo_social/Handover-v0", "social",
-             "take a ball from the partner's hand"),
+             "take a ball from the partner's hand",
+             controller=ReceiveController),
 )
 
 _BY_NAME = {e.name: e for e in CATALOG}

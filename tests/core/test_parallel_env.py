@@ -149,7 +149,8 @@ def test_instability_ends_the_episode_with_a_reason():
 
 
 def test_gaze_fixates_the_target():
-    """In reach, both eye cameras look at the ball; in high five, at the partner's right hand."""
+    """In reach, both eye cameras look at the ball; in high five with the privileged cue
+    ``assisted_gaze``, at the partner's right hand."""
     env = gym.make("mimo_social/Reach-v0").unwrapped
     for seed in range(3):
         env.reset(seed=seed)
@@ -161,7 +162,7 @@ def test_gaze_fixates_the_target():
             to_ball = ball - d.cam_xpos[cam]
             cos = look @ to_ball / np.linalg.norm(to_ball)
             assert cos > np.cos(np.deg2rad(2.0))
-    hf = high_five_v0.parallel_env(expressions=False)
+    hf = high_five_v0.parallel_env(expressions=False, task_options={"assisted_gaze": True})
     hf.reset(seed=0)
     for _ in range(10):
         hf.step({a: np.full(8, 0.4, np.float32) for a in hf.agents})

@@ -19,7 +19,7 @@ torch.set_num_threads(1)
 PPO_KWARGS = dict(n_steps=64, batch_size=64, n_epochs=1, device="cpu", seed=0, verbose=0)
 N_EXPR = 7
 # high five: proprioception 84, touch 232 (the right hand's skin), vestibular 6
-HF_OBS = 84 + 232 + 6
+HF_OBS = 48 + 232 + 6   # proprioception without the head and eyes (held unless assisted_gaze)
 
 
 def _params(model):
