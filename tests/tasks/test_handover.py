@@ -52,6 +52,11 @@ def test_scripted_env_exposes_the_receiver_and_the_giver_hands_over_on_hold():
     assert giver.target == OFFER_TARGET
     other = scripted_giver(HandoverOptions(offer_target=(0.17, 0.08, -0.06)))
     assert other.target == (0.17, 0.08, -0.06)
+    # the env's own default giver (what the Gymnasium id and the baselines use) is the same
+    plain = handover_v0.scripted_env(max_steps=20).partners["infant_1"]
+    assert plain.release == "on_hold" and plain.grip and plain.target == OFFER_TARGET
+    moved = handover_v0.scripted_env(task_options={"offer_target": (0.17, 0.08, -0.06)})
+    assert moved.partners["infant_1"].target == (0.17, 0.08, -0.06)
 
 
 @pytest.mark.parametrize("actuation", ["spring_damper", "muscle"])
