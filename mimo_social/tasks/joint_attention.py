@@ -1,4 +1,4 @@
-"""Joint attention: the learner follows its partner's gaze, read from its eyes, to one of several toys.
+"""Joint attention: the learner follows its partner's gaze, read from its eyes, to one of the toys.
 
 | | |
 |---|---|
