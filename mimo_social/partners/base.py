@@ -16,7 +16,8 @@ from gymnasium import spaces
 if TYPE_CHECKING:  # pragma: no cover
     from ..core.env import MimoParallelEnv
 
-__all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop"]
+__all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop",
+           "pd_gains"]
 
 
 def zero_action(space: spaces.Space):
@@ -51,6 +52,20 @@ def require_prop(who: str, world, prop: str) -> int:
         raise ValueError(f"{who}: prop {prop!r} is not in this env; props: "
                          f"{sorted(world.prop_bodies)}")
     return world.prop_bodies[prop]
+
+
+def pd_gains(model, data, dof_adr, frequency: float, damping: float,
+             extra_inertia=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Stiffness and damping of a PD loop per joint, from each joint's own inertia (the diagonal
+    of the joint-space mass matrix at the current pose, plus ``extra_inertia``, e.g. a held
+    ball): ``kp = I w^2``, ``kd = 2 zeta I w`` with ``w = 2 pi frequency`` and ``zeta =
+    damping``, so each joint alone would settle like a mass-spring-damper at ``frequency``."""
+    import mujoco
+    M = np.zeros((model.nv, model.nv))
+    mujoco.mj_fullM(model, data, M)
+    inertia = np.diag(M)[np.asarray(dof_adr)] + extra_inertia
+    omega = 2 * np.pi * frequency
+    return inertia * omega ** 2, inertia * 2 * damping * omega
 
 
 class Partner:

@@ -37,7 +37,7 @@ import numpy as np
 from ..body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ..core.kinematics import hand_geoms
 from ..util.checks import check_number
-from .base import Partner, agent_index, require_motors, require_prop, zero_action
+from .base import Partner, agent_index, pd_gains, require_motors, require_prop, zero_action
 
 __all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]
 
@@ -295,13 +295,7 @@ class HandOffer(Partner):
                 after = offer_posture(w, i, held, target, "posture")
             self._after_angles = np.clip([after.get(n, q_target[k])
                                           for k, n in enumerate(names)], lo, hi)
-        # PD gains from each joint's own inertia (the diagonal of the joint-space mass matrix)
-        M = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, M)
-        inertia = np.diag(M)[self._dadr]
-        omega = 2 * np.pi * self.frequency
-        self._kp = inertia * omega ** 2
-        self._kd = inertia * 2 * self.damping * omega
+        self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping)
         if not self._muscle:
             self._tneg, self._tpos = self._act.torque_neg, self._act.torque_pos
         # who may take the object: the hands of every other agent (geom -> hand number, its

@@ -23,7 +23,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, agent_index, require_motors, require_prop, zero_action
+from ..base import Partner, agent_index, require_motors, require_prop, zero_action, pd_gains
 
 __all__ = ["CatchController", "palm_cup_angles", "torque_controls"]
 
@@ -140,13 +140,9 @@ class CatchController(Partner):
                 target[k] = cup[n.split("_")[-1]]
         lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]
         self.target_angles = np.clip(target, lo, hi)
-        M = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, M)
-        inertia = np.diag(M)[self._dadr].copy()
-        inertia[wrist] += self.ball_mass * 0.05 ** 2
-        omega = 2 * np.pi * self.frequency
-        self._kp = inertia * omega ** 2
-        self._kd = inertia * 2 * self.damping * omega
+        ball = np.zeros(len(self._dadr))
+        ball[wrist] = self.ball_mass * 0.05 ** 2
+        self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping, ball)
         self._ball = int(np.flatnonzero(m.geom_bodyid == w.prop_bodies[self.prop])[0])
         self._hand = np.zeros(m.ngeom, bool)
         self._hand[hand_geoms(w, i, 0)] = True

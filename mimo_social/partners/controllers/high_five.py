@@ -20,7 +20,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import reach_sites
 from ...util.checks import check_int, check_number
-from ..base import Partner, agent_index, require_motors, zero_action
+from ..base import Partner, agent_index, require_motors, zero_action, pd_gains
 from ..hand_offer import OPEN_FINGERS_DEG, PALMS, offer_posture
 from .catch import torque_controls
 
@@ -94,12 +94,7 @@ class HighFiveController(Partner):
         R = d.xmat[a.root_body].reshape(3, 3)
         heading = np.arctan2(R[1, 0], R[0, 0])
         self._c, self._s = float(np.cos(heading)), float(np.sin(heading))
-        M = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, M)
-        inertia = np.diag(M)[self._dadr]
-        omega = 2 * np.pi * self.frequency
-        self._kp = inertia * omega ** 2
-        self._kd = inertia * 2 * self.damping * omega
+        self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping)
         self._act = env.actuation[i]
         self._steps = 0
         self._plan(env)

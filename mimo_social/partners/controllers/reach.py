@@ -18,7 +18,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import reach_sites
 from ...util.checks import check_number
-from ..base import Partner, agent_index, require_motors, require_prop, zero_action
+from ..base import Partner, agent_index, require_motors, require_prop, zero_action, pd_gains
 
 __all__ = ["ReachController"]
 
@@ -77,13 +77,7 @@ class ReachController(Partner):
                                     int(a.fingertip_sites[0]), self.goal, iters=100)
         target[arm] = s.qpos[self._qadr[arm]]
         self.target_angles = target
-        # PD gains from each joint's own inertia
-        M = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, M)
-        inertia = np.diag(M)[self._dadr]
-        omega = 2 * np.pi * self.frequency
-        self._kp = inertia * omega ** 2
-        self._kd = inertia * 2 * self.damping * omega
+        self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping)
         self._act = env.actuation[i]
         self._muscle = self._act.name == "muscle"
         if not self._muscle:

@@ -25,7 +25,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, agent_index, require_motors, require_prop, zero_action
+from ..base import Partner, agent_index, require_motors, require_prop, zero_action, pd_gains
 from .catch import torque_controls
 
 __all__ = ["ReceiveController", "hand_frame", "palm_posture"]
@@ -191,12 +191,7 @@ class ReceiveController(Partner):
                              np.deg2rad({"right_thumb_swivel": 40.0,
                                          "right_thumb_adduction": -35.0}.get(n, 0.0))
                              for k, n in enumerate(names)], lo, hi)
-        M = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, M)
-        inertia = np.diag(M)[self._dadr]
-        omega = 2 * np.pi * self.frequency
-        self._kp = inertia * omega ** 2
-        self._kd = inertia * 2 * self.damping * omega
+        self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping)
         self._dt = env.dt
         self.phase = "reach"
         self._t = 0

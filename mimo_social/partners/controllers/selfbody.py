@@ -20,7 +20,7 @@ import numpy as np
 
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, agent_index, zero_action
+from ..base import Partner, agent_index, zero_action, pd_gains
 
 __all__ = ["RAISE_DEG", "VARIANTS", "SelfBodyController", "touch_posture"]
 
@@ -209,12 +209,7 @@ class SelfBodyController(Partner):
         self._geom = geom
         self._hand = np.zeros(m.ngeom, bool)
         self._hand[hand_geoms(w, i, 0)] = True
-        M = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, M)
-        inertia = np.diag(M)[self._dadr]
-        omega = 2 * np.pi * self.frequency
-        self._kp = inertia * omega ** 2
-        self._kd = inertia * 2 * self.damping * omega
+        self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping)
         act = env.actuation[i]
         if act.name == "muscle":
             raise ValueError("SelfBodyController drives spring-damper motors (the task's "

@@ -26,7 +26,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, agent_index, require_motors, zero_action
+from ..base import Partner, agent_index, require_motors, zero_action, pd_gains
 
 __all__ = [
     "BACK_COS",
@@ -357,12 +357,7 @@ class SocialTouchController(Partner):
         k = a.actuated_joint_idx
         self._qadr, self._dadr = a.qpos_adr[k], a.dof_adr[k]
         self._lo, self._hi = a.joint_range[k, 0], a.joint_range[k, 1]
-        M = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, M)
-        inertia = np.diag(M)[self._dadr]
-        omega = 2 * np.pi * self.frequency
-        self._kp = inertia * omega ** 2
-        self._kd = inertia * 2 * self.damping * omega
+        self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping)
         self._act = act
         self._tneg, self._tpos = act.torque_neg, act.torque_pos
         self._arm_mask = np.zeros(m.ngeom, bool)
