@@ -53,7 +53,6 @@ DEFAULT_CLOTHES_RGBA = (0.35, 0.55, 0.85, 1.0)
 SKIN_SEGMENTS = {"head", "right_hand", "left_hand", "right_fingers", "left_fingers",
                  "right_lower_arm", "left_lower_arm"}
 EYE_FOVY_DEG = 60.0
-HIDDEN_GROUP = 3  # geom group not drawn by default renderers (no geom of the body uses it now)
 
 
 def axis_angle_quat(axis, angle: float) -> np.ndarray:

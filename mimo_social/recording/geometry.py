@@ -28,7 +28,7 @@ __all__ = [
     "visible_bodies",
 ]
 
-HIDDEN_GEOM_GROUP = 3             # MuJoCo geom group of the eye spheres (not drawn)
+HIDDEN_GEOM_GROUP = 3             # MuJoCo geom group left out of recordings (a user's hidden geoms)
 RGB_ROLE = int(mujoco.mjtTextureRole.mjTEXROLE_RGB)
 WXYZ_TO_XYZW = np.array([1, 2, 3, 0])  # MuJoCo: (w, x, y, z); Rerun: (x, y, z, w)
 

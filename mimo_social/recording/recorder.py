@@ -40,8 +40,9 @@ Layout of a recording::
                                     infant_1 right_fingers")
     /scalars/<name>                 Scalars: the ``scalars={name: fn(env)}`` given to the Recorder
 
-Heads are textured spheres (Mesh3D) that show the current face; geoms in group 3 (the hidden eye
-spheres) are left out. Face images and head textures are logged for expressions that stay at
+Heads are textured spheres (Mesh3D) that show the current face; the eyeballs (sclera, iris,
+pupil) are drawn and turn with the eye joints; geoms in group 3 (none of the body's) are left
+out. Face images and head textures are logged for expressions that stay at
 least ``face_hold_s`` (0.05 s), stamped with the step they appeared, so that a policy switching
 faces every step does not fill the file with images; the text log has every change.
 
