@@ -28,6 +28,7 @@ arm sinks under gravity and the ball falls (a failure) within half a second.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import mujoco
 import numpy as np
@@ -63,6 +64,7 @@ class HandoverOptions(TaskOptions):
     whether success ends the episode, and whether the task aims the eyes (a privileged cue)."""
 
     task = "handover"
+    privileged: ClassVar[tuple[str, ...]] = ("assisted_gaze",)
     distance: float = 0.34
     ball_radius: float = 0.03
     ball_mass: float = 0.03

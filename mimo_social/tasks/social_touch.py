@@ -33,6 +33,7 @@ under gravity until the heads meet.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from gymnasium import spaces
@@ -105,6 +106,7 @@ class SocialTouchOptions(TaskOptions):
     toucher's hand: a privileged cue)."""
 
     task = "social_touch"
+    privileged: ClassVar[tuple[str, ...]] = ("assisted_gaze",)
     targets: tuple[str, ...] | None = None
     target: str | None = None
     success_reward: float = 100.0
