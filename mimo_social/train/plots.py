@@ -24,6 +24,19 @@ __all__ = ["COLORS", "plot_learning_curve", "plot_compare"]
 COLORS = {"ppo": "tab:red", "sac": "tab:blue"}
 
 
+
+def _steps_axis(ax) -> None:
+    """Label an axis of environment steps, its ticks short (``50k``, ``1.2M``) so that they do
+    not run into each other on long runs."""
+    from matplotlib.ticker import FuncFormatter
+
+    def short(v, _pos):
+        if abs(v) >= 1e6:
+            return f"{v / 1e6:g}M"
+        return f"{v / 1e3:g}k" if abs(v) >= 1e3 else f"{v:g}"
+    ax.set_xlabel("environment steps")
+    ax.xaxis.set_major_formatter(FuncFormatter(short))
+
 def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path:
     """``learning_curve.png`` of one run (from its ``progress.csv`` and ``episodes.csv``)."""
     import matplotlib
@@ -52,7 +65,7 @@ def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path
     color = COLORS.get(config.get("algo"), "tab:green")
     ax.plot(t, m, "-o", ms=3, color=color, label="evaluation (mean)")
     ax.fill_between(t, m - s, m + s, color=color, alpha=0.2, lw=0)
-    ax.set_xlabel("environment steps")
+    _steps_axis(ax)
     ax.set_ylabel("episode return")
     ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
                  f"(seed {config.get('seed', '?')})")
@@ -62,7 +75,7 @@ def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path
         ax = axes[0, 1]
         ax.plot(t, 100 * p["eval_success_rate"], "-o", ms=3, color=color)
         ax.set_ylim(-5, 105)
-        ax.set_xlabel("environment steps")
+        _steps_axis(ax)
         ax.set_ylabel("evaluation success rate (%)")
         ax.grid(alpha=0.3)
     fig.tight_layout()
@@ -98,7 +111,7 @@ def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> P
         ls, mk = styles[a]
         ax.plot(t, p[f"eval_return_mean_{a}"], ls=ls, marker=mk, ms=4, color=colors[a],
                 label=f"{a} (evaluation)")
-    ax.set_xlabel("environment steps")
+    _steps_axis(ax)
     ax.set_ylabel("episode return")
     ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
                  f"{config.get('mode', '')} (seed {config.get('seed', '?')})")
@@ -111,7 +124,7 @@ def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> P
             ax.plot(t, 100 * p[f"eval_success_rate_{a}"], ls=ls, marker=mk, ms=4, color=colors[a],
                     label=a)
         ax.set_ylim(-5, 105)
-        ax.set_xlabel("environment steps")
+        _steps_axis(ax)
         ax.set_ylabel("evaluation success rate (%)")
         ax.legend(loc="best", fontsize=8)
         ax.grid(alpha=0.3)
@@ -201,6 +214,8 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
             ax.set_title(f"{what} (mean over seeds, min-max band)" if (i, j) == (0, 0)
                          else what, fontsize=10)
             ax.set_xlabel(xlabel)
+            if xlabel == "environment steps":
+                _steps_axis(ax)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
             if key == "eval_success_rate":
