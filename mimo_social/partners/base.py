@@ -17,7 +17,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..core.env import MimoParallelEnv
 
 __all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop",
-           "pd_gains"]
+           "pd_gains", "motor_action"]
 
 
 def zero_action(space: spaces.Space):
@@ -30,6 +30,18 @@ def zero_action(space: spaces.Space):
     if isinstance(space, spaces.Box):
         return np.clip(np.zeros(space.shape, space.dtype), space.low, space.high)
     raise TypeError(f"no resting action for space {space}")
+
+
+def motor_action(space: spaces.Space, motors) -> Any:
+    """An action of ``space`` that sends the motor commands ``motors`` (float32): the array
+    itself for a Box action, or the resting action with its ``"motors"`` entry set for a Dict
+    one (the face stays neutral)."""
+    u = np.asarray(motors, dtype=np.float32)
+    action = zero_action(space)
+    if isinstance(action, dict):
+        action["motors"] = u
+        return action
+    return u
 
 
 def agent_index(env, agent: str) -> int:

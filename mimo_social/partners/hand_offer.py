@@ -37,7 +37,7 @@ import numpy as np
 from ..body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ..core.kinematics import hand_geoms
 from ..util.checks import check_number
-from .base import Partner, agent_index, pd_gains, require_motors, require_prop, zero_action
+from .base import Partner, agent_index, motor_action, pd_gains, require_motors, require_prop
 
 __all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]
 
@@ -482,8 +482,4 @@ class HandOffer(Partner):
             u = np.clip(np.where(tau >= 0, tau / self._tpos, tau / self._tneg), -1.0, 1.0)
             if closing:
                 u = np.where(grip, self._flex * self._strength, u)
-        action = zero_action(env.action_space(agent))
-        if isinstance(action, dict):
-            action["motors"] = u.astype(np.float32)
-            return action
-        return u.astype(np.float32)
+        return motor_action(env.action_space(agent), u)

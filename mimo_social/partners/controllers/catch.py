@@ -23,7 +23,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, agent_index, require_motors, require_prop, zero_action, pd_gains
+from ..base import Partner, agent_index, motor_action, pd_gains, require_motors, require_prop
 
 __all__ = ["CatchController", "palm_cup_angles", "torque_controls"]
 
@@ -173,8 +173,4 @@ class CatchController(Partner):
                 u[n:][flex] = self.grip
             else:
                 u[flex] = self.grip
-        action = zero_action(env.action_space(agent))
-        if isinstance(action, dict):
-            action["motors"] = u.astype(np.float32)
-            return action
-        return u.astype(np.float32)
+        return motor_action(env.action_space(agent), u)

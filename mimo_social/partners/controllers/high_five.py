@@ -20,7 +20,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import reach_sites
 from ...util.checks import check_int, check_number
-from ..base import Partner, agent_index, require_motors, zero_action, pd_gains
+from ..base import Partner, agent_index, motor_action, pd_gains, require_motors
 from ..hand_offer import OPEN_FINGERS_DEG, PALMS, offer_posture
 from .catch import torque_controls
 
@@ -135,11 +135,7 @@ class HighFiveController(Partner):
         tau = self._kp * (self.target_angles - q) - self._kd * qd
         tau += d.qfrc_bias[self._dadr] - d.qfrc_spring[self._dadr]
         u = torque_controls(self._act, q, tau).astype(np.float32)
-        action = zero_action(env.action_space(agent))
-        if isinstance(action, dict):
-            action["motors"] = u
-            return action
-        return u
+        return motor_action(env.action_space(agent), u)
 
 
 class ArmSweep(HighFiveController):

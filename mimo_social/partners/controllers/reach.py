@@ -18,7 +18,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import reach_sites
 from ...util.checks import check_number
-from ..base import Partner, agent_index, require_motors, require_prop, zero_action, pd_gains
+from ..base import Partner, agent_index, motor_action, pd_gains, require_motors, require_prop
 
 __all__ = ["ReachController"]
 
@@ -103,8 +103,4 @@ class ReachController(Partner):
             u = np.concatenate([neg, pos])
         else:
             u = np.clip(np.where(tau >= 0, tau / self._tpos, tau / self._tneg), -1.0, 1.0)
-        action = zero_action(env.action_space(agent))
-        if isinstance(action, dict):
-            action["motors"] = u.astype(np.float32)
-            return action
-        return u.astype(np.float32)
+        return motor_action(env.action_space(agent), u)

@@ -20,7 +20,7 @@ import numpy as np
 
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, agent_index, zero_action, pd_gains
+from ..base import Partner, agent_index, motor_action, pd_gains
 
 __all__ = ["RAISE_DEG", "VARIANTS", "SelfBodyController", "touch_posture"]
 
@@ -314,8 +314,4 @@ class SelfBodyController(Partner):
         state = [self._wp, self._in_wp, self.target_angles]
         u = self._control(env.world.data, self.waypoints, state)
         self._wp, self._in_wp, self.target_angles = state
-        action = zero_action(env.action_space(agent))
-        if isinstance(action, dict):
-            action["motors"] = u.astype(np.float32)
-            return action
-        return u.astype(np.float32)
+        return motor_action(env.action_space(agent), u)

@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from ...util.checks import check_number
-from ..base import Partner, agent_index, zero_action
+from ..base import Partner, agent_index, motor_action
 
 __all__ = ["STAND_DEG", "StandupController"]
 
@@ -102,8 +102,4 @@ class StandupController(Partner):
             tau += self._jac[:, self._dadr].T @ force
         u = np.clip(np.where(tau >= 0, tau / self._act.torque_pos, tau / self._act.torque_neg),
                     -1.0, 1.0).astype(np.float32)
-        action = zero_action(env.action_space(agent))
-        if isinstance(action, dict):
-            action["motors"] = u
-            return action
-        return u
+        return motor_action(env.action_space(agent), u)

@@ -26,7 +26,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, agent_index, require_motors, zero_action, pd_gains
+from ..base import Partner, agent_index, motor_action, pd_gains, require_motors
 
 __all__ = [
     "BACK_COS",
@@ -493,11 +493,7 @@ class SocialTouchController(Partner):
         state = [self._wp, self._in_wp, self.target_angles]
         u = self._control(env.world.data, self.waypoints, state)
         self._wp, self._in_wp, self.target_angles = state
-        action = zero_action(env.action_space(agent))
-        if isinstance(action, dict):
-            action["motors"] = u.astype(np.float32)
-            return action
-        return u.astype(np.float32)
+        return motor_action(env.action_space(agent), u)
 
 
 class NearestPartToucher(SocialTouchController):
