@@ -81,6 +81,7 @@ class MimoParallelEnv(ParallelEnv):
         self._index = {name: i for i, name in enumerate(self.possible_agents)}
         self._bind()
         self._rng = np.random.default_rng()
+        self._was_reset = False   # step() before the first reset() is an error, not a crash
         self._renderer = None
         self.timing = dict.fromkeys(TIMING_KEYS, 0.0)
         self.steps = 0
@@ -169,6 +170,7 @@ class MimoParallelEnv(ParallelEnv):
         self._update_shared()
         self.agents = list(self.possible_agents)
         self.steps = 0
+        self._was_reset = True
         obs = {a: self._observe(i) for i, a in enumerate(self.agents)}
         infos = {a: self._info(i) for i, a in enumerate(self.agents)}
         return obs, infos
@@ -176,6 +178,8 @@ class MimoParallelEnv(ParallelEnv):
     def step(self, actions: Mapping[str, Any]):
         t0 = time.perf_counter()
         timing = self.timing
+        if not getattr(self, "_was_reset", True):
+            raise RuntimeError("step() called before reset(); call reset(seed=...) first")
         if not self.agents:
             raise RuntimeError("step() called after the episode ended; call reset() first")
         self._apply_actions(actions)
@@ -250,17 +254,37 @@ class MimoParallelEnv(ParallelEnv):
                 w.set_expression(i, self._expression[i])
             else:
                 motors = action
-            u = np.asarray(motors, dtype=np.float64)
-            if u.shape != (act.n_controls,):
-                raise ValueError(f"{a}: motor action has shape {u.shape}; expected "
-                                 f"({act.n_controls},) for motors {act.control_names}")
-            if not np.isfinite(u).all():
-                bad = [act.control_names[k] for k in np.flatnonzero(~np.isfinite(u))]
-                raise ValueError(f"{a}: motor action has NaN/inf for {bad}; values must be finite, "
-                                 f"in [{act.control_low.min():g}, {act.control_high.max():g}]")
-            np.clip(u, act.control_low, act.control_high, out=u)
-            self.controls[i] = u
-            act.apply(w.model, w.data, u)
+            u = self._motor_values(a, act, motors)
+            # the env's own buffer: the caller's array is never written to nor kept
+            c = self.controls[i]
+            np.clip(u, act.control_low, act.control_high, out=c)
+            act.apply(w.model, w.data, c)
+
+    @staticmethod
+    def _motor_values(agent: str, act, motors) -> np.ndarray:
+        """The motor commands as a float array of the right shape, finite; else a ValueError
+        naming the agent, the field, the value and what is allowed."""
+        lo = f"{act.control_low.min():g}" if act.n_controls else "-1"
+        hi = f"{act.control_high.max():g}" if act.n_controls else "1"
+        allowed = (f"allowed: {act.n_controls} finite numbers in [{lo}, {hi}] (motors "
+                   f"{list(act.control_names)[:4]}{' ...' if act.n_controls > 4 else ''})")
+        try:
+            raw = np.asarray(motors)
+        except (TypeError, ValueError) as e:       # ragged nested lists and the like
+            raise ValueError(f"{agent}: action field 'motors' = {motors!r:.120} is not an array "
+                             f"of numbers ({e}); {allowed}") from None
+        if raw.dtype.kind not in "iuf":
+            raise ValueError(f"{agent}: action field 'motors' = {motors!r:.120} has "
+                             f"{raw.dtype} values, not numbers; {allowed}")
+        if raw.shape != (act.n_controls,):
+            raise ValueError(f"{agent}: motor action has shape {raw.shape}; expected "
+                             f"({act.n_controls},) for motors {act.control_names}")
+        u = raw.astype(np.float64, copy=False)
+        if not np.isfinite(u).all():
+            bad = [act.control_names[k] for k in np.flatnonzero(~np.isfinite(u))]
+            raise ValueError(f"{agent}: motor action has NaN/inf for {bad}; values must be "
+                             f"finite, in [{lo}, {hi}]")
+        return u
 
     def _observe(self, i: int) -> dict:
         m, d = self.world.model, self.world.data
