@@ -442,15 +442,61 @@ def _compute(parts, density: float) -> dict:
             "grid_lo": np.array(grid_lo), "grid_dims": np.array(grid_dims, np.int64)}
 
 
-def _load(path: Path, n_parts: int) -> dict | None:
+def _load(path: Path, part_geom_counts: Sequence[int]) -> dict | None:
+    """The cached arrays, or None (computed again, and the file rewritten) when the file is
+    missing, unreadable, of another layout, or a valid archive whose arrays do not fit
+    together or this body (lengths, index ranges, finite values: see :func:`_consistent`)."""
     try:
         with np.load(path) as z:
             arrays = {k: z[k] for k in _ARRAYS}
     except Exception:  # missing, unreadable or from another layout: compute it again
         return None
-    if len(arrays["counts"]) != n_parts:
-        return None
-    return arrays
+    try:
+        ok = _consistent(arrays, np.asarray(part_geom_counts, np.int64))
+    except (ValueError, TypeError, IndexError):
+        ok = False
+    return arrays if ok else None
+
+
+def _consistent(a: dict, n_geoms: np.ndarray) -> bool:
+    """Whether cached skin arrays describe a skin of parts with ``n_geoms`` geoms each: every
+    length agrees with the per-part point counts, every index points inside its range (points
+    of their own part for the grid), positions and normals are finite."""
+    n_parts = len(n_geoms)
+    ints = ("counts", "point_part", "geom_local", "nbr", "grid", "grid_counts", "grid_dims")
+    if any(a[k].dtype.kind not in "iu" for k in ints):
+        return False
+    counts = a["counts"]
+    if counts.shape != (n_parts,) or (counts < 0).any():
+        return False
+    n = int(counts.sum())
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    if a["points"].shape != (n, 3) or a["normals"].shape != (n, 3):
+        return False
+    if not (np.isfinite(a["points"]).all() and np.isfinite(a["normals"]).all()):
+        return False
+    part = a["point_part"]
+    if not np.array_equal(part, np.repeat(np.arange(n_parts), counts)):
+        return False
+    local = a["geom_local"]
+    if local.shape != (n,) or (n and ((local < 0).any() or (local >= n_geoms[part]).any())):
+        return False
+    nbr, dist = a["nbr"], a["nbr_dist"]
+    if nbr.ndim != 2 or nbr.shape[0] != n or dist.shape != nbr.shape:
+        return False
+    if n and ((nbr < 0).any() or (nbr >= n).any() or np.isnan(dist).any()):
+        return False
+    cells, dims = a["grid_counts"], a["grid_dims"]
+    if cells.shape != (n_parts,) or dims.shape != (n_parts, 3) \
+            or a["grid_lo"].shape != (n_parts, 3):
+        return False
+    if (dims < 1).any() or not np.array_equal(cells, dims.prod(axis=1)):
+        return False
+    grid = a["grid"]
+    if grid.shape != (int(cells.sum()),):
+        return False
+    owner = np.repeat(np.arange(n_parts), cells)
+    return not grid.size or bool(((grid >= starts[owner]) & (grid < starts[owner + 1])).all())
 
 
 def _save(path: Path, arrays: dict) -> None:
@@ -488,7 +534,7 @@ def build_skin(model: mujoco.MjModel, body_ids: Sequence[int], prefix: str,
     else:
         path = cache_dir() / f"{key}.npz"
         if cache:
-            arrays = _load(path, len(parts))
+            arrays = _load(path, [len(geoms) for _, _, _, geoms in parts])
             if arrays is not None:
                 source = "disk"
         if arrays is None:

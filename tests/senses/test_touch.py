@@ -470,3 +470,38 @@ def test_contacts_land_where_they_touched():
                 total += 1
     assert total > 500
     assert hits / total > 0.95
+
+
+@pytest.mark.parametrize("damage", ["short_points", "nbr_out_of_range", "grid_of_another_part",
+                                    "nan_normals", "float_counts", "geom_out_of_range"])
+def test_a_valid_archive_with_wrong_arrays_is_rebuilt_not_fatal(tmp_path, monkeypatch, damage):
+    """A cache file that is a readable archive but whose arrays do not fit together (wrong
+    lengths, indices out of range, NaN) is ignored: the skin is computed again, equal to a fresh
+    one, and the file is rewritten, so the next env reads a good one from disk."""
+    monkeypatch.setenv("MIMO_SOCIAL_CACHE", str(tmp_path))
+    monkeypatch.setattr(skin_module, "_MEMORY", {})
+    good = skin(free_play_v0.parallel_env(n_agents=1, touch={"density": 0.3})).skins[0]
+    (path,) = list((tmp_path / "skin").glob("*.npz"))
+    with np.load(path) as z:
+        a = {k: z[k].copy() for k in z.files}
+    if damage == "short_points":
+        a["points"] = a["points"][:-5]
+    elif damage == "nbr_out_of_range":
+        a["nbr"][3, 0] = len(a["points"]) + 10
+    elif damage == "grid_of_another_part":
+        a["grid"][0] = len(a["points"]) - 1          # a cell of part 0 naming the last part's point
+    elif damage == "nan_normals":
+        a["normals"][7] = np.nan
+    elif damage == "float_counts":
+        a["counts"] = a["counts"].astype(float)
+    else:
+        a["geom_local"][0] = 99
+    np.savez(path, **a)
+    monkeypatch.setattr(skin_module, "_MEMORY", {})
+    again = skin(free_play_v0.parallel_env(n_agents=1, touch={"density": 0.3})).skins[0]
+    assert again.from_cache == ""                    # computed again
+    for key in ("points", "normals", "nbr", "grid"):
+        np.testing.assert_array_equal(getattr(good, key), getattr(again, key))
+    monkeypatch.setattr(skin_module, "_MEMORY", {})
+    third = skin(free_play_v0.parallel_env(n_agents=1, touch={"density": 0.3})).skins[0]
+    assert third.from_cache == "disk"                # the rewritten file is good
