@@ -42,6 +42,7 @@ Seeding (the SuperSuit/SB3 mismatch this module fixes)
 from __future__ import annotations
 
 import multiprocessing as mp
+import time
 import warnings
 from typing import Any, Callable, Sequence
 
@@ -66,10 +67,17 @@ class SpawnConcatVecEnv(gymnasium.vector.VectorEnv):
     """SuperSuit-style vector env (``reset -> (obs, infos)``, 5-tuple ``step``, single-slot
     ``observation_space`` / ``action_space``) whose worlds live in worker processes started with
     ``start_method`` (``"spawn"`` by default). Worker ``p`` holds a contiguous block of worlds.
+    A worker that dies, or does not answer within ``timeout_s`` seconds (stopped, stuck), is a
+    RuntimeError naming it, its process id and exit code, never a raw pipe error or a hang.
     """
 
     def __init__(self, env_fn: Callable[[], ParallelEnv], n_envs: int, n_procs: int,
-                 start_method: str = "spawn"):
+                 start_method: str = "spawn", timeout_s: float = 600.0):
+        if not (isinstance(timeout_s, (int, float)) and not isinstance(timeout_s, bool)
+                and timeout_s > 0):
+            raise ValueError(f"vector env: timeout_s={timeout_s!r}; allowed: a positive number "
+                             "of seconds")
+        self.timeout_s = float(timeout_s)
         if start_method == "fork":
             warnings.warn("start_method='fork': a process forked after a GL context was made "
                           "(any rendering) can crash; prefer 'spawn'", stacklevel=3)
@@ -103,11 +111,18 @@ class SpawnConcatVecEnv(gymnasium.vector.VectorEnv):
 
     def _gather(self) -> list:
         results, errors = [], []
+        deadline = time.monotonic() + self.timeout_s
         for p, conn in enumerate(self._conns):  # read every answer, so the pipes stay in step
             try:
+                if not self._answer_ready(p, conn, deadline):
+                    errors.append(f"worker {p} (pid {self._procs[p].pid}) did not answer within "
+                                  f"{self.timeout_s:g} s (alive: stopped or stuck); close this "
+                                  "env and make a new one")
+                    results.append(None)
+                    continue
                 status, value = conn.recv()
             except (EOFError, OSError):
-                errors.append(f"worker {p} died (exit code {self._procs[p].exitcode})")
+                errors.append(self._died(p))
                 results.append(None)
                 continue
             if status == "error":
@@ -117,9 +132,33 @@ class SpawnConcatVecEnv(gymnasium.vector.VectorEnv):
             raise RuntimeError("vector env " + "\n".join(errors))
         return results
 
+    def _answer_ready(self, p: int, conn, deadline: float) -> bool:
+        """Wait for worker ``p``'s answer until ``deadline``, in short slices, so that a worker
+        that dies meanwhile is seen at once (its pipe then reads EOF)."""
+        while True:
+            left = deadline - time.monotonic()
+            if conn.poll(max(0.0, min(1.0, left))):
+                return True
+            if not self._procs[p].is_alive():
+                return True            # recv() reads EOF: reported as died
+            if left <= 0:
+                return False
+
+    def _died(self, p: int) -> str:
+        proc = self._procs[p]
+        proc.join(0.5)
+        return (f"worker {p} (pid {proc.pid}) died (exit code {proc.exitcode}); close this env "
+                "and make a new one")
+
     def _send_all(self, messages) -> None:
-        for conn, msg in zip(self._conns, messages):
-            conn.send(msg)
+        dead = []
+        for p, (conn, msg) in enumerate(zip(self._conns, messages)):
+            try:
+                conn.send(msg)
+            except (BrokenPipeError, EOFError, OSError):
+                dead.append(self._died(p))
+        if dead:
+            raise RuntimeError("vector env " + "\n".join(dead))
 
     def reset(self, seed: int | None = None, options: dict | None = None):
         self._send_all(("reset", (None if seed is None else int(seed) + start, options))
