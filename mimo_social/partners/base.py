@@ -17,7 +17,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..core.env import MimoParallelEnv
 
 __all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop",
-           "pd_gains", "motor_action"]
+           "pd_gains", "motor_action", "follow_waypoints"]
 
 
 def zero_action(space: spaces.Space):
@@ -78,6 +78,24 @@ def pd_gains(model, data, dof_adr, frequency: float, damping: float,
     inertia = np.diag(M)[np.asarray(dof_adr)] + extra_inertia
     omega = 2 * np.pi * frequency
     return inertia * omega ** 2, inertia * 2 * damping * omega
+
+
+def follow_waypoints(data, waypoints, state: list, hold_steps: int, tolerance: float, qpos_adr,
+                     dof_adr, kp, kd, torque_neg, torque_pos) -> np.ndarray:
+    """One step of a PD walk through joint-angle ``waypoints``: the spring-damper motor commands
+    (in [-1, 1]) toward the current waypoint, with gravity and passive-spring compensation.
+    ``state`` = [waypoint index, steps spent at it, target angles] is advanced in place: to the
+    next waypoint after ``hold_steps`` steps or once every joint is within ``tolerance`` (rad)."""
+    q = data.qpos[qpos_adr]
+    state[1] += 1
+    if state[0] < len(waypoints) - 1 and (
+            state[1] >= hold_steps or np.max(np.abs(state[2] - q)) < tolerance):
+        state[0] += 1
+        state[1] = 0
+        state[2] = waypoints[state[0]]
+    tau = kp * (state[2] - q) - kd * data.qvel[dof_adr]
+    tau += data.qfrc_bias[dof_adr] - data.qfrc_spring[dof_adr]
+    return np.clip(np.where(tau >= 0, tau / torque_pos, tau / torque_neg), -1.0, 1.0)
 
 
 class Partner:

@@ -26,7 +26,8 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import Partner, agent_index, motor_action, pd_gains, require_motors
+from ..base import (Partner, agent_index, follow_waypoints, motor_action, pd_gains,
+                    require_motors)
 
 __all__ = [
     "BACK_COS",
@@ -478,16 +479,8 @@ class SocialTouchController(Partner):
     def _control(self, d, waypoints, state) -> np.ndarray:
         """The controls of one step (PD + compensation toward the current waypoint); ``state``
         [waypoint, steps in it, target angles] is advanced in place."""
-        q = d.qpos[self._qadr]
-        state[1] += 1
-        if state[0] < len(waypoints) - 1 and (
-                state[1] >= self.hold_steps or np.max(np.abs(state[2] - q)) < self.tolerance):
-            state[0] += 1
-            state[1] = 0
-            state[2] = waypoints[state[0]]
-        tau = self._kp * (state[2] - q) - self._kd * d.qvel[self._dadr]
-        tau += d.qfrc_bias[self._dadr] - d.qfrc_spring[self._dadr]
-        return np.clip(np.where(tau >= 0, tau / self._tpos, tau / self._tneg), -1.0, 1.0)
+        return follow_waypoints(d, waypoints, state, self.hold_steps, self.tolerance, self._qadr,
+                                self._dadr, self._kp, self._kd, self._tneg, self._tpos)
 
     def act(self, env, agent, observation):
         state = [self._wp, self._in_wp, self.target_angles]
