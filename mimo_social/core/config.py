@@ -10,8 +10,11 @@ re-exported here).
 from __future__ import annotations
 
 import dataclasses
+from functools import partial
 from dataclasses import dataclass, fields
 from typing import Any, Mapping, Sequence
+
+import numpy as np
 
 from ..body.tables import HAND_VERSIONS, SCALE_RANGE, STRENGTH_RANGE
 from ..senses import SENSES
@@ -19,21 +22,24 @@ from ..senses.proprioception import ProprioceptionConfig
 from ..senses.touch import TouchConfig
 from ..senses.vestibular import VestibularConfig
 from ..senses.vision import VisionConfig
-from ..util.checks import ConfigError, check_bool, check_choice, check_number
+from ..util.checks import (ConfigError, check_bool, check_choice, check_int, check_number,
+                           check_numbers, show)
 
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig", "AgentConfig",
     "PhysicsConfig", "ConfigError", "resolve_agents", "parse_physics", "ACTUATION_MODELS",
-    "POSTURES",
+    "POSTURES", "env_settings", "RENDER_SIZE_RANGE", "MAX_STEPS_LIMIT",
 ]
 
 ACTUATION_MODELS = ("spring_damper", "muscle")
+FLOOR_HALF = 10.0      # m: the floor plane's half size (an agent placed beyond it falls forever)
+FACING_LIMIT = 100.0   # m: how far the point an agent faces may be
 POSTURES = ("standing", "sitting", "lying")
 
 
 def _from_mapping(cls, what: str, value: Mapping[str, Any]):
     names = [f.name for f in fields(cls)]
-    unknown = sorted(set(value) - set(names))
+    unknown = sorted(set(value) - set(names), key=str)
     if unknown:
         raise ConfigError(f"{what}: unknown setting(s) {unknown}; allowed: {names}")
     return cls(**value)
@@ -62,17 +68,27 @@ class AgentConfig:
     strength: float = 1.0
 
     def __post_init__(self):
+        put = partial(object.__setattr__, self)
         check_choice("", "hands", self.hands, HAND_VERSIONS)
         check_choice("", "actuation", self.actuation, ACTUATION_MODELS)
         check_choice("", "posture", self.posture, POSTURES)
-        check_bool("", "expressions", self.expressions)
-        for key in ("position", "facing"):
-            v = getattr(self, key)
-            if v is not None and (len(v) != 2 or not all(abs(float(c)) < 1e3 for c in v)):
-                raise ConfigError(f"{key}={v!r}; expected (x, y) in metres or None")
-        object.__setattr__(self, "scale", check_number("", "scale", self.scale, *SCALE_RANGE))
-        object.__setattr__(self, "strength",
-                           check_number("", "strength", self.strength, *STRENGTH_RANGE))
+        put("expressions", check_bool("", "expressions", self.expressions))
+        for sense in SENSES:   # each sense: None (off) or its config (True / a mapping: parsed)
+            put(sense, _parse_sense(sense, getattr(self, sense)))
+        if self.position is not None:
+            put("position", check_numbers("", "position", self.position, 2, -FLOOR_HALF,
+                                          FLOOR_HALF, f"None or (x, y) in metres on the floor, "
+                                          f"each from {-FLOOR_HALF:g} to {FLOOR_HALF:g}"))
+        if self.facing is not None:
+            put("facing", check_numbers("", "facing", self.facing, 2, -FACING_LIMIT,
+                                        FACING_LIMIT, f"None or a point (x, y) in metres to "
+                                        f"face, each from {-FACING_LIMIT:g} to {FACING_LIMIT:g}"))
+        if self.clothes_rgba is not None:
+            put("clothes_rgba", check_numbers("", "clothes_rgba", self.clothes_rgba, 4, 0.0, 1.0,
+                                              "None or (red, green, blue, alpha), each from 0 "
+                                              "to 1"))
+        put("scale", check_number("", "scale", self.scale, *SCALE_RANGE))
+        put("strength", check_number("", "strength", self.strength, *STRENGTH_RANGE))
 
 
 _NO_FIELD = sorted(set(SENSES) - {f.name for f in fields(AgentConfig)})
@@ -82,32 +98,25 @@ if _NO_FIELD:  # a registered sense is switched by an AgentConfig field of its n
 
 def _parse_sense(name: str, value):
     cls = SENSES[name].config
-    if value is False or value is None:
+    if value is None or (isinstance(value, (bool, np.bool_)) and not value):
         return None
-    if value is True:
+    if isinstance(value, (bool, np.bool_)):
         return cls()
     if isinstance(value, cls):
         return value
     if isinstance(value, Mapping):
         return _from_mapping(cls, name, value)
-    raise ConfigError(f"{name}={value!r}; allowed: False, True or a mapping of "
+    raise ConfigError(f"{name}={show(value)}; allowed: False, True or a mapping of "
                       f"{[f.name for f in fields(cls)]}")
 
 
 def _agent_config(settings: Mapping[str, Any], where: str) -> AgentConfig:
     names = [f.name for f in fields(AgentConfig)]
-    unknown = sorted(set(settings) - set(names))
+    unknown = sorted(set(settings) - set(names), key=str)
     if unknown:
         raise ConfigError(f"{where}: unknown agent setting(s) {unknown}; allowed: {names}")
-    values = dict(settings)
-    for sense in SENSES:
-        if sense in values:
-            try:
-                values[sense] = _parse_sense(sense, values[sense])
-            except ConfigError as e:
-                raise ConfigError(f"{where}: {e}") from None
     try:
-        return AgentConfig(**values)
+        return AgentConfig(**settings)
     except ConfigError as e:
         raise ConfigError(f"{where}: {e}") from None
 
@@ -117,16 +126,17 @@ def resolve_agents(n_agents: int, common: Mapping[str, Any],
                    task_defaults: Sequence[Mapping[str, Any]] | None = None) -> list[AgentConfig]:
     """Agent configs from task defaults, then settings for all agents, then per-agent ones."""
     if per_agent is not None:
-        if isinstance(per_agent, Mapping) or len(per_agent) != n_agents:
+        if isinstance(per_agent, (str, bytes, Mapping)) or not isinstance(per_agent, Sequence) \
+                or len(per_agent) != n_agents:
             raise ConfigError(f"per_agent must be a list of {n_agents} mappings (one per agent), "
-                              f"got {per_agent!r}")
+                              f"got {show(per_agent)}")
     out = []
     for i in range(n_agents):
         settings = dict(task_defaults[i]) if task_defaults else {}
         settings.update(common)
         if per_agent is not None:
             if not isinstance(per_agent[i], Mapping):
-                raise ConfigError(f"per_agent[{i}] must be a mapping, got {per_agent[i]!r}")
+                raise ConfigError(f"per_agent[{i}] must be a mapping, got {show(per_agent[i])}")
             settings.update(per_agent[i])
         out.append(_agent_config(settings, f"agent infant_{i}"))
     return out
@@ -144,17 +154,17 @@ class PhysicsConfig:
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
 
     def __post_init__(self):
-        if not 1e-4 <= self.timestep <= 0.02:
-            raise ConfigError(f"physics timestep={self.timestep} s; allowed: 0.0001 to 0.02 s")
-        if not isinstance(self.frame_skip, int) or not 1 <= self.frame_skip <= 100:
-            raise ConfigError(f"physics frame_skip={self.frame_skip!r}; allowed: integer 1 to 100")
+        put = partial(object.__setattr__, self)
+        put("timestep", check_number("physics", "timestep", self.timestep, 1e-4, 0.02))
+        put("frame_skip", check_int("physics", "frame_skip", self.frame_skip, 1, 100))
         for key, allowed in (("jacobian", ("dense", "sparse", "auto")),
                              ("solver", ("newton", "cg", "pgs")),
                              ("cone", ("pyramidal", "elliptic"))):
-            if getattr(self, key) not in allowed:
-                raise ConfigError(f"physics {key}={getattr(self, key)!r}; allowed: {list(allowed)}")
-        if not 1 <= self.iterations <= 1000:
-            raise ConfigError(f"physics iterations={self.iterations}; allowed: 1 to 1000")
+            check_choice("physics", key, getattr(self, key), allowed)
+        put("iterations", check_int("physics", "iterations", self.iterations, 1, 1000))
+        put("tolerance", check_number("physics", "tolerance", self.tolerance, 0.0, 1.0))
+        put("gravity", check_numbers("physics", "gravity", self.gravity, 3, -100.0, 100.0,
+                                     "(x, y, z) in m/s^2, each from -100 to 100"))
 
 
 def parse_physics(value, task_overrides: Mapping[str, Any] | None = None) -> PhysicsConfig:
@@ -165,10 +175,34 @@ def parse_physics(value, task_overrides: Mapping[str, Any] | None = None) -> Phy
         base.update(dataclasses.asdict(value))
     elif isinstance(value, Mapping):
         names = [f.name for f in fields(PhysicsConfig)]
-        unknown = sorted(set(value) - set(names))
+        unknown = sorted(set(value) - set(names), key=str)
         if unknown:
             raise ConfigError(f"physics: unknown setting(s) {unknown}; allowed: {names}")
         base.update(value)
     else:
-        raise ConfigError(f"physics={value!r}; expected a mapping of physics settings")
+        raise ConfigError(f"physics={show(value)} not allowed; allowed: None, a PhysicsConfig "
+                          f"or a mapping of physics settings {[f.name for f in fields(PhysicsConfig)]}")
     return PhysicsConfig(**base)
+
+
+RENDER_SIZE_RANGE = (8, 4096)   # pixels, each side of render()'s image
+MAX_STEPS_LIMIT = 10**9
+
+
+def env_settings(render_mode, max_steps, render_size, default_max_steps: int,
+                 render_modes: Sequence[str]) -> tuple[str | None, int, tuple[int, int]]:
+    """The env's own settings checked and made canonical: ``render_mode`` (None or one of
+    ``render_modes``), ``max_steps`` (None: ``default_max_steps``; else an integer >= 1) and
+    ``render_size`` ((height, width) in pixels, integers); a ConfigError naming the setting."""
+    if render_mode is not None:
+        check_choice("env", "render_mode", render_mode, tuple(render_modes))
+    steps = default_max_steps if max_steps is None else max_steps
+    steps = check_int("env", "max_steps", steps, 1, MAX_STEPS_LIMIT)
+    lo, hi = RENDER_SIZE_RANGE
+    if isinstance(render_size, (str, bytes, Mapping)) or not isinstance(render_size, Sequence) \
+            or len(render_size) != 2:
+        raise ConfigError(f"env: render_size={show(render_size)} not allowed; allowed: "
+                          f"(height, width) in pixels, integers from {lo} to {hi}")
+    size = tuple(check_int("env", f"render_size[{k}]", v, lo, hi)
+                 for k, v in enumerate(render_size))
+    return render_mode, steps, size

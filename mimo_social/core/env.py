@@ -27,8 +27,9 @@ from ..body.actuation import MODELS as ACTUATION_MODELS
 from ..expressions.faces import EXPRESSIONS
 from ..render.scene import make_renderer
 from ..senses import SENSES
-from .config import ConfigError, parse_physics, resolve_agents
-from .task import Task, agent_user_settings
+from ..util.checks import check_seed
+from .config import ConfigError, env_settings, parse_physics, resolve_agents
+from .task import Task, agent_user_settings, check_start_poses
 from .world import World
 
 __all__ = ["MimoParallelEnv", "TIMING_KEYS"]
@@ -57,14 +58,10 @@ class MimoParallelEnv(ParallelEnv):
                  per_agent: Sequence[Mapping[str, Any]] | None = None,
                  render_mode: str | None = None, max_steps: int | None = None,
                  render_size: tuple[int, int] = (480, 640), **agent_settings):
-        if render_mode not in (None, "rgb_array"):
-            raise ConfigError(f"render_mode={render_mode!r}; allowed: None, 'rgb_array'")
+        self.render_mode, self.max_steps, self.render_size = env_settings(
+            render_mode, max_steps, render_size, task.default_max_steps,
+            getattr(self, "RENDER_MODES", self.metadata["render_modes"]))
         self.task = task
-        self.render_mode = render_mode
-        self.render_size = tuple(render_size)
-        self.max_steps = int(max_steps if max_steps is not None else task.default_max_steps)
-        if self.max_steps < 1:
-            raise ConfigError(f"max_steps={max_steps}; allowed: a positive integer")
         n = task.n_agents
         defaults = [task.agent_defaults(i, own) for i, own in
                     enumerate(agent_user_settings(n, agent_settings, per_agent))]
@@ -76,6 +73,7 @@ class MimoParallelEnv(ParallelEnv):
         task.configs = tuple(self.agent_configs)
         setups = [task.setup(i, cfg) for i, cfg in enumerate(self.agent_configs)]
         self.world = World(setups, task.props(), self.physics)
+        check_start_poses(self.world)   # agents placed inside each other: a ConfigError
         self.possible_agents = list(self.world.names)
         self.agents = list(self.possible_agents)
         self._index = {name: i for i, name in enumerate(self.possible_agents)}
@@ -154,8 +152,8 @@ class MimoParallelEnv(ParallelEnv):
         return agent
 
     def reset(self, seed: int | None = None, options: dict | None = None):
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
+        if check_seed(seed, "reset") is not None:   # a seed that is not an integer >= 0: a ConfigError
+            self._rng = np.random.default_rng(int(seed))
         w = self.world
         w.reset()
         for act in self.actuation:

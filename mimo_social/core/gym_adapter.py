@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import gymnasium as gym
 
+from ..util.checks import check_seed
 from .env import MimoParallelEnv
 
 __all__ = ["SingleAgentEnv"]
@@ -26,6 +27,7 @@ class SingleAgentEnv(gym.Env):
         self.metadata = {"render_modes": ["rgb_array"], "render_fps": env.metadata["render_fps"]}
 
     def reset(self, *, seed=None, options=None):
+        seed = check_seed(seed, "reset")   # before Gymnasium's own, less clear, check
         super().reset(seed=seed)
         obs, infos = self.parallel.reset(seed=seed, options=options)
         return obs[self.agent], infos[self.agent]

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any, ClassVar, Mapping, Sequence
 
+import mujoco
 import numpy as np
 from gymnasium import spaces
 
@@ -16,7 +17,14 @@ from ..util.checks import ConfigError, check_bool, check_choice, check_int, chec
 from .config import AgentConfig
 from .world import AgentSetup, Prop
 
-__all__ = ["Task", "TaskOptions", "agent_user_settings"]
+__all__ = ["Task", "TaskOptions", "agent_user_settings", "check_start_poses", "OVERLAP_DEPTH",
+           "TRUNK_PARTS"]
+
+#: m: how deep the trunks (:data:`TRUNK_PARTS`) of two agents may interpenetrate in their start
+#: poses; deeper: a ConfigError (agents placed inside each other; MuJoCo would push them apart
+#: violently at the first step). Crossing limbs are allowed (a pair made touching on purpose).
+OVERLAP_DEPTH = 0.01
+TRUNK_PARTS = ("hip", "lower_body", "upper_body", "head")
 
 #: what a hook's ``env`` is: the :class:`~mimo_social.core.env.MimoParallelEnv` running the task
 #: (its public view: ``world``, ``systems``, ``system(name)``, ``actuation``, ``controls``,
@@ -132,6 +140,48 @@ def agent_user_settings(n_agents: int, common: Mapping[str, Any],
         own = per_agent[i] if ok and isinstance(per_agent[i], Mapping) else {}
         out.append({**common, **own})
     return out
+
+
+def _xy(p) -> str:
+    return f"({p[0]:.3g}, {p[1]:.3g})"
+
+
+def check_start_poses(world) -> None:
+    """A ConfigError naming both agents when the trunks (:data:`TRUNK_PARTS`) of two agents
+    interpenetrate in their start poses by more than :data:`OVERLAP_DEPTH` (placed inside each
+    other), and naming the agent when it was told to face its own position. Reads a scratch
+    copy of the world's state."""
+    setups = world.agent_setups
+    for name, s in zip(world.names, setups):
+        if s.config.facing is not None and np.allclose(s.facing, s.position):
+            raise ConfigError(f"agent {name}: facing={_xy(s.facing)} is its own position; "
+                              "allowed: None or a point (x, y) other than where it stands")
+    if len(setups) < 2:
+        return
+    m = world.model
+    d = mujoco.MjData(m)
+    d.qpos[:] = world.data.qpos
+    mujoco.mj_kinematics(m, d)
+    mujoco.mj_collision(m, d)
+    n = d.ncon
+    if not n:
+        return
+    owner = np.full(m.ngeom, -1, dtype=np.intp)   # the agent of each trunk geom, else -1
+    for i, (name, a) in enumerate(zip(world.names, world.agents)):
+        trunk = {m.body(f"{name}/{part}").id for part in TRUNK_PARTS}
+        owner[[g for g in a.geom_ids if int(m.geom_bodyid[g]) in trunk]] = i
+    c = d.contact
+    a, b, depth = owner[c.geom1[:n]], owner[c.geom2[:n]], -c.dist[:n]
+    bad = np.flatnonzero((a >= 0) & (b >= 0) & (a != b) & (depth > OVERLAP_DEPTH))
+    if len(bad):
+        k = bad[np.argmax(depth[bad])]
+        i, j = sorted((int(a[k]), int(b[k])))
+        raise ConfigError(
+            f"agents {world.names[i]} and {world.names[j]} overlap: placed at "
+            f"{_xy(setups[i].position)} and {_xy(setups[j].position)} m, their trunks "
+            f"interpenetrate by {100 * depth[k]:.1f} cm at the start (allowed: at most "
+            f"{100 * OVERLAP_DEPTH:g} cm); place them farther apart (their position settings) "
+            "or leave position=None to the task")
 
 
 class Task:

@@ -16,6 +16,7 @@ import numpy as np
 from pettingzoo import ParallelEnv
 
 from ..core.wrappers import ParallelWrapper
+from ..util.checks import check_seed
 from .base import Partner
 
 __all__ = ["ScriptedPartners"]
@@ -63,6 +64,7 @@ class ScriptedPartners(ParallelWrapper):
         return {a: v for a, v in d.items() if a not in self.partners}
 
     def reset(self, seed: int | None = None, options: dict | None = None):
+        seed = check_seed(seed, "reset")
         obs, infos = self.env.reset(seed=seed, options=options)
         base = np.random.SeedSequence(seed) if seed is not None else np.random.SeedSequence()
         rngs = [np.random.default_rng(s) for s in base.spawn(len(self.partners))]

@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Protocol, Sequence, runtime_checkable
 
-from ..util.checks import ConfigError
+from ..util.checks import ConfigError, show
 
 __all__ = ["Sense", "SharedSystem", "SenseEntry", "components"]
 
@@ -77,8 +77,12 @@ class SenseEntry:
 def components(sense: str, given, allowed: Sequence[str]) -> tuple[str, ...]:
     """A sense's switched-on components, in the order of ``allowed``; a ConfigError saying what
     is allowed for an empty or unknown choice."""
+    if isinstance(given, (str, bytes, Mapping)) or not isinstance(given, (Sequence, set,
+                                                                         frozenset)):
+        raise ConfigError(f"{sense}: components={show(given)} not allowed; allowed: a non-empty "
+                          f"list of {list(allowed)}")
     given = tuple(given)
-    bad = [c for c in given if c not in allowed]
+    bad = [c for c in given if not isinstance(c, str) or c not in allowed]
     if bad or not given:
         raise ConfigError(f"{sense}: components {list(given)} not allowed; choose a non-empty "
                           f"subset of {list(allowed)}")

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from gymnasium import spaces
 
-from ..util.checks import ConfigError
+from ..util.checks import check_number
 from .base import SenseEntry, components
 
 __all__ = ["ProprioceptionConfig", "Proprioception", "SENSE", "COMPONENTS"]
@@ -30,9 +30,8 @@ class ProprioceptionConfig:
     def __post_init__(self):
         object.__setattr__(self, "components", components(
             "proprioception", self.components, COMPONENTS))
-        if not 0 < self.limit_margin_deg <= 90:
-            raise ConfigError(f"proprioception: limit_margin_deg={self.limit_margin_deg} "
-                              "must be in (0, 90] degrees")
+        object.__setattr__(self, "limit_margin_deg", check_number(
+            "proprioception", "limit_margin_deg", self.limit_margin_deg, 0.01, 90.0))
 
 
 class Proprioception:

@@ -57,13 +57,15 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import partial
 from typing import Sequence
 
 import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from ..util.checks import ConfigError
+from ..util.checks import (ConfigError, check_bool, check_choice, check_names,
+                           check_number)
 from .base import SenseEntry
 from .skin import GRID_CELL, Skin, build_skin
 
@@ -91,14 +93,13 @@ class TouchConfig:
     cache: bool = True
 
     def __post_init__(self):
-        if not 0.05 <= float(self.density) <= 8.0:
-            raise ConfigError(f"touch: density={self.density}; allowed: 0.05 to 8 (a multiplier "
-                              "of the published point density)")
-        if self.response not in RESPONSES:
-            raise ConfigError(f"touch: response={self.response!r}; allowed: {list(RESPONSES)}")
-        if self.frame not in FRAMES:
-            raise ConfigError(f"touch: frame={self.frame!r}; allowed: {list(FRAMES)}")
-        object.__setattr__(self, "exclude", tuple(self.exclude))
+        put = partial(object.__setattr__, self)
+        put("density", check_number("touch", "density", self.density, 0.05, 8.0))
+        check_choice("touch", "response", self.response, RESPONSES)
+        check_choice("touch", "frame", self.frame, FRAMES)
+        put("normal_only", check_bool("touch", "normal_only", self.normal_only))
+        put("exclude", check_names("touch", "exclude", self.exclude, "body part names"))
+        put("cache", check_bool("touch", "cache", self.cache))
 
 
 _SHIFT = 0.5   # a contact is looked up this many spacings outward along its normal

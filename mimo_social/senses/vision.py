@@ -37,7 +37,7 @@ from gymnasium import spaces
 
 from ..render.eye_renderer import Tile, TileRenderer
 from ..render.png import write_png
-from ..util.checks import ConfigError
+from ..util.checks import check_bool, check_int
 from .base import SenseEntry
 
 __all__ = ["VisionConfig", "VisionSystem", "VisionSense", "build_vision", "vision_system",
@@ -57,11 +57,9 @@ class VisionConfig:
 
     def __post_init__(self):
         for key in ("width", "height"):
-            v = getattr(self, key)
-            if not isinstance(v, int) or not 8 <= v <= 2048:
-                raise ConfigError(f"vision: {key}={v!r}; allowed: an integer 8 to 2048 pixels")
-        if not isinstance(self.every, int) or not 1 <= self.every <= 1000:
-            raise ConfigError(f"vision: every={self.every!r}; allowed: an integer 1 to 1000")
+            object.__setattr__(self, key, check_int("vision", key, getattr(self, key), 8, 2048))
+        object.__setattr__(self, "depth", check_bool("vision", "depth", self.depth))
+        object.__setattr__(self, "every", check_int("vision", "every", self.every, 1, 1000))
 
 
 class VisionSystem:

@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["ConfigError", "check_number", "check_int", "check_bool", "check_choice"]
+__all__ = ["ConfigError", "check_number", "check_int", "check_bool", "check_choice",
+           "check_numbers", "check_names", "check_seed"]
 
 
 class ConfigError(ValueError):
@@ -21,14 +22,39 @@ def _who(owner: str) -> str:
     return f"{owner}: " if owner else ""
 
 
+def show(value: Any, limit: int = 80) -> str:
+    """``repr(value)``, shortened in the middle past ``limit`` characters (for error messages)."""
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    return text[: limit // 2] + " ... " + text[-limit // 2 + 5:]
+
+
 def _range_text(lo, hi, what: str) -> str:
     if lo is None and hi is None:
-        return f"any finite {what}"
+        return {"a number": "any finite number", "an integer": "any integer",
+                "numbers": "finite numbers"}.get(what, what)
     if hi is None:
-        return f"{what} >= {lo:g}"
+        return f"{what} >= {_num(lo)}"
     if lo is None:
-        return f"{what} <= {hi:g}"
-    return f"{what} from {lo:g} to {hi:g}"
+        return f"{what} <= {_num(hi)}"
+    return f"{what} from {_num(lo)} to {_num(hi)}"
+
+
+def _num(x) -> str:
+    """A bound as written: integers whole (10000, not 1e+04), floats short (0.0001)."""
+    return str(x) if isinstance(x, numbers.Integral) else f"{x:g}"
+
+
+def _finite_real(value: Any) -> bool:
+    """A real number (numpy's too) that is not a bool, NaN or infinite (nor too large for a
+    float)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:   # an int beyond a float's range
+        return False
 
 
 def check_number(owner: str, name: str, value: Any, lo: float | None = None,
@@ -36,10 +62,9 @@ def check_number(owner: str, name: str, value: Any, lo: float | None = None,
     """``value`` as a float if it is a finite real number (not a bool) in [lo, hi], else a
     :class:`ConfigError` naming the owner (agent, task, partner; an empty owner: the caller
     names it), the setting and the range."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) \
-            or not math.isfinite(value) or (lo is not None and value < lo) \
+    if not _finite_real(value) or (lo is not None and value < lo) \
             or (hi is not None and value > hi):
-        raise ConfigError(f"{_who(owner)}{name}={value!r} not allowed; allowed: "
+        raise ConfigError(f"{_who(owner)}{name}={show(value)} not allowed; allowed: "
                           f"{_range_text(lo, hi, 'a number')}")
     return float(value)
 
@@ -49,7 +74,7 @@ def check_int(owner: str, name: str, value: Any, lo: int | None = None,
     """``value`` as an int if it is an integer (not a bool) in [lo, hi], else a ConfigError."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) \
             or (lo is not None and value < lo) or (hi is not None and value > hi):
-        raise ConfigError(f"{_who(owner)}{name}={value!r} not allowed; allowed: "
+        raise ConfigError(f"{_who(owner)}{name}={show(value)} not allowed; allowed: "
                           f"{_range_text(lo, hi, 'an integer')}")
     return int(value)
 
@@ -57,16 +82,60 @@ def check_int(owner: str, name: str, value: Any, lo: int | None = None,
 def check_bool(owner: str, name: str, value: Any) -> bool:
     """``value`` if it is a bool (numpy's too), else a ConfigError (truthy strings are not)."""
     if not isinstance(value, (bool, np.bool_)):
-        raise ConfigError(f"{_who(owner)}{name}={value!r} not allowed; allowed: True or False")
+        raise ConfigError(f"{_who(owner)}{name}={show(value)} not allowed; allowed: True or False")
     return bool(value)
 
 
 def check_choice(owner: str, name: str, value: Any, allowed: Sequence) -> Any:
     """``value`` if it is one of ``allowed``, else a ConfigError listing them."""
     try:
-        ok = value in allowed
-    except TypeError:  # an unhashable value against a set
+        ok = bool(value in allowed)
+    except (TypeError, ValueError):  # an unhashable value against a set, an array's ambiguity
         ok = False
     if not ok:
-        raise ConfigError(f"{_who(owner)}{name}={value!r} not allowed; allowed: {list(allowed)}")
+        raise ConfigError(f"{_who(owner)}{name}={show(value)} not allowed; allowed: {list(allowed)}")
     return value
+
+
+def _is_sequence(value: Any) -> bool:
+    """A list, tuple or 1-D array (not a string, bytes or mapping)."""
+    if isinstance(value, np.ndarray):
+        return value.ndim == 1
+    return isinstance(value, Sequence) and not isinstance(value, (str, bytes, Mapping))
+
+
+def check_numbers(owner: str, name: str, value: Any, n: int, lo: float | None = None,
+                  hi: float | None = None, allowed: str = "") -> tuple[float, ...]:
+    """``value`` as a tuple of ``n`` floats if it is a sequence (list, tuple, 1-D array) of
+    ``n`` finite real numbers in [lo, hi], else a ConfigError; ``allowed`` says what the numbers
+    mean (default: "n numbers ...")."""
+    what = allowed or f"{n} {_range_text(lo, hi, 'numbers')}"
+    if not _is_sequence(value) or len(value) != n \
+            or not all(_finite_real(v) and (lo is None or v >= lo) and (hi is None or v <= hi)
+                       for v in value):
+        raise ConfigError(f"{_who(owner)}{name}={show(value)} not allowed; allowed: {what}")
+    return tuple(float(v) for v in value)
+
+
+def check_names(owner: str, name: str, value: Any, what: str = "names",
+                empty: bool = True) -> tuple[str, ...]:
+    """``value`` as a tuple of distinct strings if it is a sequence of them (a lone string is
+    not: it would be read letter by letter), else a ConfigError; ``empty``: whether none is
+    allowed."""
+    if not _is_sequence(value) or not all(isinstance(v, str) for v in value) \
+            or len(set(value)) != len(value) or (not empty and not len(value)):
+        raise ConfigError(f"{_who(owner)}{name}={show(value)} not allowed; allowed: a list of "
+                          f"{'' if empty else 'one or more '}distinct {what}")
+    return tuple(str(v) for v in value)
+
+
+def check_seed(value: Any, owner: str = "") -> int | None:
+    """A reset seed: None (fresh entropy) or a non-negative integer (numpy's too; not a bool,
+    a float or a numeric string), returned as an int; else a ConfigError naming ``seed``."""
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) \
+            or value < 0:
+        raise ConfigError(f"{_who(owner)}seed={show(value)} not allowed; allowed: None or an "
+                          f"integer >= 0")
+    return int(value)
