@@ -53,6 +53,9 @@ class MimoParallelEnv(ParallelEnv):
       component, keys :data:`TIMING_KEYS`).
     """
     metadata = {"name": "mimo_social", "render_modes": ["rgb_array"], "is_parallelizable": True}
+    #: the render modes accepted: "human" too (PettingZoo's render_test builds it), though it has
+    #: no window here: ``render()`` then raises a RuntimeError saying to use "rgb_array"
+    RENDER_MODES = ("rgb_array", "human")
 
     def __init__(self, task: Task, physics: Mapping[str, Any] | None = None,
                  per_agent: Sequence[Mapping[str, Any]] | None = None,
@@ -60,7 +63,7 @@ class MimoParallelEnv(ParallelEnv):
                  render_size: tuple[int, int] = (480, 640), **agent_settings):
         self.render_mode, self.max_steps, self.render_size = env_settings(
             render_mode, max_steps, render_size, task.default_max_steps,
-            getattr(self, "RENDER_MODES", self.metadata["render_modes"]))
+            self.RENDER_MODES)
         self.task = task
         n = task.n_agents
         defaults = [task.agent_defaults(i, own) for i, own in
@@ -316,17 +319,65 @@ class MimoParallelEnv(ParallelEnv):
                 info.update(sense.info())
         return info
 
+    def info_spec(self, agent) -> dict:
+        """What ``infos[agent]`` may hold, key -> kind, for numeric views of the infos
+        (:class:`mimo_social.core.wrappers.NumericInfos`): the env's keys, each sense's
+        (``info_spec()`` of a sense) and the task's (``task.info_spec(i)``). Kinds:
+        ``"number"``, ``"flag"`` (1 when present and true, else 0), ``"count"`` (a list's
+        length), a tuple of strings (the string's index), ``"touch"`` (the touch info's counts)
+        or a dict of sub-keys -> kinds (a nested dict)."""
+        i = self._index[self._check_agent(agent)]
+        spec = {"expression": tuple(EXPRESSIONS), "step": "number", "time": "number",
+                "cost": "number", "weighted_cost": "number", "instability": "flag"}
+        for sense in self.senses[i]:
+            if hasattr(sense, "info_spec"):
+                spec.update(sense.info_spec())
+        if hasattr(self.task, "info_spec"):
+            spec.update(self.task.info_spec(i))
+        return spec
+
     def state(self) -> np.ndarray:
+        """The world's ``qpos`` then ``qvel`` (float32), in :attr:`state_space`."""
         d = self.world.data
         return np.concatenate([d.qpos, d.qvel]).astype(np.float32)
 
-    def state_space(self):
-        n = self.world.model.nq + self.world.model.nv
-        return spaces.Box(-np.inf, np.inf, (n,), np.float32)
+    @property
+    def state_space(self) -> spaces.Box:
+        """A float32 Box of ``nq + nv`` values (the same object every time): unit quaternions of
+        free and ball joints in [-1, 1] (MuJoCo keeps them normalised), everything else
+        unbounded (positions, and angles, which soft joint limits do not bound)."""
+        space = self.__dict__.get("_state_space")
+        if space is None:
+            m = self.world.model
+            low = np.full(m.nq + m.nv, -np.inf, np.float32)
+            for j, kind in enumerate(m.jnt_type):
+                start = int(m.jnt_qposadr[j])
+                if kind == mujoco.mjtJoint.mjJNT_FREE:
+                    low[start + 3:start + 7] = -1.0
+                elif kind == mujoco.mjtJoint.mjJNT_BALL:
+                    low[start:start + 4] = -1.0
+            space = self._state_space = spaces.Box(low, -low, dtype=np.float32)
+        return space
 
     # -- rendering -------------------------------------------------------------------------------
-    def render(self):
-        if self.render_mode != "rgb_array":
+    def render(self, mode: str | None = None):
+        """The scene as an RGB array (``render_mode="rgb_array"``), else None.
+
+        ``mode`` (older PettingZoo and RLlib's ``ParallelPettingZooEnv`` pass one): None or the
+        env's own render_mode; ``"rgb_array"`` returns a frame whatever the env's mode.
+        ``render_mode="human"`` has no window here (headless simulation, frames drawn off
+        screen): it raises a RuntimeError that says to use ``"rgb_array"``.
+        """
+        if mode is None or mode == self.render_mode:
+            mode = self.render_mode
+        elif mode != "rgb_array":
+            raise ValueError(f"render(mode={mode!r}) not allowed; allowed: None, 'rgb_array' "
+                             f"or the env's render_mode {self.render_mode!r}")
+        if mode == "human":
+            raise RuntimeError("render_mode='human' opens no window in this package; make the "
+                               "env with render_mode='rgb_array' and show its frames, or record "
+                               "the episode (mimo_social.recording)")
+        if mode != "rgb_array":
             return None
         return self.render_rgb()
 

@@ -32,7 +32,7 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-__all__ = ["ParallelWrapper", "FlattenParallel", "FlatActionWrapper", "FlatObservationWrapper",
+__all__ = ["ParallelWrapper", "FlattenParallel", "NumericInfos", "INFO_KINDS", "FlatActionWrapper", "FlatObservationWrapper",
            "ExpressionActionWrapper", "is_expression_only", "flat_action_space",
            "flat_observation_space"]
 
@@ -143,25 +143,47 @@ class _ActionDecoder:
 
     def __call__(self, action, who: str = "agent"):
         if self.discrete:
-            e = np.asarray(action)
-            if e.size != 1 or not np.isfinite(e).all():
-                raise ValueError(f"{who}: a face-only agent's action is one expression id, got "
-                                 f"{action!r}")
+            first = self.expression_start
+            allowed = f"one expression id, an integer {first}..{first + self.n_expressions - 1}"
+            e = _numbers(action, who, "expression", allowed)
+            if e.size != 1 or not np.isfinite(e).all() or e.ravel()[0] != int(e.ravel()[0]):
+                raise ValueError(f"{who}: action field 'expression' = {action!r:.120} not "
+                                 f"allowed (a face-only agent); {allowed}")
             return {"motors": self._motors, "expression": np.int64(int(e.ravel()[0]))}
-        a = np.asarray(action, dtype=np.float32)
+        layout = (f"{self.n_motors} motors + {self.n_expressions} expression logits"
+                  if self.n_expressions else f"{self.n_motors} motors")
+        a = _numbers(action, who, "action", f"{self.space.shape[0]} numbers ({layout})")
         if a.shape != self.space.shape:
-            layout = (f"{self.n_motors} motors + {self.n_expressions} expression logits"
-                      if self.n_expressions else f"{self.n_motors} motors")
             raise ValueError(f"{who}: flat action has shape {a.shape}; expected "
                              f"{self.space.shape} ({layout})")
-        motors = a[:self.n_motors].reshape(self.motor_shape)
+        # clipped in float64: a finite value beyond float32's range is clipped, not made inf
+        # (NaN and inf motors go on to the env, whose error names the motors)
+        motors = np.clip(a[:self.n_motors], self.space.low[:self.n_motors],
+                         self.space.high[:self.n_motors])
+        motors = motors.astype(np.float32).reshape(self.motor_shape)
         if not self.n_expressions:
             return motors
         logits = a[self.n_motors:]
         if not np.isfinite(logits).all():
-            raise ValueError(f"{who}: expression logits must be finite, got {logits}")
+            raise ValueError(f"{who}: action field 'expression logits' = {logits} not allowed; "
+                             f"allowed: {self.n_expressions} finite numbers (the largest picks "
+                             "the expression)")
         return {"motors": motors,
                 "expression": np.int64(self.expression_start + int(np.argmax(logits)))}
+
+
+def _numbers(action, who: str, field: str, allowed: str) -> np.ndarray:
+    """``action`` as a float64 array, else a ValueError naming the agent, the field, the value
+    and what is allowed (strings, ragged lists, dicts, None ... are not numbers)."""
+    try:
+        raw = np.asarray(action)
+    except (TypeError, ValueError) as e:        # ragged nested lists and the like
+        raise ValueError(f"{who}: action field {field!r} = {action!r:.120} is not an array of "
+                         f"numbers ({e}); allowed: {allowed}") from None
+    if raw.dtype.kind not in "iuf":
+        raise ValueError(f"{who}: action field {field!r} = {action!r:.120} has {raw.dtype} "
+                         f"values, not numbers; allowed: {allowed}")
+    return raw.astype(np.float64)
 
 
 def flat_action_space(space: spaces.Space) -> spaces.Space:
@@ -188,8 +210,9 @@ class ParallelWrapper(ParallelEnv):
     def unwrapped(self):
         return self.env.unwrapped
 
-    def render(self):
-        return self.env.render()
+    def render(self, *args):
+        # RLlib's ParallelPettingZooEnv passes a mode (see MimoParallelEnv.render)
+        return self.env.render(*args)
 
     def close(self):
         return self.env.close()
@@ -197,9 +220,9 @@ class ParallelWrapper(ParallelEnv):
     def state(self):
         return self.env.state()
 
-    def state_space(self, *args, **kwargs):
-        space = self.env.state_space
-        return space(*args, **kwargs) if callable(space) else space
+    @property
+    def state_space(self):
+        return self.env.state_space
 
     def __getattr__(self, name: str):
         # only public names, and never before __init__/__setstate__ has set ``env`` (pickling)
@@ -257,6 +280,145 @@ class FlattenParallel(ParallelWrapper):
                    for a, act in actions.items()}
         obs, rewards, terminations, truncations, infos = self.env.step(decoded)
         return self._flat_obs(obs), rewards, terminations, truncations, infos
+
+
+# -- numeric infos ------------------------------------------------------------------------------
+#: the kinds of info value an ``info_spec`` names (besides a tuple of strings and a nested dict)
+INFO_KINDS = ("number", "flag", "count", "touch")
+TOUCH_COUNTS = ("parts", "self", "agents", "object")
+
+
+class NumericInfos(ParallelWrapper):
+    """Every agent's infos as one fixed set of float numbers: the same keys at reset and at every
+    step, for clients that turn infos into tensors (TorchRL's ``PettingZooWrapper``).
+
+    The keys are declared up front by the wrapped env's ``info_spec(agent)`` (the env's, its
+    senses' and its task's, see :meth:`mimo_social.core.env.MimoParallelEnv.info_spec`) and
+    ``extra`` (key -> kind, e.g. ``{"partner_rewards": {"infant_1": "number"}}``). Per kind:
+
+    * ``"number"``: ``float(value)`` (bools 0/1);
+    * ``"flag"``: 1 when the key is there and true, else 0 (``instability``);
+    * ``"count"``: the length of a list (``touched_parts``), 0 for None;
+    * a tuple of strings: the index of the string in it (``expression``, ``target_part``), -1
+      for None or a string not in the tuple;
+    * ``"touch"``: ``key/parts``, ``key/self``, ``key/agents``, ``key/object``: how many body
+      parts are touched, by the agent itself, by other agents, by objects;
+    * a dict sub-key -> kind: ``key/sub-key`` for each (a nested dict flattened).
+
+    A declared key missing from an info (task keys at reset) reads ``missing`` (default 0).
+    Keys nobody declared are dropped; with ``strict=True`` they, and strings not in their tuple,
+    raise a ValueError naming the agent and the key (what the tests use to keep specs right).
+    ``info_keys(agent)``: the keys, in order. Observations, actions, rewards and ends are the
+    wrapped env's, untouched.
+    """
+
+    def __init__(self, env: ParallelEnv, extra: Mapping[str, Any] | None = None,
+                 missing: float = 0.0, strict: bool = False):
+        super().__init__(env)
+        spec_of = getattr(env, "info_spec", None)
+        if spec_of is None:
+            raise TypeError(f"NumericInfos needs an env with info_spec(agent) (the envs of this "
+                            f"package have one), got {type(env).__name__}")
+        self.possible_agents = list(env.possible_agents)
+        self.missing = float(missing)
+        self.strict = bool(strict)
+        self._specs = {}
+        for a in self.possible_agents:
+            spec = {**spec_of(a), **dict(extra or {})}
+            _check_spec(a, spec)
+            self._specs[a] = spec
+        self._keys = {a: tuple(self._encode(a, {})) for a in self.possible_agents}
+
+    @property
+    def agents(self):
+        return self.env.agents
+
+    def observation_space(self, agent):
+        return self.env.observation_space(agent)
+
+    def action_space(self, agent):
+        return self.env.action_space(agent)
+
+    def info_keys(self, agent) -> tuple[str, ...]:
+        """The keys of ``agent``'s numeric infos, in order."""
+        try:
+            return self._keys[agent]
+        except KeyError:
+            raise KeyError(f"unknown agent {agent!r}; agents of this env: "
+                           f"{self.possible_agents}") from None
+
+    def _encode(self, agent: str, info: Mapping[str, Any]) -> dict[str, float]:
+        spec = self._specs[agent]
+        if self.strict:
+            undeclared = sorted(set(info) - set(spec))
+            if undeclared:
+                raise ValueError(f"{agent}: info key(s) {undeclared} not declared by the env's "
+                                 f"info_spec (declared: {sorted(spec)})")
+        out: dict[str, float] = {}
+        for key, kind in spec.items():
+            self._put(agent, key, kind, key in info, info.get(key), out)
+        return out
+
+    def _put(self, agent, key, kind, present, value, out):
+        strict = self.strict
+        if isinstance(kind, Mapping):
+            sub = value if present and isinstance(value, Mapping) else {}
+            if strict and present and (not isinstance(value, Mapping) or set(sub) - set(kind)):
+                raise ValueError(f"{agent}: info {key!r} = {value!r:.120} does not fit its "
+                                 f"declared keys {sorted(kind)}")
+            for k, sub_kind in kind.items():
+                self._put(agent, f"{key}/{k}", sub_kind, k in sub, sub.get(k), out)
+        elif isinstance(kind, tuple):
+            idx = kind.index(value) if present and value in kind else -1
+            if strict and present and value is not None and idx < 0:
+                raise ValueError(f"{agent}: info {key!r} = {value!r:.120} is not one of its "
+                                 f"declared values {list(kind)}")
+            out[key] = float(idx)
+        elif kind == "flag":
+            out[key] = 1.0 if present and value is not None and value is not False else 0.0
+        elif kind == "count":
+            out[key] = float(len(value)) if present and value is not None else 0.0
+        elif kind == "touch":
+            parts = value if present and isinstance(value, Mapping) else {}
+            counts = dict.fromkeys(TOUCH_COUNTS, 0.0)
+            for who in parts.values():
+                counts["parts"] += 1.0
+                counts["self"] += float(bool(who.get("self")))
+                counts["agents"] += float(bool(who.get("agents")))
+                counts["object"] += float(bool(who.get("object")))
+            out.update({f"{key}/{c}": n for c, n in counts.items()})
+        elif not present or value is None:
+            out[key] = self.missing
+        else:
+            try:
+                out[key] = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"{agent}: info {key!r} = {value!r:.120} is declared a number "
+                                 "but is not one") from None
+
+    def _numeric(self, infos: Mapping[str, Any]) -> dict:
+        return {a: (self._encode(a, i) if a in self._specs else i) for a, i in infos.items()}
+
+    def reset(self, seed: int | None = None, options: dict | None = None):
+        obs, infos = self.env.reset(seed=seed, options=options)
+        return obs, self._numeric(infos)
+
+    def step(self, actions: Mapping[str, Any]):
+        obs, rewards, terminations, truncations, infos = self.env.step(actions)
+        return obs, rewards, terminations, truncations, self._numeric(infos)
+
+
+def _check_spec(agent: str, spec: Mapping[str, Any], prefix: str = "") -> None:
+    for key, kind in spec.items():
+        if isinstance(kind, Mapping):
+            _check_spec(agent, kind, f"{prefix}{key}/")
+        elif isinstance(kind, tuple):
+            if not all(isinstance(v, str) for v in kind):
+                raise TypeError(f"{agent}: info_spec {prefix}{key}: a tuple of kinds must hold "
+                                f"strings, got {kind!r}")
+        elif kind not in INFO_KINDS:
+            raise TypeError(f"{agent}: info_spec {prefix}{key}: kind {kind!r} not allowed; "
+                            f"allowed: {list(INFO_KINDS)}, a tuple of strings or a dict")
 
 
 # -- the Gymnasium side -------------------------------------------------------------------------

@@ -7,6 +7,7 @@ import dataclasses
 from pettingzoo.utils.conversions import parallel_to_aec
 
 from ..core.env import MimoParallelEnv
+from ..util.checks import ConfigError
 
 TASK_ARGS = ("physics", "per_agent", "render_mode", "max_steps", "render_size")
 
@@ -15,7 +16,21 @@ def make_parallel(task_cls, n_agents=None, task_options=None, **kwargs) -> MimoP
     """The task (``task_options``: a dict or the task's ``Options`` instance) in a ParallelEnv;
     ``kwargs``: the env's settings and the agents' settings."""
     task = task_cls(task_cls.default_n_agents if n_agents is None else n_agents, task_options)
-    return MimoParallelEnv(task, **kwargs)
+    return MimoParallelEnv(task, **max_cycles_alias(kwargs))
+
+
+def max_cycles_alias(kwargs: dict) -> dict:
+    """``max_cycles`` (PettingZoo's name for the episode cap, e.g. its max_cycles_test) is taken
+    as ``max_steps``; both at once is a ConfigError unless they agree."""
+    if "max_cycles" not in kwargs:
+        return kwargs
+    kwargs = dict(kwargs)
+    cycles = kwargs.pop("max_cycles")
+    if kwargs.get("max_steps") is not None and kwargs["max_steps"] != cycles:
+        raise ConfigError(f"env: max_cycles={cycles!r} and max_steps={kwargs['max_steps']!r} "
+                          "given; give one (max_cycles is another name for max_steps)")
+    kwargs["max_steps"] = cycles
+    return kwargs
 
 
 def make_aec(task_cls, **kwargs):

@@ -3,6 +3,13 @@ and the actuation model's state, each component switchable.
 
 Limit sensors rise linearly from 0 to 1 over the last ``limit_margin_deg`` before a joint limit:
 positive near the upper limit, negative near the lower one, 0 elsewhere.
+
+Bounds of the observation Box: joint angles within the joint's range widened by
+:data:`JOINT_OVERSHOOT` on each side (MuJoCo's joint limits are soft: a joint pushed hard passes
+its range, by up to 23 degrees over 6000 bang-bang steps of free play), limit sensors within the
+values of those angles, the spring-damper state within [-1, 1] (controls) and its torque limits,
+muscle activations within [0, 1]; an angle beyond the widened range (only a diverging
+simulation gets there) is clipped to it. Velocities, torques and muscle forces are unbounded.
 """
 
 from __future__ import annotations
@@ -13,9 +20,14 @@ import numpy as np
 from gymnasium import spaces
 
 from ..util.checks import check_number
+from ..body.actuation.muscle import Muscle
+from ..body.actuation.spring_damper import SpringDamper
 from .base import SenseEntry, components
 
-__all__ = ["ProprioceptionConfig", "Proprioception", "SENSE", "COMPONENTS"]
+__all__ = ["ProprioceptionConfig", "Proprioception", "SENSE", "COMPONENTS", "JOINT_OVERSHOOT"]
+
+#: how far (rad) past its range a joint angle may read (the Box's bound; clipped beyond)
+JOINT_OVERSHOOT = np.pi / 2
 
 COMPONENTS = ("qpos", "qvel", "torque", "limits", "actuation")
 
@@ -53,8 +65,30 @@ class Proprioception:
             self.slices[c] = slice(start, start + sizes[c])
             start += sizes[c]
         self.size = start
-        self.space = spaces.Box(-np.inf, np.inf, (self.size,), np.float32)
+        # joint angles: the range widened by JOINT_OVERSHOOT (unlimited joints: unbounded)
+        limited = self._hi > self._lo
+        self._q_lo = np.where(limited, self._lo - JOINT_OVERSHOOT, -np.inf)
+        self._q_hi = np.where(limited, self._hi + JOINT_OVERSHOOT, np.inf)
+        low = np.full(self.size, -np.inf)
+        high = np.full(self.size, np.inf)
+        for c, sl in self.slices.items():
+            if c == "qpos":
+                low[sl], high[sl] = self._q_lo, self._q_hi
+            elif c == "limits":
+                lo, hi = self._limit_values(self._q_lo), self._limit_values(self._q_hi)
+                low[sl] = np.where(limited, lo, -np.inf)
+                high[sl] = np.where(limited, hi, np.inf)
+            elif c == "actuation":
+                low[sl], high[sl] = _actuation_bounds(actuation)
+        self.space = spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
         self.spaces = {self.name: self.space}
+
+    def _limit_values(self, q: np.ndarray) -> np.ndarray:
+        """The limit sensors at joint angles ``q``: 1 - distance/margin, floored at 0, each side
+        (at most 1 + overshoot/margin past a limit; rising with q)."""
+        lo = np.maximum(1.0 - (q - self._lo) * self._inv_margin, 0.0)
+        hi = np.maximum(1.0 - (self._hi - q) * self._inv_margin, 0.0)
+        return hi - lo
 
     def observe(self, model, data, out: dict) -> None:
         out[self.name] = self.read(model, data)
@@ -62,7 +96,7 @@ class Proprioception:
     def read(self, model, data) -> np.ndarray:
         a = self.agent
         out = np.empty(self.size, np.float32)
-        q = data.qpos[a.qpos_adr]
+        q = np.clip(data.qpos[a.qpos_adr], self._q_lo, self._q_hi)
         for c, sl in self.slices.items():
             if c == "qpos":
                 out[sl] = q
@@ -71,12 +105,26 @@ class Proprioception:
             elif c == "torque":
                 out[sl] = data.qfrc_actuator[a.dof_adr]
             elif c == "limits":  # 1 - distance/margin, floored at 0, on each side
-                lo = np.maximum(1.0 - (q - self._lo) * self._inv_margin, 0.0)
-                hi = np.maximum(1.0 - (self._hi - q) * self._inv_margin, 0.0)
-                out[sl] = hi - lo
+                out[sl] = self._limit_values(q)
             else:
                 out[sl] = self.actuation.observation(data)
         return out
+
+
+def _actuation_bounds(actuation) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds of the actuation state: spring-damper ``[u, torque]``: [-1, 1] and the motors'
+    torque limits; muscles ``[activation, force]``: [0, 1] and unbounded; another model:
+    unbounded."""
+    n = actuation.observation_size
+    low, high = np.full(n, -np.inf), np.full(n, np.inf)
+    if isinstance(actuation, SpringDamper):
+        k = len(actuation.joints)
+        low[:k], high[:k] = -1.0, 1.0
+        low[k:], high[k:] = -np.abs(actuation.torque_neg), np.abs(actuation.torque_pos)
+    elif isinstance(actuation, Muscle):
+        k = n // 2
+        low[:k], high[:k] = 0.0, 1.0
+    return low, high
 
 
 def _build(config: ProprioceptionConfig, world, index: int, actuation) -> Proprioception:

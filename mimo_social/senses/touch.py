@@ -129,7 +129,9 @@ class AgentTouch:
         self.start, self.stop = system.agent_slices[agent]
         n = self.stop - self.start
         size = n if self.config.normal_only else 3 * n
-        self.space = spaces.Box(-np.inf, np.inf, (size,), np.float32)
+        # a normal (pressing) force is >= 0; force vectors point any way
+        low = 0.0 if self.config.normal_only else -np.inf
+        self.space = spaces.Box(low, np.inf, (size,), np.float32)
         self.spaces = {self.name: self.space}
 
     @property
@@ -141,12 +143,16 @@ class AgentTouch:
 
     def read(self) -> np.ndarray:
         """This agent's ``touch`` vector as of the last update (a new float32 array)."""
-        if self.config.normal_only:
-            return self.system._normal[self.start:self.stop].astype(np.float32)
+        if self.config.normal_only:   # (>= 0: a -0.0 or rounding below 0 reads 0)
+            return np.maximum(self.system._normal[self.start:self.stop], 0.0).astype(np.float32)
         return self.system._xyz[3 * self.start:3 * self.stop].astype(np.float32)
 
     def info(self) -> dict:
         return {"touch": self.system.touched_by(self.agent)}
+
+    def info_spec(self) -> dict:
+        """``infos["touch"]`` is a touch info (numeric views count its parts)."""
+        return {"touch": "touch"}
 
 
 class TouchSystem:

@@ -250,6 +250,11 @@ class Catch(Task):
         touch = o.contact_reward if self._n_touch else 0.0
         return np.array([touch - o.cost_weight * cost])
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"is_success": "number", "dropped": "number", "parts_touching": "number",
+                "held_steps": "number", "ball_radius": "number", "ball_mass": "number"}
+
     def terminations(self, env):
         return (np.array([self._success or self._dropped]),
                 [{"is_success": self._success, "dropped": self._dropped,

@@ -333,6 +333,12 @@ class Handover(Task):
             r += o.failure_reward
         return np.array([r, r])
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"is_success": "number", "holder": ("giver", "receiver", "none"),
+                "dropped": "number", "receiver_parts": "number", "held_steps": "number",
+                "distance": "number"}
+
     def terminations(self, env):
         done = self._dropped or (self._success and self.options.end_on_success)
         info = {"is_success": self._success, "holder": self._holder, "dropped": self._dropped,

@@ -196,6 +196,11 @@ class HighFive(Task):
         self._distance = dist
         return np.array([r, r])
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"is_success": "number", "hands_touching": "number",
+                "hand_feels_partner": "number", "hand_distance": "number"}
+
     def terminations(self, env):
         done = self._touching and self.options.end_on_touch
         infos = [{"is_success": self._touching, "hands_touching": self._touching,

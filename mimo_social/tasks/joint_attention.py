@@ -277,6 +277,12 @@ class JointAttention(Task):
         r = on.astype(float) - self.options.shaping * np.where(has, err, 0.0)
         return self._weights * r
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"looked_at": "number", "target": "number", "gaze_error_deg": "number",
+                "shared": "number", "on_target_fraction": "number", "leader": "number",
+                "is_success": "number"}
+
     def terminations(self, env):
         infos = []
         enough = self._with * self._dt >= MIN_TARGET_S - 1e-9

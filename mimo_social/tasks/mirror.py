@@ -150,6 +150,11 @@ class Mirror(Task):
         self._matched += int(self._match)
         return self._weights * float(self._match)
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"match": "number", "matched_steps": "number", "is_success": "number",
+                "is_leader": "number"}
+
     def terminations(self, env):
         success = self._matched >= self._need
         infos = [{"match": self._match, "matched_steps": self._matched, "is_success": success,

@@ -167,6 +167,10 @@ class Reach(Task):
         self._dist = float(np.linalg.norm(d.site_xpos[self._tip] - d.xpos[self._ball_body]))
         return np.array([self.options.success_reward if self._touched else -self._dist])
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"is_success": "number", "distance": "number"}
+
     def terminations(self, env):
         return (np.array([self._touched]),
                 [{"is_success": self._touched, "distance": self._dist}])

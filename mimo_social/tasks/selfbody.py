@@ -200,6 +200,12 @@ class SelfBody(Task):
         self._distance = None
         return np.array([self.options.miss_reward])
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"target": tuple(self.targets),
+                "target_part": tuple(dict.fromkeys(self.target_parts)), "is_success": "number",
+                "touched": "count", "distance": "number"}
+
     def terminations(self, env):
         return (np.array([self._success]),
                 [{"target": self.target, "target_part": self.target_part,

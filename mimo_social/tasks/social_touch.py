@@ -338,6 +338,12 @@ class SocialTouch(Task):
                     r -= self._distance * max(env.max_steps - env.steps, 0)
         return np.array([r, r])
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"target_part": tuple(self.targets), "is_success": "number",
+                "wrong_touch": "number", "first_touch": "count", "target_felt": "number",
+                "fingertip_distance": "number", "touched_parts": "count"}
+
     def terminations(self, env):
         done = self._first is not None and self.options.end_on_touch
         info = {"target_part": self.target, "is_success": self._success,

@@ -241,6 +241,11 @@ class Standup(Task):
         self._cost = self.options.cost_weight * float(np.dot(u, u))
         return np.array([self._height - self._ref - self._cost])
 
+    def info_spec(self, i):
+        """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
+        return {"head_height": "number", "head_gain": "number", "is_success": "number",
+                "control_cost": "number"}
+
     def terminations(self, env):
         gain = self._height - self._start_height
         self._above = self._above + 1 if gain >= self.options.success_gain else 0

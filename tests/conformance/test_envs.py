@@ -112,11 +112,10 @@ def test_max_cycles(entry, form):
 
 @pytest.mark.parametrize("entry, form", _cases("state"))
 def test_state_is_in_state_space(entry, form):
-    """``state()`` lies in ``state_space()`` after reset and every step, in the parallel and the
-    AEC form. (PettingZoo's state_test reads ``state_space`` as an attribute; here it is a
-    method, so its checks are done here.)"""
+    """``state()`` lies in ``state_space`` after reset and every step, in the parallel and the
+    AEC form (PettingZoo's own state_test runs in tests/clients)."""
     env = entry.parallel_env(max_steps=SHORT)
-    space = env.state_space()
+    space = env.state_space
     assert isinstance(space, gym.spaces.Box)
     env.reset(seed=0)
     assert space.contains(env.state())

@@ -72,7 +72,7 @@ def test_flatten_parallel_observations_actions_and_passthrough():
     with pytest.raises(ValueError, match="infant_0"):
         env.step({"infant_0": np.zeros(8, np.float32), "infant_1": act["infant_1"]})
     # pass-through: state, state_space, render_mode, attributes of the wrapped env
-    assert env.state().shape == env.state_space().shape
+    assert env.state().shape == env.state_space.shape
     assert env.render_mode is None and env.render() is None
     assert env.max_steps == raw.max_steps
     # no expressions: the motor Box itself
