@@ -13,9 +13,10 @@ from . import bench, bench_vision, calibrate, compliance, demo, figure, replay
 from . import docs
 from . import bench_recording
 from . import baselines
+from . import soak
 
 SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, bench_vision, figure, docs,
-               bench_recording, baselines)
+               bench_recording, baselines, soak)
 
 
 def build_parser() -> argparse.ArgumentParser:
