@@ -336,16 +336,24 @@ class MimoParallelEnv(ParallelEnv):
             spec.update(self.task.info_spec(i))
         return spec
 
+    def _has_faces(self) -> bool:
+        return any(c.expressions for c in self.agent_configs)
+
     def state(self) -> np.ndarray:
-        """The world's ``qpos`` then ``qvel`` (float32), in :attr:`state_space`."""
+        """The world's ``qpos`` then ``qvel``, then, when some agent has expressions on, every
+        agent's expression id (float32, in :attr:`state_space`)."""
         d = self.world.data
-        return np.concatenate([d.qpos, d.qvel]).astype(np.float32)
+        parts = [d.qpos, d.qvel]
+        if self._has_faces():
+            parts.append(self._expression)
+        return np.concatenate(parts).astype(np.float32)
 
     @property
     def state_space(self) -> spaces.Box:
-        """A float32 Box of ``nq + nv`` values (the same object every time): unit quaternions of
-        free and ball joints in [-1, 1] (MuJoCo keeps them normalised), everything else
-        unbounded (positions, and angles, which soft joint limits do not bound)."""
+        """A float32 Box of the :meth:`state` values (the same object every time): unit
+        quaternions of free and ball joints in [-1, 1] (MuJoCo keeps them normalised),
+        expression ids in [0, 6], everything else unbounded (positions, velocities, and angles,
+        which soft joint limits do not bound)."""
         space = self.__dict__.get("_state_space")
         if space is None:
             m = self.world.model
@@ -356,7 +364,12 @@ class MimoParallelEnv(ParallelEnv):
                     low[start + 3:start + 7] = -1.0
                 elif kind == mujoco.mjtJoint.mjJNT_BALL:
                     low[start:start + 4] = -1.0
-            space = self._state_space = spaces.Box(low, -low, dtype=np.float32)
+            high = -low
+            if self._has_faces():
+                n = len(self.possible_agents)
+                low = np.concatenate([low, np.zeros(n, np.float32)])
+                high = np.concatenate([high, np.full(n, len(EXPRESSIONS) - 1, np.float32)])
+            space = self._state_space = spaces.Box(low, high, dtype=np.float32)
         return space
 
     # -- rendering -------------------------------------------------------------------------------
