@@ -13,10 +13,20 @@
       expression played is ``argmax(logits)`` (ties go to the lowest id, so "neutral" wins when
       all logits are equal, e.g. all clipped to the same bound).
 
+    Motor values beyond the Box are clipped to it in float64 (a finite 1e39 is 1, not inf);
+    an action that is not numbers (a string, a ragged list, a dict, None, bools), NaN/inf
+    expression logits or a face-only agent's expression that is not one integer raise a
+    ValueError naming the agent, the field, the value and what is allowed.
+
     Spaces are built once: ``observation_space(agent)`` / ``action_space(agent)`` return the same
     object every call. ``reset(seed=...)`` passes the seed to the wrapped env; ``render``,
     ``close``, ``state`` and ``state_space`` are the wrapped env's, other public attributes are
     looked up on it. The wrapper pickles (the wrapped env drops its renderer when pickled).
+
+``NumericInfos(env)``
+    Every agent's infos as the same fixed set of float numbers at reset and at every step (the
+    keys the env, its senses and its task declare in ``info_spec``): what TorchRL's
+    ``PettingZooWrapper`` needs to turn infos into tensors.
 
 ``FlatObservationWrapper`` / ``FlatActionWrapper`` / ``ExpressionActionWrapper``
     The same flat observations and actions for a Gymnasium env (one agent);

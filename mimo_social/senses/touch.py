@@ -8,7 +8,8 @@ Observation ``touch`` (flat float32)
     The skin points of every skinned body part, part after part in model body order (see
     :meth:`TouchSystem.layout`); per point the force the touching thing exerts on the skin there,
     3 floats (x, y, z) in the part's body frame (``frame="body"``, default) or the world frame
-    (``frame="world"``), or 1 float, the normal (pressing) force, with ``normal_only=True``.
+    (``frame="world"``), or 1 float, the normal (pressing) force, with ``normal_only=True``
+    (>= 0: the Box's lower bound; force vectors are unbounded).
     A pressing force points into the body, against the point's outward normal.
 
 How a contact is felt
