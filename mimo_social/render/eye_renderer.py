@@ -35,8 +35,11 @@ the model right after, so other renderers of the same model see the model's own 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import ctypes
 import os
+import sys
+import threading
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -45,45 +48,158 @@ import numpy as np
 
 from .gl import INSTALL_HINT, gl_backend, gl_context_class
 
-__all__ = ["shared_gl_context", "free_shared_gl_context", "TileRenderer", "Tile",
+__all__ = ["shared_gl_context", "gl_current", "free_shared_gl_context", "TileRenderer", "Tile",
            "tessellation_for", "coarse_planes", "free_render_context", "MAX_BUFFER_SIDE"]
 
 MAX_BUFFER_SIDE = 4096      # tiles are packed in batches no larger than this (pixels per side)
 _GL = None                  # the process's GL context
 _GL_PID = None              # the process that made it
 _ATEXIT = False
+_LOCK = threading.RLock()   # one thread at a time renders on the context
+_FORKED_FROM = None         # (parent pid, what it had made) in a child forked after GL was used
+_TLS = threading.local()    # .depth: gl_current blocks open on this thread
+_PENDING = []               # MjrContexts to free when the current render ends
+_LEFT_ON = None             # the thread shared_gl_context() left the context current on
+
+
+def _gl_state_in_use() -> str | None:
+    """What of OpenGL this process has set up (a context of ours, an EGL display), if any."""
+    if _GL is not None:
+        return f"an OpenGL context (MUJOCO_GL={gl_backend()!r})"
+    egl = sys.modules.get("mujoco.egl")
+    if egl is not None and getattr(egl, "EGL_DISPLAY", None) is not None:
+        return "an EGL display"
+    return None
+
+
+def _after_fork_in_child() -> None:
+    global _FORKED_FROM
+    used = _gl_state_in_use()
+    if used is not None and _FORKED_FROM is None:
+        _FORKED_FROM = (os.getppid(), used)
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_after_fork_in_child)
+
+
+def _refuse_after_fork() -> None:
+    if _FORKED_FROM is None:
+        return
+    parent, used = _FORKED_FROM
+    raise RuntimeError(
+        f"cannot render in process {os.getpid()}: it was forked from process {parent}, which "
+        f"had already made {used}; OpenGL (Mesa's EGL and OSMesa alike) does not survive "
+        "fork: a new context here hangs and the inherited one fails. Start worker processes "
+        "with the 'spawn' or 'forkserver' method (multiprocessing.set_start_method('spawn'), "
+        "or the start_method argument of the vector env), or make and step the vision envs "
+        "only inside the workers, forking before the parent renders anything")
+
+
+def _context():
+    """The process's GL context, made on first use (not left current); call under _LOCK."""
+    global _GL, _GL_PID, _ATEXIT
+    _refuse_after_fork()
+    if _GL is not None and _GL_PID == os.getpid():
+        return _GL
+    _GL = None
+    cls = gl_context_class()
+    try:
+        ctx = cls(16, 16)   # its own buffer is unused: an MjrContext renders to its FBO
+        with ctx.as_current():
+            pass
+    except Exception as e:  # noqa: BLE001 - re-raised with the fix attached
+        raise RuntimeError(f"could not create an OpenGL context with MUJOCO_GL="
+                           f"{gl_backend()!r} ({type(e).__name__}: {e}); {INSTALL_HINT}") from e
+    _GL, _GL_PID = ctx, os.getpid()
+    if not _ATEXIT:  # free before interpreter teardown (avoids noisy errors from PyOpenGL)
+        atexit.register(free_shared_gl_context)
+        _ATEXIT = True
+    return _GL
+
+
+@contextlib.contextmanager
+def gl_current():
+    """Hold the process's GL context, current on the calling thread, for the ``with`` block.
+
+    The renderers draw only inside this block: one thread at a time (a process-wide lock), and
+    at the end the context is released again (or the context that was current before is made
+    current again), so any thread may render next: an env made and reset on one thread can be
+    stepped on another. Costs ~10 us a block (EGL, llvmpipe). Raises a RuntimeError naming the
+    cause in a process forked from one that had used OpenGL (where rendering would hang)."""
+    global _LEFT_ON
+    with _LOCK:
+        ctx = _context()
+        me = threading.get_ident()
+        with contextlib.ExitStack() as stack:
+            try:
+                stack.enter_context(ctx.as_current())
+            except Exception as e:  # noqa: BLE001 - re-raised with the cause and the fix
+                where = (f"thread {_thread_name(_LEFT_ON)!r}, where shared_gl_context() left it"
+                         if _LEFT_ON not in (None, me) else "another thread")
+                raise RuntimeError(
+                    f"could not make the OpenGL context current on thread "
+                    f"{threading.current_thread().name!r} ({type(e).__name__}): it is still "
+                    f"current on {where}; render through gl_current(), which releases it "
+                    "after each block") from e
+            _TLS.depth = getattr(_TLS, "depth", 0) + 1
+            try:
+                yield ctx
+            finally:
+                _TLS.depth -= 1
+                while _TLS.depth == 0 and _PENDING:   # freed while this thread was rendering
+                    _free_now(_PENDING.pop())
+                if _TLS.depth == 0 and _LEFT_ON == me:  # left current by shared_gl_context()
+                    _release(ctx)
+                    _LEFT_ON = None
+
+
+def _thread_name(ident) -> str:
+    return next((t.name for t in threading.enumerate() if t.ident == ident), str(ident))
+
+
+def _release(ctx) -> None:
+    """Make no context current on this thread (ctx's backend: EGL, OSMesa or GLFW)."""
+    mod = sys.modules.get(type(ctx).__module__)
+    if hasattr(mod, "EGL_DISPLAY"):
+        egl = mod.EGL
+        egl.eglMakeCurrent(mod.EGL_DISPLAY, egl.EGL_NO_SURFACE, egl.EGL_NO_SURFACE,
+                           egl.EGL_NO_CONTEXT)
+    elif hasattr(mod, "osmesa"):
+        mod.osmesa.OSMesaMakeCurrent(None, None, mod.GL.GL_FLOAT, 0, 0)
+        if hasattr(mod, "_current_context"):
+            mod._current_context.ref = None
+    elif hasattr(mod, "glfw"):
+        mod.glfw.make_context_current(None)
 
 
 def shared_gl_context():
-    """The process's GL context (made on first use, made current on every call)."""
-    global _GL, _GL_PID, _ATEXIT
-    if _GL is None or _GL_PID != os.getpid():
-        # a context inherited through fork is unusable: drop it without freeing it
-        _GL = None
-        cls = gl_context_class()
+    """The process's GL context, made current on the calling thread and LEFT current there
+    (for code that calls OpenGL itself, on one thread) until the next render on this thread.
+    The renderers use :func:`gl_current`, which releases it after each render so that other
+    threads can render too."""
+    global _LEFT_ON
+    with _LOCK:
+        ctx = _context()
         try:
-            ctx = cls(16, 16)   # its own buffer is unused: an MjrContext renders to its FBO
             ctx.make_current()
-        except Exception as e:  # noqa: BLE001 - re-raised with the fix attached
-            raise RuntimeError(f"could not create an OpenGL context with MUJOCO_GL="
-                               f"{gl_backend()!r} ({type(e).__name__}: {e}); {INSTALL_HINT}") from e
-        _GL, _GL_PID = ctx, os.getpid()
-        if not _ATEXIT:  # free before interpreter teardown (avoids noisy errors from PyOpenGL)
-            atexit.register(free_shared_gl_context)
-            _ATEXIT = True
-        return _GL
-    _GL.make_current()
-    return _GL
+        except Exception as e:  # noqa: BLE001 - re-raised with the cause
+            raise RuntimeError(f"could not make the OpenGL context current on thread "
+                               f"{threading.current_thread().name!r} ({type(e).__name__}); is "
+                               "it current on another thread?") from e
+        _LEFT_ON = threading.get_ident()
+        return ctx
 
 
 def free_shared_gl_context() -> None:
     global _GL, _GL_PID
-    if _GL is not None and _GL_PID == os.getpid():
-        try:
-            _GL.free()
-        except Exception:  # noqa: BLE001 - best effort at exit
-            pass
-    _GL, _GL_PID = None, None
+    with _LOCK:
+        if _GL is not None and _GL_PID == os.getpid():
+            try:
+                _GL.free()
+            except Exception:  # noqa: BLE001 - best effort at exit
+                pass
+        _GL, _GL_PID = None, None
 
 
 def _gl_functions():
@@ -134,12 +250,23 @@ def coarse_planes(model):
 
 def free_render_context(con) -> None:
     """Free an MjrContext made on this process's shared GL context (no-op after a fork)."""
-    if con is not None and _GL is not None and _GL_PID == os.getpid():
-        try:
-            _GL.make_current()
-            con.free()
-        except Exception:  # noqa: BLE001 - freeing at shutdown must not raise
-            pass
+    if con is None or _GL is None or _GL_PID != os.getpid() or _FORKED_FROM is not None:
+        return
+    if getattr(_TLS, "depth", 0):   # called (e.g. by the garbage collector) amid a render
+        _PENDING.append(con)
+        return
+    try:
+        with gl_current():
+            _free_now(con)
+    except Exception:  # noqa: BLE001 - freeing at shutdown must not raise
+        pass
+
+
+def _free_now(con) -> None:
+    try:
+        con.free()
+    except Exception:  # noqa: BLE001 - freeing must not raise
+        pass
 
 
 @dataclass
@@ -209,7 +336,6 @@ class TileRenderer:
 
     # -- lazily made GL objects ----------------------------------------------------------------
     def _make(self, model):
-        shared_gl_context()
         vis = model.vis
         saved = (vis.global_.offwidth, vis.global_.offheight, vis.quality.offsamples,
                  vis.quality.numslices, vis.quality.numstacks, vis.quality.numquads,
@@ -260,8 +386,11 @@ class TileRenderer:
         self._depth_b = np.float32(near / (far - near))
 
     def close(self):
-        free_render_context(self._con)
+        free_render_context(getattr(self, "_con", None))
         self._con = self._scn = None
+
+    def __del__(self):   # the GL objects live in a context current only while rendering:
+        self.close()     # MjrContext's own destructor, run with none current, would leak them
 
     def __getstate__(self):
         state = self.__dict__.copy()
@@ -276,17 +405,16 @@ class TileRenderer:
         """Render ``jobs`` = [(tile index, camera id), ...] now; return {tile index: (rgb,
         depth or None)} as new arrays (rgb uint8 (h, w, 3); depth float32 (h, w) in metres
         along the camera's view axis)."""
-        if self._con is None:
-            self._make(model)
-        else:
-            shared_gl_context()
-        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._con)
-        out = {}
-        by_batch: dict[int, list] = {}
-        for t, cam in jobs:
-            by_batch.setdefault(self.tiles[t].batch, []).append((t, cam))
-        for batch_jobs in by_batch.values():
-            self._render_batch(model, data, batch_jobs, out)
+        with gl_current():     # any thread; the context is released again at the end
+            if self._con is None:
+                self._make(model)
+            mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._con)
+            out = {}
+            by_batch: dict[int, list] = {}
+            for t, cam in jobs:
+                by_batch.setdefault(self.tiles[t].batch, []).append((t, cam))
+            for batch_jobs in by_batch.values():
+                self._render_batch(model, data, batch_jobs, out)
         return out
 
     def _update_scene(self, model, data, cam_ids: Sequence[int], aspect: float) -> None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from .eye_renderer import coarse_planes, free_render_context, shared_gl_context
+from .eye_renderer import coarse_planes, free_render_context, gl_current
 from .gl import ensure_gl_backend
 
 __all__ = ["SceneRenderer", "make_scene_renderer", "make_renderer"]
@@ -43,7 +43,6 @@ class SceneRenderer:
         return self._scene
 
     def _make(self):
-        shared_gl_context()
         model = self._model
         vis = model.vis.global_
         saved = (vis.offwidth, vis.offheight)
@@ -77,14 +76,13 @@ class SceneRenderer:
                                mujoco.mjtCatBit.mjCAT_ALL, self._scene)
 
     def render(self, *, out: np.ndarray | None = None) -> np.ndarray:
-        if self._con is None:
-            self._make()
-        else:
-            shared_gl_context()
-        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._con)
-        mujoco.mjr_render(self._rect, self._scene, self._con)
         buf = np.empty((self._height, self._width, 3), np.uint8)
-        mujoco.mjr_readPixels(buf, None, self._rect, self._con)
+        with gl_current():     # any thread; the context is released again at the end
+            if self._con is None:
+                self._make()
+            mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._con)
+            mujoco.mjr_render(self._rect, self._scene, self._con)
+            mujoco.mjr_readPixels(buf, None, self._rect, self._con)
         img = np.flipud(buf)
         if out is not None:
             np.copyto(out, img)
@@ -92,8 +90,11 @@ class SceneRenderer:
         return np.ascontiguousarray(img)
 
     def close(self):
-        free_render_context(self._con)
+        free_render_context(getattr(self, "_con", None))
         self._con = None
+
+    def __del__(self):   # free the GL objects on the shared context (not current after a render)
+        self.close()
 
     def __getstate__(self):
         raise TypeError("a SceneRenderer holds GL objects and does not pickle; make a new one")
@@ -109,5 +110,6 @@ def make_renderer(model, height: int, width: int) -> SceneRenderer:
     ``close()`` on the process's shared GL context (the model's own visual quality); errors
     explain what to install."""
     ensure_gl_backend()
-    shared_gl_context()  # fail here, with the install hint, if no context can be made
+    with gl_current():  # fail here, with the install hint, if no context can be made
+        pass
     return make_scene_renderer(model, height, width)
