@@ -235,56 +235,99 @@ class MimoParallelEnv(ParallelEnv):
         if missing:
             raise ValueError(f"no action for live agent(s) {missing}; every live agent of "
                              f"{self.agents} needs one")
-        w = self.world
+        # every live agent's action is read and checked before any is applied: a bad action
+        # leaves the env as it was (no agent's controls or face changed)
+        checked = []
         for a in self.agents:
             i = self._index[a]
             act = self.actuation[i]
             action = actions[a]
+            expression = None
             if self.agent_configs[i].expressions:
                 if not isinstance(action, Mapping) or set(action) != {"motors", "expression"}:
                     raise ValueError(f"{a}: action must be a dict with keys 'motors' and "
-                                     f"'expression' (expressions are on), got {action!r:.200}")
-                motors, expression = action["motors"], action["expression"]
-                e = np.asarray(expression)
-                if e.shape not in ((), (1,)) or e.dtype.kind not in "iu" \
-                        or not 0 <= int(e.reshape(())) < len(EXPRESSIONS):
+                                     f"'expression' (expressions are on), got "
+                                     f"{self._shown(action)}")
+                motors, given = action["motors"], action["expression"]
+                try:        # an integer id, also as a numpy or tensor scalar or 1-element array
+                    e = np.asarray(given)
+                    ok = e.shape in ((), (1,)) and e.dtype.kind in "iu" \
+                        and 0 <= int(e.reshape(())) < len(EXPRESSIONS)
+                except Exception:  # noqa: BLE001  (ragged lists, tensors that need grad ...)
+                    ok = False
+                if not ok:
                     raise ValueError(
-                        f"{a}: expression={expression!r} not allowed; an integer 0..{len(EXPRESSIONS) - 1}: "
+                        f"{a}: expression={self._shown(given)} not allowed; allowed: an integer "
+                        f"0..{len(EXPRESSIONS) - 1}: "
                         + ", ".join(f"{k}={n}" for k, n in enumerate(EXPRESSIONS)))
-                self._expression[i] = int(e.reshape(()))
-                w.set_expression(i, self._expression[i])
+                expression = int(e.reshape(()))
             else:
                 motors = action
-            u = self._motor_values(a, act, motors)
+            checked.append((i, act, expression, self._motor_values(a, act, motors)))
+        w = self.world
+        for i, act, expression, u in checked:
+            if expression is not None:
+                self._expression[i] = expression
+                w.set_expression(i, expression)
             # the env's own buffer: the caller's array is never written to nor kept
             c = self.controls[i]
             np.clip(u, act.control_low, act.control_high, out=c)
             act.apply(w.model, w.data, c)
 
     @staticmethod
+    def _shown(value, limit: int = 120) -> str:
+        """``repr(value)`` for an error message: shortened, and never an error itself."""
+        try:
+            text = repr(value)
+        except Exception:  # noqa: BLE001
+            text = f"<{type(value).__name__} without a repr>"
+        return text if len(text) <= limit else text[:limit - 5] + " ..."
+
+    @staticmethod
     def _motor_values(agent: str, act, motors) -> np.ndarray:
         """The motor commands as a float array of the right shape, finite; else a ValueError
-        naming the agent, the field, the value and what is allowed."""
+        naming the agent, the field, the value and what is allowed.
+
+        Accepted: anything numpy reads as an array of shape ``(n_controls,)`` of integers or
+        floats of any width (Python numbers too, ints beyond 64 bits included) whose values are
+        finite in float64. Refused: bools, complex numbers, strings, bytes, dates, masked
+        entries, tensors that need a gradient, NaN/inf and values beyond float64."""
         lo = f"{act.control_low.min():g}" if act.n_controls else "-1"
         hi = f"{act.control_high.max():g}" if act.n_controls else "1"
         allowed = (f"allowed: {act.n_controls} finite numbers in [{lo}, {hi}] (motors "
                    f"{list(act.control_names)[:4]}{' ...' if act.n_controls > 4 else ''})")
+        field = f"{agent}: action field 'motors'"
+        shown = MimoParallelEnv._shown
+        if isinstance(motors, np.ma.MaskedArray) and np.ma.is_masked(motors):
+            raise ValueError(f"{field} = {shown(motors)} has masked entries; {allowed}")
         try:
             raw = np.asarray(motors)
-        except (TypeError, ValueError) as e:       # ragged nested lists and the like
-            raise ValueError(f"{agent}: action field 'motors' = {motors!r:.120} is not an array "
-                             f"of numbers ({e}); {allowed}") from None
+        except Exception as e:  # noqa: BLE001  (ragged lists, tensors that need grad ...)
+            raise ValueError(f"{field} = {shown(motors)} is not an array of numbers "
+                             f"({type(e).__name__}: {e}); {allowed}") from None
+        if raw.dtype.kind == "O" and all(
+                isinstance(v, (int, float, np.integer, np.floating))
+                and not isinstance(v, (bool, np.bool_)) for v in raw.flat):
+            # Python ints beyond 64 bits (and the like) are numbers all the same
+            values = []
+            for v in raw.flat:
+                try:
+                    values.append(float(v))
+                except OverflowError:               # beyond float64: not finite
+                    values.append(float("inf"))
+            raw = np.array(values, dtype=np.float64).reshape(raw.shape)
         if raw.dtype.kind not in "iuf":
-            raise ValueError(f"{agent}: action field 'motors' = {motors!r:.120} has "
-                             f"{raw.dtype} values, not numbers; {allowed}")
+            raise ValueError(f"{field} = {shown(motors)} has {raw.dtype} values, not numbers; "
+                             f"{allowed}")
         if raw.shape != (act.n_controls,):
-            raise ValueError(f"{agent}: motor action has shape {raw.shape}; expected "
-                             f"({act.n_controls},) for motors {act.control_names}")
-        u = raw.astype(np.float64, copy=False)
+            raise ValueError(f"{field} has shape {raw.shape}; expected ({act.n_controls},) "
+                             f"for motors {act.control_names}")
+        with np.errstate(over="ignore", invalid="ignore"):   # longdouble beyond float64: inf
+            u = raw.astype(np.float64, copy=False)
         if not np.isfinite(u).all():
             bad = [act.control_names[k] for k in np.flatnonzero(~np.isfinite(u))]
-            raise ValueError(f"{agent}: motor action has NaN/inf for {bad}; values must be "
-                             f"finite, in [{lo}, {hi}]")
+            raise ValueError(f"{field} has NaN/inf (or values beyond float64) for {bad}; "
+                             f"values must be finite, in [{lo}, {hi}]")
         return u
 
     def _observe(self, i: int) -> dict:
