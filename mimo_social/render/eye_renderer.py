@@ -4,10 +4,11 @@ Software OpenGL (Mesa llvmpipe through EGL or OSMesa) spends almost all of its t
 work on the calling thread, plus a fixed cost per ``mjr_render`` and per read-back (each
 read-back waits for the rasterizer threads). So:
 
-* one GL context per process (:func:`shared_gl_context`), created lazily in the process that
-  renders and never pickled; a process forked after it was made gets a fresh one (but forking a
-  process that has rendered is unsafe with Mesa: use the ``spawn`` / ``forkserver`` start
-  methods for worker processes);
+* one GL context per process, created lazily in the process that renders and never pickled;
+  current only inside :func:`gl_current` (a process-wide lock; released after each render, ~10
+  us), so any thread may render; a process forked after OpenGL was used refuses to render
+  with a RuntimeError (Mesa would hang there): use the ``spawn`` / ``forkserver`` start methods
+  for worker processes;
 * one :class:`TileRenderer` (one ``MjrContext``, one offscreen buffer) for all the cameras of
   a world: every image is a tile (a viewport) of that buffer, rendered one after the other and
   read back with ONE ``glReadPixels`` per step; an agent's two eyes sit side by side and are

@@ -11,8 +11,10 @@ was as fast as any other thread count, and ``softpipe`` is ~50x slower.
 
 Every renderer of the package shares ONE GL context per process (made on first use, in the
 process that renders): the eyes (:mod:`mimo_social.render.eye_renderer`) and ``env.render()``
-(:mod:`mimo_social.render.scene`). A GL context does not survive ``fork``, so subprocess vector
-envs must use the ``spawn`` or ``forkserver`` start method. When ``mujoco`` was imported before
+(:mod:`mimo_social.render.scene`). It is current only while a renderer draws, so any thread
+may render. OpenGL does not survive ``fork`` (Mesa hangs in the child): a process forked after
+its parent used OpenGL raises a RuntimeError when it tries to render, so subprocess vector envs
+must use the ``spawn`` or ``forkserver`` start method (or fork before anything renders). When ``mujoco`` was imported before
 ``mimo_social`` (so it chose GLFW, useless without a display), :func:`gl_context_class` loads
 EGL's or OSMesa's context class when the first context is made.
 """
