@@ -3,8 +3,9 @@
 Each infant is built by :func:`mimo_social.body.builder.build_infant` with unprefixed names and
 attached with ``MjSpec.attach`` under the prefix ``infant_<i>/``. After compiling, every name an
 agent needs is resolved to integer ids and address arrays (:class:`AgentIndex`); no string
-lookups or MuJoCo accessor views are kept, so a world pickles (it rebuilds its model from its
-recipe when unpickled).
+lookups or MuJoCo accessor views are kept, so a world pickles: its MjData travels whole, with its
+model (every model field a task wrote, every quantity of the last step), and the index tables
+are rebuilt from the recipe; a copy continues exactly as the original.
 
 Agents may differ in body: hands, actuation, senses, and size and strength (``scale``,
 ``strength`` of :class:`~mimo_social.core.config.AgentConfig`). Each infant is built from its

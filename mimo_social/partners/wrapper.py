@@ -66,8 +66,11 @@ class ScriptedPartners(ParallelWrapper):
     def reset(self, seed: int | None = None, options: dict | None = None):
         seed = check_seed(seed, "reset")
         obs, infos = self.env.reset(seed=seed, options=options)
-        base = np.random.SeedSequence(seed) if seed is not None else np.random.SeedSequence()
-        rngs = [np.random.default_rng(s) for s in base.spawn(len(self.partners))]
+        # the partners' generators come from the last seeded reset's sequence: an unseeded reset
+        # continues it (reproducible, and a pickled copy continues exactly as the original)
+        if seed is not None or self.__dict__.get("_seeds") is None:
+            self._seeds = np.random.SeedSequence(seed)
+        rngs = [np.random.default_rng(s) for s in self._seeds.spawn(len(self.partners))]
         inner = self.env.unwrapped
         for (name, partner), rng in zip(self.partners.items(), rngs):
             partner.reset(inner, name, rng)
