@@ -9,11 +9,10 @@ prints a markdown table (policy | episodes | success | return | length | steps t
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 from ..train.baselines import baselines, markdown_table, write_json
 from ..train.tasks import ALL_TASKS, TrainInputError
-from .train import _json_arg
+from ._args import env_kwargs, output_file, positive_int, seed, write_file
 
 __all__ = ["add_parser"]
 
@@ -28,7 +27,7 @@ def _main(args) -> int:
     table = markdown_table(res)
     print(table, end="")
     if args.markdown:
-        Path(args.markdown).write_text(table)
+        write_file(args.markdown, table)
         print(f"wrote {args.markdown}")
     if args.json:
         write_json(res, args.json)
@@ -44,18 +43,20 @@ def add_parser(subparsers) -> None:
         "steps to success as a markdown table.")
     p.add_argument("task", choices=ALL_TASKS, help="a task of the catalogue (social tasks: the "
                    "learner, its partner scripted)")
-    p.add_argument("--episodes", type=int, default=30, help="episodes per policy")
-    p.add_argument("--seed", type=int, default=0, help="seed of the first episode (episodes are "
+    p.add_argument("--episodes", type=positive_int, default=30, help="episodes per policy")
+    p.add_argument("--seed", type=seed, default=0, help="seed of the first episode (episodes are "
                    "seeded seed .. seed+episodes-1)")
     p.add_argument("--run", nargs="+", action="extend", default=[], metavar="DIR",
                    help="directories written by 'mimo-social train' (their final model)")
-    p.add_argument("--model", default="final", help="final (model.zip) or best "
+    p.add_argument("--model", default="final", choices=("final", "best"),
+                   help="final (model.zip) or best "
                    "(best_model.zip) of each run")
-    p.add_argument("--env-kwargs", type=_json_arg, default=None,
+    p.add_argument("--env-kwargs", type=env_kwargs, default=None,
                    help="JSON keyword arguments for the env of every policy (default: those the "
                    "runs were trained with)")
-    p.add_argument("--markdown", default=None, metavar="FILE", help="also write the table here")
-    p.add_argument("--json", default=None, metavar="FILE",
+    p.add_argument("--markdown", default=None, metavar="FILE", type=output_file,
+                   help="also write the table here")
+    p.add_argument("--json", default=None, metavar="FILE", type=output_file,
                    help="write every number (and each episode's) as JSON")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=_main)

@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 from .. import bench
+from ._args import input_file, output_file, positive_float, seed, write_file
 
 __all__ = ["add_parser", "run"]
 
@@ -24,25 +25,26 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                     "configuration, split by component. Default set: "
                     + ", ".join(bench.DEFAULT_CONFIGS) + "; also: "
                     + ", ".join(n for n in bench.CONFIGS if n not in bench.DEFAULT_CONFIGS) + ".")
-    parser.add_argument("--json", default="bench.json", metavar="FILE",
+    parser.add_argument("--json", default="bench.json", metavar="FILE", type=output_file,
                         help="where to write the results (default: bench.json)")
-    parser.add_argument("--sim-seconds", type=float, default=bench.DEFAULT_SIM_SECONDS, metavar="S",
+    parser.add_argument("--sim-seconds", type=positive_float, default=bench.DEFAULT_SIM_SECONDS,
+                        metavar="S",
                         help=f"simulated seconds per configuration (default: "
                              f"{bench.DEFAULT_SIM_SECONDS:g}, one episode of the grid)")
     parser.add_argument("--only", default=None, metavar="NAME,...",
                         help="comma-separated configurations to run (default: the default set; "
                              "'all': every configuration)")
-    parser.add_argument("--markdown", default=None, metavar="FILE",
+    parser.add_argument("--markdown", default=None, metavar="FILE", type=output_file,
                         help="write a Markdown report there (default: none)")
     parser.add_argument("--update-benchmarks-md", action="store_true",
                         help="write BENCHMARKS.md (and docs/benchmarks.png unless --plot is given)")
-    parser.add_argument("--plot", default=None, metavar="FILE.png",
+    parser.add_argument("--plot", default=None, metavar="FILE.png", type=output_file,
                         help="write stacked bar charts of the components there (and a second "
                              "one, tasks and scaling, beside it as <stem>_tasks_scaling.png)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the random actions")
+    parser.add_argument("--seed", type=seed, default=0, help="seed of the random actions")
     parser.add_argument("--no-recording", action="store_true",
                         help="do not record the runs (the recording component is then 0)")
-    parser.add_argument("--from-json", default=None, metavar="FILE",
+    parser.add_argument("--from-json", default=None, metavar="FILE", type=input_file,
                         help="measure nothing: re-render --markdown/--plot from an earlier --json "
                              "output (its recorded command is kept)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -87,14 +89,13 @@ def run(args) -> int:
                                 measure_cold_start=not args.no_cold_start,
                                 record=not getattr(args, "no_recording", False))
         report["settings"]["command"] = _command(args, markdown, plot)
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
+        write_file(args.json, json.dumps(report, indent=2) + "\n")
     plots = bench.plot_report(report, plot) if plot else []
     if markdown:
         md = Path(markdown)
         rel = [os.path.relpath(Path(p).resolve(), md.resolve().parent) for p in plots]
-        md.parent.mkdir(parents=True, exist_ok=True)
-        md.write_text(bench.markdown_report(report, report["settings"].get("command"), rel) + "\n")
+        write_file(md, bench.markdown_report(report, report["settings"].get("command"), rel)
+                   + "\n")
     print(bench.markdown_table(report))
     for s in report.get("skipped") or []:
         print(f"skipped: {s['name']}: {s['reason']}")

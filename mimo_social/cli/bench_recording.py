@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 
 from ..bench import recording_cost
+from ._args import comma_choices, output_dir, positive_float
 
 __all__ = ["add_parser", "run"]
 
@@ -17,10 +18,14 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Cost (share of the env step time) and size (MB per simulated minute) of "
                     "recording with the Recorder, for 2 infants without images, with touch and "
                     "with 2 x 64x64 eyes each.")
-    parser.add_argument("--sim-seconds", type=float, default=60.0)
-    parser.add_argument("--only", default=None,
-                        help="comma-separated indices of the configurations to run (0, 1, 2)")
-    parser.add_argument("--folder", default=None, help="where to keep the .rrd files")
+    parser.add_argument("--sim-seconds", type=positive_float, default=60.0,
+                        help="simulated seconds per configuration (default: 60)")
+    indices = [str(i) for i in range(len(recording_cost.BENCH_CONFIGS))]
+    parser.add_argument("--only", default=None, type=comma_choices(indices, "index"),
+                        help="comma-separated indices of the configurations to run "
+                             f"({', '.join(indices)})")
+    parser.add_argument("--folder", default=None, type=output_dir,
+                        help="where to keep the .rrd files")
     parser.set_defaults(func=run)
     return parser
 
@@ -28,11 +33,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     configs = dict(recording_cost.BENCH_CONFIGS)
     if args.only:
-        try:
-            keep = {int(x) for x in args.only.split(",")}
-        except ValueError:
-            raise SystemExit(f"mimo-social bench-recording: --only {args.only!r}: "
-                             "comma-separated integers, e.g. 0,2") from None
+        keep = {int(x) for x in args.only}
         configs = {k: v for i, (k, v) in enumerate(configs.items()) if i in keep}
     results = recording_cost.bench_recording(configs, args.sim_seconds, folder=args.folder)
     print(recording_cost.format_table(results))

@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 from ..bench import vision_cost
+from ._args import comma_choices, output_file, positive_float, positive_int, write_file
+
+BACKENDS = ["egl", "osmesa", "glfw"]
 
 __all__ = ["add_parser", "run"]
 
@@ -21,10 +23,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "bench-vision", help="vision benchmark: ms per eye image by variant, env steps",
         description="Vision benchmark: ms per eye image by variant, and real s per simulated s "
                     "of whole env steps; each backend in its own process.")
-    parser.add_argument("--backends", default="egl,osmesa", help="MUJOCO_GL values to compare")
-    parser.add_argument("--rounds", type=int, default=5)
-    parser.add_argument("--sim-seconds", type=float, default=5.0)
-    parser.add_argument("--json", default=None, help="write all results here")
+    parser.add_argument("--backends", default="egl,osmesa",
+                        type=comma_choices(BACKENDS, "backend", as_text=True),
+                        help="MUJOCO_GL values to compare, comma-separated (default: egl,osmesa)")
+    parser.add_argument("--rounds", type=positive_int, default=5)
+    parser.add_argument("--sim-seconds", type=positive_float, default=5.0)
+    parser.add_argument("--json", default=None, type=output_file, help="write all results here")
     parser.add_argument("--worker", action="store_true",
                         help="measure in this process only and print one JSON line")
     parser.set_defaults(func=run)
@@ -44,5 +48,5 @@ def run(args: argparse.Namespace) -> int:
             print(e)
     print(vision_cost.format_results(results))
     if args.json:
-        Path(args.json).write_text(json.dumps(results, indent=1))
+        write_file(args.json, json.dumps(results, indent=1))
     return 0

@@ -9,6 +9,7 @@ import sys
 import numpy as np
 
 from ..experiments import calibration as cal
+from ._args import int_range, non_negative_int, positive_float, positive_int, seed
 
 __all__ = ["add_parser", "run"]
 
@@ -22,11 +23,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                                       "achieved vs Table I torques")
     f.add_argument("--hands", choices=cal.HAND_CHOICES, default="both",
                    help="body version(s) to calibrate (default: both)")
-    f.add_argument("--iterations", type=int, default=cal.ITERATIONS,
+    f.add_argument("--iterations", type=non_negative_int, default=cal.ITERATIONS,
                    help=f"fmax updates (default: {cal.ITERATIONS}); 0 only checks the shipped "
                         "values")
-    f.add_argument("--steps", type=int, default=cal.PHASE_STEPS,
-                   help=f"physics steps per phase (default: {cal.PHASE_STEPS})")
+    f.add_argument("--steps", type=int_range(4), default=cal.PHASE_STEPS,
+                   help=f"physics steps per phase, at least 4 (default: {cal.PHASE_STEPS})")
     f.add_argument("--write", action="store_true",
                    help="store the calibrated fmax in mimo_social/body/data/<hands>_muscles.csv")
     f.set_defaults(func=run)
@@ -34,10 +35,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                                       "muscles, peak speeds")
     v.add_argument("--hands", choices=cal.HAND_CHOICES, default="mitten",
                    help="body version(s) (default: mitten)")
-    v.add_argument("--episodes", type=int, default=30, help="episodes (default: 30)")
-    v.add_argument("--seconds", type=float, default=30.0,
+    v.add_argument("--episodes", type=positive_int, default=30, help="episodes (default: 30)")
+    v.add_argument("--seconds", type=positive_float, default=30.0,
                    help="simulated seconds per episode (default: 30)")
-    v.add_argument("--seed", type=int, default=0, help="random seed (default: 0)")
+    v.add_argument("--seed", type=seed, default=0, help="random seed (default: 0)")
     v.add_argument("--no-scale", action="store_true",
                    help="keep the raw values (no common factor matching the knee reference)")
     v.add_argument("--write", action="store_true",
@@ -47,7 +48,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                                         "physics-only speed of one infant")
     sp.add_argument("--hands", choices=cal.HAND_CHOICES, default="both",
                     help="body version(s) (default: both)")
-    sp.add_argument("--seconds", type=float, default=20.0,
+    sp.add_argument("--seconds", type=positive_float, default=20.0,
                     help="simulated seconds per measurement (default: 20)")
     sp.set_defaults(func=run)
     return parser
@@ -56,9 +57,6 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     out = sys.stdout
     if args.parameter == "fmax":
-        if args.iterations < 0 or args.steps < 4:
-            raise SystemExit("mimo-social calibrate fmax: --iterations must be >= 0 and "
-                             "--steps >= 4")
         worst = 0.0
         for hands in cal.hand_versions(args.hands):
             res = cal.calibrate_fmax(hands, args.iterations, args.steps)
@@ -74,8 +72,6 @@ def run(args: argparse.Namespace) -> int:
                 print(f"wrote {cal.write_parameters(hands, updates)}", file=out)
         return 0 if worst <= 0.05 else 1
     if args.parameter == "speed":
-        if not args.seconds > 0:
-            raise SystemExit("mimo-social calibrate speed: --seconds must be positive")
         print(f"{'body':14s} {'physics only':>22s} {'physics + muscles':>22s} "
               f"{'muscle model':>28s}", file=out)
         for hands in cal.hand_versions(args.hands):
@@ -86,8 +82,6 @@ def run(args: argparse.Namespace) -> int:
                   file=out)
         return 0
     # vmax
-    if args.episodes < 1 or not args.seconds > 0:
-        raise SystemExit("mimo-social calibrate vmax: --episodes must be >= 1 and --seconds > 0")
     for hands in cal.hand_versions(args.hands):
         res = cal.calibrate_vmax(hands, args.episodes, args.seconds, seed=args.seed,
                                  scale_to_reference=not args.no_scale)

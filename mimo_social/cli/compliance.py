@@ -8,6 +8,7 @@ import argparse
 import numpy as np
 
 from ..experiments import compliance
+from ._args import draw_to, float_above, output_file
 
 __all__ = ["add_parser", "run"]
 
@@ -16,22 +17,20 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "compliance", help="drop a ball on the outstretched arm; plot shoulder angle and torque",
         description=compliance.__doc__.split("\n\n")[1])
-    parser.add_argument("--out", default="compliance.png",
+    parser.add_argument("--out", default="compliance.png", type=output_file,
                         help="the plot (default: compliance.png)")
     parser.add_argument("--hands", choices=("mitten", "five_fingers"), default="mitten",
                         help="body version (default: mitten)")
-    parser.add_argument("--seconds", type=float, default=compliance.SECONDS,
-                        help=f"simulated seconds (default: {compliance.SECONDS})")
+    parser.add_argument("--seconds", type=float_above(0.3), default=compliance.SECONDS,
+                        help=f"simulated seconds, more than 0.3 (default: {compliance.SECONDS})")
     parser.set_defaults(func=run)
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
-    if not args.seconds > 0.3:
-        raise SystemExit(f"mimo-social compliance: --seconds {args.seconds}: must exceed 0.3")
     trials = compliance.run_compliance(hands=args.hands, seconds=args.seconds)
     for tr in trials:
         print(f"{tr.label:34s} controls {np.round(tr.controls, 3)}  impact {tr.impact_time:.3f} s  "
               f"deflection {tr.deflection_deg:.2f} deg")
-    print(f"wrote {compliance.plot_compliance(trials, args.out)}")
+    print(f"wrote {draw_to(args.out, lambda path: compliance.plot_compliance(trials, path))}")
     return 0

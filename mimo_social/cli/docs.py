@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from ..envs import task_docs
+from ._args import output_file, write_file
 
 __all__ = ["add_parser", "run"]
 
@@ -21,7 +22,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "docs", help="write docs/tasks.md from the task modules' docstring tables",
         description="Render docs/tasks.md from the catalogue and the docstring table of each "
                     "task module (mimo_social/tasks/*.py), the one source of the task docs.")
-    parser.add_argument("--out", default="docs/tasks.md", metavar="FILE",
+    parser.add_argument("--out", default="docs/tasks.md", metavar="FILE", type=output_file,
                         help="the file to write or check (default: docs/tasks.md)")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 when FILE differs from the generated text")
@@ -46,7 +47,6 @@ def run(args) -> int:
             return 1
         print(f"{out} is up to date")
         return 0
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text)
+    write_file(out, text)
     print(f"wrote {out} ({len(text.splitlines())} lines, {len(task_docs.task_docs())} tasks)")
     return 1 if incomplete else 0

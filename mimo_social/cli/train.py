@@ -21,8 +21,6 @@
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import sys
 from pathlib import Path
@@ -30,18 +28,13 @@ from pathlib import Path
 from ..train import (ALGOS, ALL_TASKS, MULTI_TASKS, TASKS, TrainInputError, VideoUnavailable,
                      compare, evaluate, train)
 from ..train.comparison import parse_steps_per_algo
+from ._args import (env_kwargs, input_dir, json_object, non_negative_int, output_dir, output_file,
+                    positive_int, seed)
 
 __all__ = ["add_parser"]
 
 
-def _json_arg(text: str) -> dict:
-    try:
-        value = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise argparse.ArgumentTypeError(f"not JSON: {e}") from None
-    if not isinstance(value, dict):
-        raise argparse.ArgumentTypeError("expected a JSON object, e.g. '{\"max_steps\": 200}'")
-    return value
+_json_arg = json_object   # (kept for callers of the old name)
 
 
 def _common(p, steps_required: bool = True):
@@ -51,16 +44,17 @@ def _common(p, steps_required: bool = True):
                    help="multi-agent tasks: shared (one policy for all agents, the default), "
                    "independent (one policy per agent) or scripted (one learner, the partner "
                    "scripted)")
-    p.add_argument("--steps", type=int, required=steps_required,
+    p.add_argument("--steps", type=positive_int, required=steps_required,
                    help="environment steps to train for")
-    p.add_argument("--eval-every", type=int, default=None,
+    p.add_argument("--eval-every", type=positive_int, default=None,
                    help="steps between evaluations (default: steps / 20)")
-    p.add_argument("--eval-episodes", type=int, default=5, help="episodes per evaluation")
-    p.add_argument("--checkpoint-every", type=int, default=None,
+    p.add_argument("--eval-episodes", type=positive_int, default=5,
+                   help="episodes per evaluation")
+    p.add_argument("--checkpoint-every", type=non_negative_int, default=None,
                    help="steps between checkpoints (default: steps / 5; 0: none)")
-    p.add_argument("--env-kwargs", type=_json_arg, default={},
+    p.add_argument("--env-kwargs", type=env_kwargs, default={},
                    help="JSON keyword arguments for the env, e.g. '{\"max_steps\": 200}'")
-    p.add_argument("--algo-kwargs", type=_json_arg, default={},
+    p.add_argument("--algo-kwargs", type=json_object, default={},
                    help="JSON keyword arguments for the SB3 algorithm (default: SB3's defaults)")
     p.add_argument("--normalize-obs", action="store_true",
                    help="normalise every observation input by running statistics inside the "
@@ -159,31 +153,33 @@ def add_parser(subparsers) -> None:
                               "learning curve (CSV and PNG).")
     _common(p)
     p.add_argument("--algo", required=True, choices=ALGOS)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--seed", type=seed, default=0)
+    p.add_argument("--out", required=True, type=output_dir, help="output directory")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.add_argument("--n-envs", type=int, default=1, help="--mode shared: worlds stepped "
+    p.add_argument("--n-envs", type=positive_int, default=1, help="--mode shared: worlds stepped "
                    "together (one VecEnv slot per agent of each)")
-    p.add_argument("--n-cpus", type=int, default=0, help="--mode shared: worker processes for "
+    p.add_argument("--n-cpus", type=non_negative_int, default=0, help="--mode shared: worker "
+                   "processes for "
                    "the worlds (0: all in this process)")
     p.set_defaults(func=_train_main)
 
     p = subparsers.add_parser("eval", help="run a trained policy (optionally record or film it)",
                               description="Reload the policy of a 'train' directory and run "
                               "episodes with it.")
-    p.add_argument("dir", help="a directory written by 'mimo-social train'")
-    p.add_argument("--episodes", type=int, default=10)
+    p.add_argument("dir", type=input_dir, help="a directory written by 'mimo-social train'")
+    p.add_argument("--episodes", type=positive_int, default=10)
     p.add_argument("--model", default="final", help="final (model.zip), best (best_model.zip) "
                    "or a path to a .zip")
-    p.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    p.add_argument("--seed", type=seed, default=0, help="seed of the first episode")
     p.add_argument("--stochastic", action="store_true", help="sample actions from the policy")
-    p.add_argument("--record", default=None, help="write a Rerun recording (.rrd)")
-    p.add_argument("--video", default=None, help="write an MP4 video (needs imageio+ffmpeg "
-                   "or an ffmpeg program)")
-    p.add_argument("--frames", default=None, help="write every frame as a PNG file into this "
-                   "directory")
-    p.add_argument("--frame-every", type=int, default=1, help="keep every k-th frame")
-    p.add_argument("--env-kwargs", type=_json_arg, default={},
+    p.add_argument("--record", default=None, type=output_file,
+                   help="write a Rerun recording (.rrd)")
+    p.add_argument("--video", default=None, type=output_file, help="write an MP4 video (needs "
+                   "imageio+ffmpeg or an ffmpeg program)")
+    p.add_argument("--frames", default=None, type=output_dir, help="write every frame as a PNG "
+                   "file into this directory")
+    p.add_argument("--frame-every", type=positive_int, default=1, help="keep every k-th frame")
+    p.add_argument("--env-kwargs", type=env_kwargs, default={},
                    help="JSON keyword arguments for the env, over those of the training run")
     p.set_defaults(func=_eval_main)
 
@@ -198,9 +194,10 @@ def add_parser(subparsers) -> None:
                    help="a step budget per algorithm over --steps, e.g. ppo=100000,sac=20000 "
                    "(SAC costs far more per step than PPO)")
     p.add_argument("--algos", default="ppo,sac", help="comma-separated: ppo,sac")
-    p.add_argument("--seeds", type=int, default=3, help="seeds 0 .. n-1 per algorithm")
-    p.add_argument("--out", required=True, help="output directory (one sub-directory a run)")
-    p.add_argument("--jobs", type=int, default=1, help="runs at a time, each in its own "
+    p.add_argument("--seeds", type=positive_int, default=3, help="seeds 0 .. n-1 per algorithm")
+    p.add_argument("--out", required=True, type=output_dir,
+                   help="output directory (one sub-directory a run)")
+    p.add_argument("--jobs", type=positive_int, default=1, help="runs at a time, each in its own "
                    "process with torch on one thread (the runs' files are the same as with "
                    "--jobs 1, apart from wall times)")
     p.add_argument("--plot-only", action="store_true", help="only re-plot existing runs")
