@@ -439,9 +439,10 @@ class FlatActionWrapper(gym.ActionWrapper):
         super().__init__(env)
         self._decoder = _ActionDecoder(env.action_space)
         self.action_space = self._decoder.space
+        self._who = str(getattr(env.unwrapped, "agent", "agent"))   # named in errors
 
     def action(self, action):
-        return self._decoder(action, "action")
+        return self._decoder(action, self._who)
 
 
 class ExpressionActionWrapper(gym.ActionWrapper):

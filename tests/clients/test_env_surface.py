@@ -160,3 +160,16 @@ def test_expression_only_agents_and_logits_name_the_field():
     act[-2] = np.nan
     with pytest.raises(ValueError, match="infant_0: action field 'expression logits'"):
         logits.step({"infant_0": act, "infant_1": np.zeros(m)})
+
+
+def test_the_gymnasium_flat_action_names_the_agent_and_clips():
+    import gymnasium as gym
+
+    import mimo_social  # noqa: F401  (registers the Gymnasium ids)
+    from mimo_social.core.wrappers import FlatActionWrapper
+    env = FlatActionWrapper(gym.make("mimo_social/FreePlay-v0", max_steps=SHORT))
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="infant_0: action field 'action' = 'abc'"):
+        env.step("abc")
+    env.step(np.full(env.action_space.shape, 1e39))
+    assert np.all(env.unwrapped.parallel.controls[0] == 1.0)
