@@ -13,7 +13,8 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from ..util.checks import ConfigError, check_bool, check_choice, check_int, check_number
+from ..util.checks import (ConfigError, check_bool, check_choice, check_int, check_number,
+                           check_numbers)
 from .config import AgentConfig
 from .world import AgentSetup, Prop
 
@@ -97,12 +98,7 @@ class TaskOptions:
         stored as a tuple of floats; ``allowed`` says what they mean in the error."""
         value = getattr(self, name)
         what = allowed or f"{n} numbers" + (" from low to high" if rising else "")
-        if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence) \
-                or len(value) != n:
-            raise ConfigError(f"{self.task}: {self._label(name)}={value!r} not allowed; "
-                              f"allowed: {what}")
-        out = tuple(check_number(self.task, f"{self._label(name)}[{k}]", v, lo, hi)
-                    for k, v in enumerate(value))
+        out = check_numbers(self.task, self._label(name), value, n, lo, hi, what)
         if rising and any(b < a for a, b in zip(out, out[1:])):
             raise ConfigError(f"{self.task}: {self._label(name)}={value!r} not allowed; "
                               f"allowed: {what}")
@@ -176,8 +172,10 @@ def check_start_poses(world) -> None:
     if len(bad):
         k = bad[np.argmax(depth[bad])]
         i, j = sorted((int(a[k]), int(b[k])))
+        who = [f"{world.names[k]} (posture={setups[k].config.posture!r}, scale="
+               f"{setups[k].config.scale:g})" for k in (i, j)]
         raise ConfigError(
-            f"agents {world.names[i]} and {world.names[j]} overlap: placed at "
+            f"agents {who[0]} and {who[1]} overlap: placed at "
             f"{_xy(setups[i].position)} and {_xy(setups[j].position)} m, their trunks "
             f"interpenetrate by {100 * depth[k]:.1f} cm at the start (allowed: at most "
             f"{100 * OVERLAP_DEPTH:g} cm); place them farther apart (their position settings) "

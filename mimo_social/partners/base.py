@@ -8,16 +8,19 @@ changing the task.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+import inspect
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Sequence
 
 import numpy as np
 from gymnasium import spaces
+
+from ..util.checks import ConfigError, check_number, show
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..core.env import MimoParallelEnv
 
 __all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop",
-           "pd_gains", "motor_action", "follow_waypoints"]
+           "pd_gains", "motor_action", "follow_waypoints", "check_angles", "check_variants"]
 
 
 def zero_action(space: spaces.Space):
@@ -30,6 +33,39 @@ def zero_action(space: spaces.Space):
     if isinstance(space, spaces.Box):
         return np.clip(np.zeros(space.shape, space.dtype), space.low, space.high)
     raise TypeError(f"no resting action for space {space}")
+
+
+def check_angles(who: str, name: str, value, joints: Sequence[str] | None = None,
+                 limit: float = 360.0) -> dict[str, float]:
+    """A partner's joint-angle setting: a mapping joint name -> degrees (each a finite number
+    within +-``limit``; ``joints``: the names allowed, None: any string), as a dict of floats;
+    else a ConfigError naming the setting."""
+    allowed = f"a mapping of {'joint names' if joints is None else list(joints)} to degrees"
+    if not isinstance(value, Mapping):
+        raise ConfigError(f"{who}: {name}={show(value)} not allowed; allowed: {allowed}")
+    bad = [k for k in value if not isinstance(k, str) or (joints is not None and k not in joints)]
+    if bad:
+        raise ConfigError(f"{who}: {name} joints {bad} unknown; allowed: {allowed}")
+    return {k: check_number(who, f"{name}[{k!r}]", v, -limit, limit) for k, v in value.items()}
+
+
+def check_variants(who: str, value, plan: Callable, default: Sequence[Mapping],
+                   extra: Sequence[str] = ()) -> list[dict]:
+    """A planner's ``variants`` setting: None (``default``) or a non-empty list of mappings
+    whose keys are keyword arguments of ``plan`` (or ``extra``), as a list of dicts; else a
+    ConfigError naming ``variants``."""
+    if value is None:
+        return [dict(v) for v in default]
+    keys = sorted({p.name for p in inspect.signature(plan).parameters.values()
+                   if p.default is not inspect.Parameter.empty} | set(extra))
+    allowed = f"None or a non-empty list of mappings with keys from {keys}"
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence) \
+            or not len(value) or not all(isinstance(v, Mapping) for v in value):
+        raise ConfigError(f"{who}: variants={show(value)} not allowed; allowed: {allowed}")
+    bad = sorted({str(k) for v in value for k in v if k not in keys})
+    if bad:
+        raise ConfigError(f"{who}: variants name unknown plan settings {bad}; allowed: {allowed}")
+    return [dict(v) for v in value]
 
 
 def motor_action(space: spaces.Space, motors) -> Any:

@@ -15,6 +15,7 @@ import numpy as np
 from gymnasium import spaces
 
 from ..expressions.faces import EXPRESSIONS
+from ..util.checks import ConfigError, check_numbers, show
 from .base import Partner, zero_action
 
 __all__ = ["ExpressionShow", "expression_ids", "hold_range"]
@@ -22,13 +23,10 @@ __all__ = ["ExpressionShow", "expression_ids", "hold_range"]
 
 def hold_range(hold_s, who: str) -> tuple[float, float]:
     """Validate a ``(min, max)`` hold time in seconds."""
-    try:
-        lo, hi = (float(v) for v in hold_s)
-    except (TypeError, ValueError):
-        raise ValueError(f"{who}: hold_s={hold_s!r}; expected (min, max) seconds, "
-                         f"0 < min <= max") from None
-    if not (np.isfinite(lo) and np.isfinite(hi) and 0.0 < lo <= hi):
-        raise ValueError(f"{who}: hold_s={hold_s!r}; expected (min, max) seconds, 0 < min <= max")
+    allowed = "(min, max) seconds, 0 < min <= max <= 3600"
+    lo, hi = check_numbers(who, "hold_s", hold_s, 2, 0.0, 3600.0, allowed)
+    if not 0.0 < lo <= hi:
+        raise ConfigError(f"{who}: hold_s={show(hold_s)} not allowed; allowed: {allowed}")
     return lo, hi
 
 
@@ -38,7 +36,8 @@ def expression_ids(expressions: Sequence | None, who: str = "ExpressionShow") ->
     if expressions is None:
         return np.arange(len(EXPRESSIONS))
     if isinstance(expressions, (str, bytes)) or not isinstance(expressions, Sequence):
-        raise ValueError(f"{who}: expressions={expressions!r}; expected a list of {allowed}")
+        raise ConfigError(f"{who}: expressions={show(expressions)} not allowed; allowed: a list "
+                          f"of {allowed}")
     ids = []
     for e in expressions:
         if isinstance(e, str) and e in EXPRESSIONS:
@@ -47,7 +46,8 @@ def expression_ids(expressions: Sequence | None, who: str = "ExpressionShow") ->
               and 0 <= e < len(EXPRESSIONS)):
             ids.append(int(e))
         else:
-            raise ValueError(f"{who}: unknown expression {e!r}; allowed: {allowed}")
+            raise ConfigError(f"{who}: expressions={show(expressions)}: unknown expression "
+                              f"{show(e)}; allowed: {allowed}")
     ids = sorted(set(ids))
     if len(ids) < 2:
         raise ValueError(f"{who}: expressions={expressions!r} gives {len(ids)} distinct "

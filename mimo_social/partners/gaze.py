@@ -33,6 +33,7 @@ import numpy as np
 from gymnasium import spaces
 
 from ..core.kinematics import LookAt
+from ..util.checks import ConfigError, check_number, check_numbers, show
 from .base import Partner, agent_index, require_motors
 from .expression import hold_range
 
@@ -65,13 +66,12 @@ def head_share_range(value, who: str = "GazeAtTarget") -> tuple[float, float] | 
     if value is None:
         return None
     allowed = "None, a number in [0, 1] or a (lo, hi) range with 0 <= lo <= hi <= 1"
-    try:
-        lo, hi = ((float(value),) * 2 if isinstance(value, (int, float, np.number))
-                  and not isinstance(value, bool) else (float(v) for v in value))
-    except (TypeError, ValueError):
-        raise ValueError(f"{who}: head_share={value!r}; allowed: {allowed}") from None
-    if not 0.0 <= lo <= hi <= 1.0:
-        raise ValueError(f"{who}: head_share={value!r}; allowed: {allowed}")
+    if isinstance(value, (int, float, np.number)) and not isinstance(value, (bool, np.bool_)):
+        share = check_number(who, "head_share", value, 0.0, 1.0)
+        return share, share
+    lo, hi = check_numbers(who, "head_share", value, 2, 0.0, 1.0, allowed)
+    if lo > hi:
+        raise ConfigError(f"{who}: head_share={show(value)} not allowed; allowed: {allowed}")
     return lo, hi
 
 
@@ -93,13 +93,12 @@ class GazeAtTarget(Partner):
         if targets is not None:
             if isinstance(targets, str) or not isinstance(targets, Sequence) or not targets \
                     or not all(isinstance(t, str) for t in targets):
-                raise ValueError(f"GazeAtTarget: targets={targets!r}; expected None (the task's "
-                                 "toys) or a non-empty list of body or site names")
+                raise ConfigError(f"GazeAtTarget: targets={show(targets)} not allowed; allowed: "
+                                  "None (the task's toys) or a non-empty list of body or site "
+                                  "names")
         self.targets = None if targets is None else tuple(targets)
-        for key, v in (("omega", omega), ("zeta", zeta)):
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v < 1e3:
-                raise ValueError(f"GazeAtTarget: {key}={v!r}; allowed: a number in (0, 1000)")
-        self.omega, self.zeta = float(omega), float(zeta)
+        self.omega = check_number("GazeAtTarget", "omega", omega, 0.01, 1000.0)
+        self.zeta = check_number("GazeAtTarget", "zeta", zeta, 0.01, 1000.0)
         self.target: int | None = None
         self._left = 0
 

@@ -36,8 +36,10 @@ import numpy as np
 
 from ..body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ..core.kinematics import hand_geoms
-from ..util.checks import check_number
-from .base import Partner, agent_index, motor_action, pd_gains, require_motors, require_prop
+from ..util.checks import (ConfigError, check_bool, check_choice, check_int, check_number,
+                           check_numbers, show)
+from .base import (Partner, agent_index, check_angles, motor_action, pd_gains, require_motors,
+                   require_prop)
 
 __all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]
 
@@ -77,11 +79,8 @@ def _number(name, value, lo, hi):
 
 
 def _pair(name, value, lo, hi) -> tuple[float, float]:
-    t = np.asarray(value, dtype=float) if not isinstance(value, str) else None
-    if t is None or t.shape != (2,) or not np.all((t >= lo) & (t <= hi)):
-        raise ValueError(f"HandOffer: {name}={value!r}; allowed: two numbers from {lo:g} to "
-                         f"{hi:g}")
-    return float(t[0]), float(t[1])
+    return check_numbers("HandOffer", name, value, 2, lo, hi,
+                         f"two numbers from {lo:g} to {hi:g}")
 
 
 def _palm_at(w, a, qadr, q) -> np.ndarray:
@@ -197,27 +196,19 @@ class HandOffer(Partner):
                  present_time: float = 0.5, ready_time: float = 0.3, ready_radius: float = 0.08,
                  palm_tilt=(0.15, -0.1), withdraw=(0.03, 0.08)):
         if posture is not None:
-            if not isinstance(posture, Mapping):
-                raise ValueError(f"HandOffer: posture={posture!r}; allowed: a mapping of right "
-                                 f"arm joints {list(ARM)} to degrees")
-            bad = sorted(set(posture) - set(ARM))
-            if bad:
-                raise ValueError(f"HandOffer: posture joints {bad} unknown; allowed: {list(ARM)}")
-            for k, v in posture.items():
-                _number(f"posture[{k!r}]", v, -360.0, 360.0)
+            posture = check_angles("HandOffer", "posture", posture, ARM)
         if target is not None:
-            t = np.asarray(target, dtype=float) if not isinstance(target, str) else None
-            if t is None or t.shape != (3,) or not np.isfinite(t).all() \
-                    or np.linalg.norm(t) > 0.5:
-                raise ValueError(f"HandOffer: target={target!r}; allowed: None or (forward, "
-                                 "left, up) in metres from the right shoulder, within 0.5 m")
-            target = tuple(float(x) for x in t)
-        if not isinstance(grip, bool):
-            raise ValueError(f"HandOffer: grip={grip!r}; allowed: True or False")
-        if release not in RELEASES:
-            raise ValueError(f"HandOffer: release={release!r}; allowed: {list(RELEASES)}")
+            where = ("None or (forward, left, up) in metres from the right shoulder, within "
+                     "0.5 m")
+            target = check_numbers("HandOffer", "target", target, 3, allowed=where)
+            if np.linalg.norm(target) > 0.5:
+                raise ConfigError(f"HandOffer: target={show(target)} not allowed; allowed: "
+                                  f"{where}")
+        grip = check_bool("HandOffer", "grip", grip)
+        check_choice("HandOffer", "release", release, RELEASES)
         if not isinstance(prop, str) or not prop:
-            raise ValueError(f"HandOffer: prop={prop!r}; allowed: the name of a prop of the env")
+            raise ConfigError(f"HandOffer: prop={show(prop)} not allowed; allowed: the name of a "
+                              "prop of the env")
         self.posture_deg = {**OFFER_POSTURE_DEG, **(posture or {})}
         self.target = target
         self.grip = grip
@@ -229,17 +220,12 @@ class HandOffer(Partner):
         self.grip_strength = _number("grip_strength", grip_strength, 0.0, 1.0)
         self.thumb_strength = _number("thumb_strength", thumb_strength, 0.0, 1.0)
         self.pour = _number("pour", pour, 0.0, 3.0)
-        if palm not in PALMS:
-            raise ValueError(f"HandOffer: palm={palm!r}; allowed: {list(PALMS)}")
-        if pour > 0 and palm != "up":
+        check_choice("HandOffer", "palm", palm, PALMS)
+        if self.pour > 0 and palm != "up":
             raise ValueError(f"HandOffer: pour={pour} needs palm='up' (it tips an upturned "
                              f"palm), got palm={palm!r}")
         self.palm = palm
-        if isinstance(hold_parts, bool) or not isinstance(hold_parts, (int, np.integer)) \
-                or not 1 <= hold_parts <= 16:
-            raise ValueError(f"HandOffer: hold_parts={hold_parts!r}; allowed: an integer from 1 "
-                             "to 16 (segments of the taker's hand touching the object)")
-        self.hold_parts = int(hold_parts)
+        self.hold_parts = check_int("HandOffer", "hold_parts", hold_parts, 1, 16)
         self.hold_load = _number("hold_load", hold_load, 0.0, 2.0)
         self.hold_time = _number("hold_time", hold_time, 0.0, 5.0)
         self.present = _number("present", present, 0.0, 2.0)

@@ -22,7 +22,7 @@ import numpy as np
 
 from ...body.joint_groups import RIGHT_WRIST
 from ...core.kinematics import hand_geoms
-from ...util.checks import check_number
+from ...util.checks import ConfigError, check_number, check_numbers, show
 from ..base import Partner, agent_index, motor_action, pd_gains, require_motors, require_prop
 
 __all__ = ["CatchController", "palm_cup_angles", "torque_controls"]
@@ -93,18 +93,14 @@ class CatchController(Partner):
     def __init__(self, tilt=(0.2, 0.05), frequency: float = 6.0, damping: float = 1.0,
                  ball_mass: float = 0.3, cup=(20.0, 20.0, 10.0), grip: float = 0.3,
                  prop: str = "ball"):
-        t = np.asarray(tilt, dtype=float) if not isinstance(tilt, str) else None
-        if t is None or t.shape != (2,) or not np.all(np.abs(t) <= 2.0):
-            raise ValueError(f"CatchController: tilt={tilt!r}; allowed: (toward the thumb, "
-                             "toward the wrist), two slopes within [-2, 2]")
-        c = np.asarray(cup, dtype=float) if not isinstance(cup, str) else None
-        if c is None or c.shape != (3,) or not np.all((c >= 0) & (c <= 90)):
-            raise ValueError(f"CatchController: cup={cup!r}; allowed: (mcp, pip, dip) degrees, "
-                             "each from 0 to 90")
+        self.tilt = check_numbers("CatchController", "tilt", tilt, 2, -2.0, 2.0,
+                                  "(toward the thumb, toward the wrist), two slopes within "
+                                  "[-2, 2]")
+        self.cup = check_numbers("CatchController", "cup", cup, 3, 0.0, 90.0,
+                                 "(mcp, pip, dip) degrees, each from 0 to 90")
         if not isinstance(prop, str) or not prop:
-            raise ValueError(f"CatchController: prop={prop!r}; allowed: the ball's prop name")
-        self.tilt = (float(t[0]), float(t[1]))
-        self.cup = tuple(float(x) for x in c)
+            raise ConfigError(f"CatchController: prop={show(prop)} not allowed; allowed: the "
+                              "ball's prop name")
         self.frequency = _number("frequency", frequency, 0.1, 30.0)
         self.damping = _number("damping", damping, 0.1, 5.0)
         self.ball_mass = _number("ball_mass", ball_mass, 0.0, 10.0)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...util.checks import check_number
+from ...util.checks import check_choice, check_number
 from ..base import agent_index, zero_action
 from ..gaze import GazeAtTarget
 
@@ -39,8 +39,7 @@ class GazeFollowController(GazeAtTarget):
         if partner is not None and (not isinstance(partner, str) or not partner):
             raise ValueError(f"GazeFollowController: partner={partner!r}; allowed: None (the "
                              "other agent) or an agent's name")
-        if read not in READS:
-            raise ValueError(f"GazeFollowController: read={read!r}; allowed: {list(READS)}")
+        check_choice("GazeFollowController", "read", read, READS)
         self.partner, self.read = partner, read
         self.max_angle_deg = check_number("GazeFollowController", "max_angle_deg",
                                           max_angle_deg, 1.0, 30.0)

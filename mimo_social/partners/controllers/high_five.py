@@ -44,7 +44,7 @@ class HighFiveController(Partner):
                  tolerance: float = 0.02):
         self.push = check_number(WHO, "push", push, -0.1, 0.1)
         self.tolerance = check_number(WHO, "tolerance", tolerance, 0.0, 1.0)
-        if palm not in PALMS:
+        if not isinstance(palm, str) or palm not in PALMS:
             raise ValueError(f"{WHO}: palm={palm!r}; allowed: {list(PALMS)}")
         self.palm = palm
         self.replan_steps = check_int(WHO, "replan_steps", replan_steps, 1, 1000)

@@ -24,7 +24,7 @@ import numpy as np
 
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
-from ...util.checks import check_number
+from ...util.checks import ConfigError, check_number, check_numbers, show
 from ..base import Partner, agent_index, motor_action, pd_gains, require_motors, require_prop
 from .catch import torque_controls
 
@@ -40,11 +40,8 @@ def _number(name, value, lo, hi):
 
 
 def _triple(name, value, lo, hi) -> tuple[float, ...]:
-    t = np.asarray(value, dtype=float) if not isinstance(value, str) else None
-    if t is None or t.shape != (3,) or not np.all((t >= lo) & (t <= hi)):
-        raise ValueError(f"ReceiveController: {name}={value!r}; allowed: three numbers from "
-                         f"{lo:g} to {hi:g}")
-    return tuple(float(x) for x in t)
+    return check_numbers("ReceiveController", name, value, 3, lo, hi,
+                         f"three numbers from {lo:g} to {hi:g}")
 
 
 def hand_frame(normal, fingers) -> np.ndarray:
@@ -123,11 +120,9 @@ class ReceiveController(Partner):
                  frequency: float = 3.0, damping: float = 1.0, tolerance: float = 0.01,
                  reach_time: float = 1.0, prop: str = "ball"):
         self.offset = _triple("offset", offset, -0.2, 0.2)
-        ln = np.asarray(lean, dtype=float) if not isinstance(lean, str) else None
-        if ln is None or ln.shape != (2,) or not np.all(np.abs(ln) <= 1.0):
-            raise ValueError(f"ReceiveController: lean={lean!r}; allowed: (toward the wrist, "
-                             "toward the thumb), two slopes within [-1, 1]")
-        self.lean = (float(ln[0]), float(ln[1]))
+        self.lean = check_numbers("ReceiveController", "lean", lean, 2, -1.0, 1.0,
+                                  "(toward the wrist, toward the thumb), two slopes within "
+                                  "[-1, 1]")
         self.cup_deg = _triple("cup_deg", cup_deg, 0.0, 90.0)
         self.grip = _number("grip", grip, 0.0, 1.0)
         self.close_after = _number("close_after", close_after, 0.0, 5.0)
@@ -139,7 +134,8 @@ class ReceiveController(Partner):
         self.tolerance = _number("tolerance", tolerance, 0.001, 0.1)
         self.reach_time = _number("reach_time", reach_time, 0.0, 10.0)
         if not isinstance(prop, str) or not prop:
-            raise ValueError(f"ReceiveController: prop={prop!r}; allowed: the ball's prop name")
+            raise ConfigError(f"ReceiveController: prop={show(prop)} not allowed; allowed: the "
+                              "ball's prop name")
         self.prop = prop
 
     def __repr__(self):

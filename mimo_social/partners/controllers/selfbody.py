@@ -19,8 +19,9 @@ import mujoco
 import numpy as np
 
 from ...core.kinematics import hand_geoms
-from ...util.checks import check_number
-from ..base import Partner, agent_index, follow_waypoints, motor_action, pd_gains
+from ...util.checks import check_int, check_number
+from ..base import (Partner, agent_index, check_angles, check_variants, follow_waypoints,
+                    motor_action, pd_gains)
 
 __all__ = ["RAISE_DEG", "VARIANTS", "SelfBodyController", "touch_posture"]
 
@@ -176,9 +177,11 @@ class SelfBodyController(Partner):
         self.frequency = check_number("SelfBodyController", "frequency", frequency, 0.1, 20.0)
         self.damping = check_number("SelfBodyController", "damping", damping, 0.1, 5.0)
         self.restarts = int(check_number("SelfBodyController", "restarts", restarts, 0, 50))
-        self.variants = list(VARIANTS if variants is None else variants)
-        self.good_steps = int(good_steps)
-        self.raise_deg = dict(RAISE_DEG if raise_deg is None else raise_deg)
+        self.variants = check_variants("SelfBodyController", variants, self._plan, VARIANTS,
+                                       ("hold_steps", "tolerance"))
+        self.good_steps = check_int("SelfBodyController", "good_steps", good_steps, 1, 100000)
+        self.raise_deg = check_angles("SelfBodyController", "raise_deg",
+                                      RAISE_DEG if raise_deg is None else raise_deg)
         self.lift = check_number("SelfBodyController", "lift", lift, 0.0, 0.3)
         self.approach = check_number("SelfBodyController", "approach", approach, 0.0, 0.2)
         self.tolerance = check_number("SelfBodyController", "tolerance", tolerance, 0.01, 1.0)

@@ -20,8 +20,8 @@ from collections.abc import Mapping
 import mujoco
 import numpy as np
 
-from ...util.checks import check_number
-from ..base import Partner, agent_index, motor_action
+from ...util.checks import check_number, check_numbers
+from ..base import Partner, agent_index, check_angles, motor_action
 
 __all__ = ["STAND_DEG", "StandupController"]
 
@@ -43,9 +43,8 @@ class StandupController(Partner):
     def __init__(self, posture: Mapping[str, float] | None = None,
                  foot_force=FOOT_FORCE, hand_force=HAND_FORCE, stiffness: float = 0.3,
                  frequency: float = 3.0):
-        self.posture_deg = {**STAND_DEG, **(posture or {})}
-        for k, v in self.posture_deg.items():
-            check_number("StandupController", f"posture[{k!r}]", v, -360.0, 360.0)
+        self.posture_deg = {**STAND_DEG, **check_angles("StandupController", "posture",
+                                                        {} if posture is None else posture)}
         self.foot_force = self._force("foot_force", foot_force)
         self.hand_force = self._force("hand_force", hand_force)
         self.stiffness = check_number("StandupController", "stiffness", stiffness, 0.0, 10.0)
@@ -53,11 +52,8 @@ class StandupController(Partner):
 
     @staticmethod
     def _force(name, value) -> np.ndarray:
-        f = np.asarray(value, dtype=float) if not isinstance(value, str) else None
-        if f is None or f.shape != (3,) or not np.isfinite(f).all() or np.abs(f).max() > 500:
-            raise ValueError(f"StandupController: {name}={value!r}; allowed: (x, y, z) in N, "
-                             "world frame, each within 500")
-        return f
+        return np.array(check_numbers("StandupController", name, value, 3, -500.0, 500.0,
+                                      "(x, y, z) in N, world frame, each within 500"))
 
     def __repr__(self):
         return (f"StandupController(foot_force={tuple(self.foot_force)}, "

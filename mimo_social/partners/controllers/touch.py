@@ -26,8 +26,8 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_number
-from ..base import (Partner, agent_index, follow_waypoints, motor_action, pd_gains,
-                    require_motors)
+from ..base import (Partner, agent_index, check_variants, follow_waypoints, motor_action,
+                    pd_gains, require_motors)
 
 __all__ = [
     "BACK_COS",
@@ -332,7 +332,7 @@ class SocialTouchController(Partner):
         self.damping = check_number(self.who, "damping", damping, 0.1, 5.0)
         self.tolerance = check_number(self.who, "tolerance", tolerance, 0.01, 1.0)
         self.hold_steps = int(check_number(self.who, "hold_steps", hold_steps, 1, 10000))
-        self.variants = list(VARIANTS if variants is None else variants)
+        self.variants = check_variants(self.who, variants, self._plan, VARIANTS)
         self.good_steps = int(check_number(self.who, "good_steps", good_steps, 1, 100000))
         self.tilt_deg = check_number(self.who, "tilt_deg", tilt_deg, 0.0, 90.0)
 
