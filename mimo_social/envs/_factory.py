@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 
 from pettingzoo.utils.conversions import parallel_to_aec
 
@@ -42,4 +43,6 @@ def with_options(task_cls, task_options, **values):
     own entries win over ``values``; an ``Options`` instance gets them (checked)."""
     if isinstance(task_options, task_cls.Options):
         return dataclasses.replace(task_options, **values)
+    if task_options is not None and not isinstance(task_options, Mapping):
+        return task_options   # not options at all: the task's Options.of says what is allowed
     return {**values, **(task_options or {})}

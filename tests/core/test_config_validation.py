@@ -53,6 +53,7 @@ from mimo_social.partners.gaze import GazeAtTarget
     (lambda: catch_v0.parallel_env(task_options={"mass": (0.5, 0.1)}),
      r"catch: task option mass=\(0.5, 0.1\).*low <= high"),
     (lambda: catch_v0.parallel_env(task_options={"mass": ("0.1", 0.2)}), r"catch.*mass="),
+    (lambda: entry("mirror").scripted_env(task_options=5), r"mirror: task_options=5"),
 ])
 def test_bad_settings_are_config_errors(make, pattern):
     with pytest.raises(ConfigError, match=pattern):

@@ -30,7 +30,7 @@ from mimo_social.util.checks import ConfigError
 
 CHEAP = settings(max_examples=40, deadline=None, derandomize=True,
                  suppress_health_check=[HealthCheck.too_slow])
-ENV = settings(max_examples=20, deadline=None, derandomize=True,
+ENV = settings(max_examples=40, deadline=None, derandomize=True,
                suppress_health_check=[HealthCheck.too_slow])
 
 # -- bad (and some good) values of any kind ------------------------------------------------------
@@ -195,7 +195,8 @@ def _zero_step(env):
 @given(data=st.data())
 def test_env_settings(entry, data):
     """One setting of one kind (an env argument, an agent's, physics, a task option) with a
-    random value: a ConfigError naming it, or an env that resets and steps."""
+    random value, given to the env or its scripted form: a ConfigError naming it, or an env that
+    resets and steps."""
     task = task_of(entry.name)
     kind = data.draw(st.sampled_from(["env", "agent", "physics", "option"]), label="kind")
     if kind == "env":
@@ -217,8 +218,9 @@ def test_env_settings(entry, data):
         name = data.draw(st.sampled_from(fields), label="name")
         value = data.draw(near(getattr(task.Options(), name)), label="value")
         kwargs, words = {"task_options": {name: value}}, (entry.name, name)
+    scripted = data.draw(st.booleans(), label="scripted form")
     try:
-        env = entry.parallel_env(**kwargs)
+        made = (entry.scripted_env if scripted else entry.parallel_env)(**kwargs)
     except ConfigError as e:
         text = str(e)
         if "overlap" in text:   # a body setting that makes the task's placement collide
@@ -227,6 +229,7 @@ def test_env_settings(entry, data):
             for w in words:
                 assert w in text, f"{kwargs}: error {text} does not name {w!r}"
         return
+    env = made.unwrapped
     if kind == "agent":
         for cfg in env.agent_configs:
             assert conforms(getattr(cfg, name), hints(AgentConfig)[name]), (kwargs, cfg)
@@ -237,8 +240,8 @@ def test_env_settings(entry, data):
     else:
         assert type(env.max_steps) is int and env.max_steps >= 1
         assert len(env.render_size) == 2 and all(type(v) is int for v in env.render_size)
-    _zero_step(env)
-    env.close()
+    _zero_step(made)
+    made.close()
 
 
 SEEDS = st.one_of(WEIRD, st.integers(0, 2**70), st.integers(-2**70, -1),
