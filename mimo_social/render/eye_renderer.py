@@ -55,6 +55,7 @@ __all__ = ["shared_gl_context", "gl_current", "free_shared_gl_context", "TileRen
 MAX_BUFFER_SIDE = 4096      # tiles are packed in batches no larger than this (pixels per side)
 _GL = None                  # the process's GL context
 _GL_PID = None              # the process that made it
+_GL_MADE = False            # whether this process (or the one it was forked from) made one
 _ATEXIT = False
 _LOCK = threading.RLock()   # one thread at a time renders on the context
 _FORKED_FROM = None         # (parent pid, what it had made) in a child forked after GL was used
@@ -65,7 +66,7 @@ _LEFT_ON = None             # the thread shared_gl_context() left the context cu
 
 def _gl_state_in_use() -> str | None:
     """What of OpenGL this process has set up (a context of ours, an EGL display), if any."""
-    if _GL is not None:
+    if _GL is not None or _GL_MADE:
         return f"an OpenGL context (MUJOCO_GL={gl_backend()!r})"
     egl = sys.modules.get("mujoco.egl")
     if egl is not None and getattr(egl, "EGL_DISPLAY", None) is not None:
@@ -99,7 +100,7 @@ def _refuse_after_fork() -> None:
 
 def _context():
     """The process's GL context, made on first use (not left current); call under _LOCK."""
-    global _GL, _GL_PID, _ATEXIT
+    global _GL, _GL_PID, _GL_MADE, _ATEXIT
     _refuse_after_fork()
     if _GL is not None and _GL_PID == os.getpid():
         return _GL
@@ -112,7 +113,7 @@ def _context():
     except Exception as e:  # noqa: BLE001 - re-raised with the fix attached
         raise RuntimeError(f"could not create an OpenGL context with MUJOCO_GL="
                            f"{gl_backend()!r} ({type(e).__name__}: {e}); {INSTALL_HINT}") from e
-    _GL, _GL_PID = ctx, os.getpid()
+    _GL, _GL_PID, _GL_MADE = ctx, os.getpid(), True
     if not _ATEXIT:  # free before interpreter teardown (avoids noisy errors from PyOpenGL)
         atexit.register(free_shared_gl_context)
         _ATEXIT = True

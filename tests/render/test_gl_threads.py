@@ -195,3 +195,36 @@ def test_fork_after_rendering_is_a_clear_error_not_a_hang(tmp_path):
     for line in errors:
         assert "RuntimeError" in line and "forked from process" in line
         assert "spawn" in line and "forkserver" in line
+
+
+SUPERSUIT_SCRIPT = textwrap.dedent("""
+    import supersuit as ss
+    from mimo_social.envs import free_play_v0
+
+    env = free_play_v0.parallel_env(n_agents=2, vision={"width": 24, "height": 24},
+                                    max_steps=20)
+    env.reset(seed=0)                   # the parent renders the eyes, then forks its workers
+    venv = ss.concat_vec_envs_v1(ss.pettingzoo_env_to_vec_env_v1(env), 2, num_cpus=2,
+                                 base_class="gymnasium")
+    try:
+        venv.reset(seed=0)
+        print("RESET-OK")
+    except RuntimeError as e:
+        print("ERROR", e)
+""")
+
+
+def test_supersuit_forked_workers_after_the_parent_rendered_say_why(tmp_path):
+    pytest.importorskip("supersuit")
+    script = tmp_path / "ss_fork.py"
+    script.write_text(SUPERSUIT_SCRIPT)
+    proc = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    try:
+        out, _ = proc.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, _ = proc.communicate()
+        pytest.fail(f"SuperSuit's forked workers hung:\n{out[-3000:]}")
+    line = next((x for x in out.splitlines() if x.startswith("ERROR")), out[-3000:])
+    assert "forked from process" in line and "spawn" in line, line
