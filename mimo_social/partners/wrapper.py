@@ -55,6 +55,14 @@ class ScriptedPartners(ParallelWrapper):
         self._check(agent)
         return self.env.action_space(agent)
 
+    def info_spec(self, agent) -> dict:
+        """The env's info keys of a learner (:meth:`MimoParallelEnv.info_spec`) plus
+        ``partner_rewards``: one number per scripted agent, so numeric views of the infos
+        (:class:`mimo_social.core.wrappers.NumericInfos`) keep them."""
+        self._check(agent)
+        return {**self.env.info_spec(agent),
+                "partner_rewards": {name: "number" for name in self.partners}}
+
     def _check(self, agent):
         if agent not in self.possible_agents:
             raise KeyError(f"unknown agent {agent!r}; learners of this env: {self.possible_agents}"

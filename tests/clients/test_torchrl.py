@@ -106,3 +106,22 @@ def test_numeric_infos_extra_keys_flatten_a_nested_dict():
     assert tuple(info) == env.info_keys("infant_0")
     with pytest.raises(TypeError, match="kind 'text' not allowed"):
         NumericInfos(high_five_v0.parallel_env(), extra={"x": "text"})
+
+
+def test_numeric_infos_keep_scripted_partners_rewards():
+    """A scripted-partner env declares ``partner_rewards`` itself: the numeric view carries the
+    partner's reward of each step (0 at reset), equal to the plain info's."""
+    from mimo_social.envs import high_five_v0
+    plain = high_five_v0.scripted_env()
+    numeric = NumericInfos(high_five_v0.scripted_env())
+    (learner,) = plain.possible_agents
+    _, info = numeric.reset(seed=3)
+    plain.reset(seed=3)
+    assert info[learner]["partner_rewards/infant_1"] == 0.0
+    space = plain.action_space(learner)
+    space.seed(0)
+    for _ in range(5):
+        act = {learner: space.sample()}
+        *_, pinfo = plain.step(act)
+        *_, ninfo = numeric.step(act)
+        assert ninfo[learner]["partner_rewards/infant_1"] == pinfo[learner]["partner_rewards"]["infant_1"]
