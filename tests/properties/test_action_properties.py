@@ -42,7 +42,7 @@ _COMMON = dict(deadline=None, derandomize=True, database=None,
                phases=[Phase.explicit, Phase.generate, Phase.shrink],
                suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                       HealthCheck.filter_too_much])
-FAST = settings(max_examples=20, **_COMMON)
+FAST = settings(max_examples=12, **_COMMON)
 DEEP = settings(max_examples=300, **_COMMON)
 
 #: every env of the catalogue without eyes (cheap), and mirror with 8x8 eyes
@@ -332,12 +332,14 @@ def assert_state_unchanged(before, after):
         np.testing.assert_array_equal(x, y)
 
 
-def assert_finite_observations(obs):
+def assert_finite_observations(env, obs):
     for agent, o in obs.items():
         for key, v in o.items():
             v = np.asarray(v)
             if v.dtype.kind == "f":
                 assert np.isfinite(v).all(), f"{agent}: observation {key} not finite"
+            assert env.observation_space(agent)[key].contains(v), \
+                f"{agent}: observation {key} outside its space"
 
 
 # -- the properties -------------------------------------------------------------------------------
@@ -367,7 +369,7 @@ def check_step(env, actions):
                 assert infos[a]["expression"] == EXPRESSIONS[expression]
         assert all(math.isfinite(r) for r in rewards.values())
         if not any("instability" in infos[a] for a in infos):
-            assert_finite_observations(obs)
+            assert_finite_observations(env, obs)
     for a in snaps:
         assert same(snaps[a], snapshot(actions[a])), f"{a}: step() changed the caller's action"
 
