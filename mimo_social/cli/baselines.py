@@ -22,7 +22,7 @@ def _main(args) -> int:
         res = baselines(args.task, args.episodes, args.seed, args.run, model=args.model,
                         env_kwargs=args.env_kwargs, progress=not args.no_progress)
     except (TrainInputError, FileNotFoundError) as e:
-        print(f"mimo-social baselines: {e}", file=sys.stderr)
+        print(f"mimo-social baselines: error: {e}", file=sys.stderr)
         return 2
     table = markdown_table(res)
     print(table, end="")

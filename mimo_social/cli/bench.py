@@ -75,7 +75,7 @@ def run(args) -> int:
     try:
         names = bench.check_names(args.only)
     except ValueError as e:
-        print(f"mimo-social bench: {e}", file=sys.stderr)
+        print(f"mimo-social bench: error: {e}", file=sys.stderr)
         return 2
     markdown, plot = args.markdown, args.plot
     if args.update_benchmarks_md:

@@ -48,13 +48,13 @@ def viewer_available() -> str | None:
 def run(args: argparse.Namespace) -> int:
     path = Path(args.file)
     if not path.is_file():
-        print(f"mimo-social replay: {path}: no such file", file=sys.stderr)
+        print(f"mimo-social replay: error: {path}: no such file", file=sys.stderr)
         return 2
     if args.summary:
         try:
             summary = summarize(path)
         except Exception as e:  # not a readable .rrd
-            print(f"mimo-social replay: cannot read {path} as a Rerun recording: {e}",
+            print(f"mimo-social replay: error: cannot read {path} as a Rerun recording: {e}",
                   file=sys.stderr)
             return 2
         print(format_summary(summary))

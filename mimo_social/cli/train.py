@@ -69,7 +69,7 @@ def _train_main(args) -> int:
                     env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs, mode=args.mode,
                     n_envs=args.n_envs, n_cpus=args.n_cpus, normalize_obs=args.normalize_obs)
     except TrainInputError as e:
-        print(f"mimo-social train: {e}", file=sys.stderr)
+        print(f"mimo-social train: error: {e}", file=sys.stderr)
         return 2
     last = res["last_eval"]
     success = last["eval_success_rate"]
@@ -94,7 +94,7 @@ def _eval_main(args) -> int:
                        frames=args.frames, frame_every=args.frame_every,
                        env_kwargs=args.env_kwargs)
     except (VideoUnavailable, FileNotFoundError, TrainInputError) as e:
-        print(f"mimo-social eval: {e}", file=sys.stderr)
+        print(f"mimo-social eval: error: {e}", file=sys.stderr)
         return 2
     success = res["success_rate"]
     mode = f" {res['mode']}" if res.get("mode") else ""
@@ -117,7 +117,7 @@ def _compare_main(args) -> int:
     try:
         png = _compare_run(args, algos)
     except TrainInputError as e:
-        print(f"mimo-social compare: {e}", file=sys.stderr)
+        print(f"mimo-social compare: error: {e}", file=sys.stderr)
         return 2
     print(f"wrote {png} and {png.with_suffix('.csv')}")
     return 0
