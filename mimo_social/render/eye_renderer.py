@@ -75,10 +75,12 @@ def _gl_state_in_use() -> str | None:
 
 
 def _after_fork_in_child() -> None:
-    global _FORKED_FROM
+    global _FORKED_FROM, _LOCK, _TLS, _PENDING, _LEFT_ON
     used = _gl_state_in_use()
     if used is not None and _FORKED_FROM is None:
         _FORKED_FROM = (os.getppid(), used)
+    # a lock held by a parent's thread at the fork would never be released here
+    _LOCK, _TLS, _PENDING, _LEFT_ON = threading.RLock(), threading.local(), [], None
 
 
 if hasattr(os, "register_at_fork"):
@@ -130,6 +132,7 @@ def gl_current():
     stepped on another. Costs ~10 us a block (EGL, llvmpipe). Raises a RuntimeError naming the
     cause in a process forked from one that had used OpenGL (where rendering would hang)."""
     global _LEFT_ON
+    _refuse_after_fork()
     with _LOCK:
         ctx = _context()
         me = threading.get_ident()
