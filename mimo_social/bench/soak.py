@@ -10,6 +10,9 @@ end of every episode:
   folder (so the recordings are many: one per ``episode_steps``; the closed files are deleted as
   it goes unless ``keep_recordings``), default 1e5 steps.
 
+An ended episode is followed at once by a reset (as vector envs do in training), so a recording
+is open at every sample; ``recordings`` counts the files opened.
+
 Every ``sample_every`` steps (and at the start and end of each phase) it samples the process's
 resident memory (``VmRSS`` of ``/proc/self/status``, MB), its OS threads (``/proc/self/task``)
 and open file descriptors (``/proc/self/fd``). :func:`soak` returns per phase the steps per
@@ -120,15 +123,14 @@ def _run_phase(phase: str, n_steps: int, seed: int, sample_every: int, episode_s
             n = min(sample_every, n_steps - done)
             block_seed = int(np.random.SeedSequence([seed, chunk]).generate_state(1)[0])
             for k, actions in enumerate(random_action_block(env, n, block_seed), 1):
-                if not env.agents:                       # the last episode ended: a new one
+                env.step({a: actions[a] for a in env.agents})
+                if not env.agents:              # reset at once, as vector envs do in training
+                    episode += 1
                     env.reset(seed=seed + episode)
                     if recorder is not None and not keep_recordings:
                         for p in recorder.paths[:-1]:     # closed ones: only the last is open
                             if p.exists():
                                 p.unlink()
-                env.step({a: actions[a] for a in env.agents})
-                if not env.agents:
-                    episode += 1
                 if k % 1000 == 0:
                     on_steps(1000)
             done += n

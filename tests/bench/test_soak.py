@@ -45,8 +45,8 @@ def test_soak_writes_csv_json_png_and_prints_the_growth(ran):
     for r in rows:
         assert float(r["rss_mb"]) > 10 and int(float(r["threads"])) >= 1
         assert int(float(r["fds"])) >= 3
-    # every episode of 50 steps is its own recording: 200 steps -> 4
-    assert [int(r["recordings"]) for r in vision][::5] == [1, 1, 2, 3, 4]
+    # every episode of 50 steps is its own recording, the next opened at once
+    assert [int(r["recordings"]) for r in vision][::5] == [1, 2, 3, 4, 5]
     figures = json.loads((out / "soak.json").read_text())
     assert figures["command"].startswith("mimo-social soak --steps 600 --vision-steps 200")
     assert figures["settings"]["seed"] == 3
@@ -66,8 +66,8 @@ def test_the_recordings_are_deleted_as_it_goes_unless_kept(tmp_path):
     keep = tmp_path / "recs"
     res = soak.soak(0, 120, episode_steps=30, sample_every=60, vision_size=16, progress=False,
                     folder=keep, keep_recordings=True)
-    assert sorted(p.name for p in keep.glob("*.rrd")) == [f"ep{k:06d}.rrd" for k in range(4)]
-    assert res["phases"]["vision+recording"]["recordings"] == 4
+    assert sorted(p.name for p in keep.glob("*.rrd")) == [f"ep{k:06d}.rrd" for k in range(5)]
+    assert res["phases"]["vision+recording"]["recordings"] == 5
     assert res["phases"]["vision+recording"]["episodes"] == 4
     gone = tmp_path / "gone"
     soak.soak(0, 120, episode_steps=30, sample_every=60, vision_size=16, progress=False,
