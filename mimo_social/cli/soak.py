@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from ..bench import soak as soak_lib
 
@@ -33,6 +34,13 @@ def _positive(text: str) -> int:
     value = _count(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"{text!r}: give a whole number >= 1")
+    return value
+
+
+def _eye_size(text: str) -> int:
+    value = _count(text)
+    if not 8 <= value <= 2048:
+        raise argparse.ArgumentTypeError(f"{text!r}: give a whole number of pixels, 8 to 2048")
     return value
 
 
@@ -78,8 +86,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--episode-steps", type=_positive, default=1000, metavar="N",
                         help="steps per episode; the recording rotates to a new file every "
                              "episode (default: 1000)")
-    parser.add_argument("--vision-size", type=_positive, default=64, metavar="PX",
-                        help="eye image edge in pixels (default: 64)")
+    parser.add_argument("--vision-size", type=_eye_size, default=64, metavar="PX",
+                        help="eye image edge in pixels, 8 to 2048 (default: 64)")
     parser.add_argument("--warmup", type=_fraction, default=0.1, metavar="F",
                         help="share of each phase's steps left out of the fit (default: 0.1)")
     parser.add_argument("--keep-recordings", default=None, metavar="DIR",
@@ -109,6 +117,11 @@ def run(args: argparse.Namespace) -> int:
         print("mimo-social soak: --steps 0 and --vision-steps 0: nothing to run",
               file=sys.stderr)
         return 2
+    try:                                   # a folder that cannot be made: say so before the run
+        Path(args.out).mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        print(f"mimo-social soak: --out {args.out}: {e}", file=sys.stderr)
+        return 1
     try:
         result = soak_lib.soak(args.steps, args.vision_steps, seed=args.seed,
                                sample_every=args.sample_every, episode_steps=args.episode_steps,

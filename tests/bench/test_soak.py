@@ -105,7 +105,8 @@ def test_process_sample_sees_a_new_thread_and_an_open_file(tmp_path):
 
 @pytest.mark.parametrize("bad", [["--steps", "-1"], ["--steps", "abc"], ["--steps", "1.5"],
                                  ["--vision-steps", "nan"], ["--seed", "-2"],
-                                 ["--sample-every", "0"], ["--warmup", "2"]])
+                                 ["--sample-every", "0"], ["--warmup", "2"],
+                                 ["--vision-size", "4"], ["--episode-steps", "1e20"]])
 def test_bad_arguments_are_usage_errors(bad, capsys):
     with pytest.raises(SystemExit) as e:
         cli.main(["soak", *bad])
@@ -116,3 +117,12 @@ def test_bad_arguments_are_usage_errors(bad, capsys):
 def test_nothing_to_run_says_so(capsys):
     assert cli.main(["soak", "--steps", "0", "--vision-steps", "0", "--no-progress"]) == 2
     assert "nothing to run" in capsys.readouterr().err
+
+
+def test_an_output_folder_that_cannot_be_made_is_refused_before_the_run(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert cli.main(["soak", "--steps", "10", "--vision-steps", "0", "--no-progress",
+                     "--out", str(blocker / "sub")]) == 1
+    err = capsys.readouterr().err
+    assert "--out" in err and "sub" in err
