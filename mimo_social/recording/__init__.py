@@ -3,7 +3,8 @@
 ``recorder``: :class:`Recorder`, which writes an env's steps (the layout of a recording is in
 its docstring); ``episodes``: one episode (:func:`record_episode`) or every k-th episode during
 training (:class:`RecordingParallelEnv`, :func:`recording_env_fn`); ``summary``: what a file
-holds (:func:`summarize`). The parts of a recording: ``geometry`` (geom shapes), ``faces``
+holds (:func:`summarize`); ``streams``: Rerun file streams that free their threads when closed and
+write errors that name the file and the cause (:class:`RecordingFileError`). The parts of a recording: ``geometry`` (geom shapes), ``faces``
 (expressions), ``eyes``, ``skin``, ``contacts``, ``blueprint`` (viewer layout), ``columns``
 (Arrow columns and the row buffer).
 """
@@ -19,7 +20,8 @@ from .episodes import (
 )
 from .eyes import EYE_FORMATS
 from .geometry import HIDDEN_GEOM_GROUP, geom_archetype, geom_rgba
-from .recorder import Recorder
+from .recorder import Recorder, parallel_of
+from .streams import RecordingFileError
 from .skin import SKIN_FORCE_RANGE, SKIN_POINT_RADIUS, force_colors
 from .summary import format_summary, summarize
 
@@ -34,11 +36,13 @@ __all__ = [
                        "STEP",
                        "RecordSubEnv",
                        "Recorder",
+                       "RecordingFileError",
                        "RecordingParallelEnv",
                        "force_colors",
                        "format_summary",
                        "geom_archetype",
                        "geom_rgba",
+                       "parallel_of",
                        "record_episode",
                        "recording_env_fn",
                        "summarize",

@@ -12,8 +12,8 @@ from typing import Any
 
 from ..core.wrappers import ParallelWrapper
 
-from ..util.checks import check_int
-from .recorder import Recorder
+from ..util.checks import check_int, check_seed
+from .recorder import Recorder, parallel_of
 
 __all__ = [
     "FIRST_VEC_WORKER",
@@ -31,9 +31,16 @@ def record_episode(env, path: str | Path, policy: Callable[[dict], dict] | None 
 
     ``policy(obs) -> actions`` gets the observation dict of the live agents and returns their
     actions; without one, actions are sampled from the action spaces (seeded by ``seed``). The
-    episode ends when no agent is left or after ``max_steps`` steps.
+    episode ends when no agent is left or after ``max_steps`` steps. ``env``: as for
+    :class:`Recorder` (the episode is run on the ``MimoParallelEnv`` inside it).
     """
-    penv = getattr(env, "parallel", env)
+    seed = check_seed(seed, "record_episode")
+    if max_steps is not None:
+        max_steps = check_int("record_episode", "max_steps", max_steps, lo=0)
+    penv = parallel_of(env)
+    if penv is None:
+        raise TypeError(f"record_episode needs a MimoParallelEnv, the Gymnasium adapter or a "
+                        f"wrapper of one, got {type(env).__name__}")
     if policy is None:
         for k, a in enumerate(penv.possible_agents):
             penv.action_space(a).seed(None if seed is None else seed + k)

@@ -77,11 +77,11 @@ from __future__ import annotations
 
 import math
 import time
-import uuid
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 import pyarrow as pa
 import rerun as rr
@@ -105,8 +105,26 @@ from .eyes import EYE_FORMATS, EyeLog
 from .faces import FaceLog
 from .geometry import WXYZ_TO_XYZW, log_shapes, visible_bodies
 from .skin import SkinLog
+from .streams import WRITE_TIMEOUT_S, FileStream
 
-__all__ = ["Recorder"]
+__all__ = ["Recorder", "parallel_of"]
+
+
+def parallel_of(env):
+    """The ``MimoParallelEnv`` inside ``env``: ``env`` itself, the ``.parallel`` of the Gymnasium
+    adapter, or found through wrappers (``gym.make``'s chain, PettingZoo-style ``.env``); None
+    if there is none."""
+    seen = 0
+    while env is not None and seen < 64:
+        if hasattr(env, "world") and hasattr(env, "possible_agents"):
+            return env
+        inner = env.__dict__.get("parallel") if hasattr(env, "__dict__") else None
+        if inner is None:
+            inner = getattr(env, "env", None)
+        if inner is None and isinstance(env, gym.Env) and env.unwrapped is not env:
+            inner = env.unwrapped
+        env, seen = inner, seen + 1
+    return None
 
 
 class Recorder:
@@ -115,17 +133,21 @@ class Recorder:
     Parameters
     ----------
     env:
-        A ``MimoParallelEnv`` or anything with a ``.parallel`` one (``SingleAgentEnv``). With a
-        single-agent adapter, :meth:`log_step` takes that agent's action and reward directly.
+        A ``MimoParallelEnv`` (or a wrapper of one), or the Gymnasium adapter (``SingleAgentEnv``,
+        also inside ``gym.make``'s wrappers). With a Gymnasium env, :meth:`log_step` takes that
+        agent's action and reward directly.
     path:
-        The ``.rrd`` file to write (its folder is created).
+        The ``.rrd`` file to write (its folder is created). A path that cannot be written (a
+        folder, no permission, a full disk) is a :class:`~mimo_social.recording.streams.
+        RecordingFileError` (an ``OSError``) here; a write that fails later (the disk fills up)
+        is one at the next flush or at :meth:`close`, naming the file and the cause.
     every_k_steps:
         Record poses and scalars every k-th env step (rewards are summed over the k steps);
         expression changes are always recorded at the step they happen.
     flush_every_s:
-        Send buffered rows at least this often, in simulated seconds; a crash keeps the rows up
-        to :attr:`flushed_step` (so it loses at most the rows of two such intervals). Shorter
-        intervals cost more (see the module docstring).
+        Send buffered rows at least this often, in simulated seconds (default 4); a crash keeps
+        the rows up to :attr:`flushed_step` (so it loses at most the rows of two such
+        intervals). Shorter intervals cost more (see the module docstring).
     face_size:
         Edge length in pixels of the face images (and of the head textures).
     face_hold_s:
@@ -155,6 +177,9 @@ class Recorder:
         Log the skin points that feel a force (agents with touch) and each agent's touch total.
     contacts:
         Log an event when a body part of one agent starts touching a body part of another.
+    write_timeout_s:
+        How long a flush may wait for Rerun's file writer while it is alive before the write
+        counts as failed (a writer that stopped is noticed within a second).
     """
 
     def __init__(self, env, path: str | Path, every_k_steps: int = 1, *,
@@ -164,12 +189,13 @@ class Recorder:
                  scalars: Mapping[str, Callable[[Any], float]] | None = None,
                  eyes: bool = True, eye_format: str = "png",
                  eye_every_k_steps: int | None = None, eye_jpeg_quality: int = 90,
-                 skin: bool = True, contacts: bool = True):
-        penv = getattr(env, "parallel", env)
-        world = getattr(penv, "world", None)
-        if world is None or not hasattr(penv, "possible_agents"):
-            raise TypeError(f"Recorder needs a MimoParallelEnv (or an adapter with .parallel), "
-                            f"got {type(env).__name__}")
+                 skin: bool = True, contacts: bool = True,
+                 write_timeout_s: float = WRITE_TIMEOUT_S):
+        penv = parallel_of(env)
+        if penv is None:
+            raise TypeError(f"Recorder needs a MimoParallelEnv, the Gymnasium adapter or a wrapper "
+                            f"of one, got {type(env).__name__}")
+        world = penv.world
         every_k_steps = check_int("Recorder", "every_k_steps", every_k_steps, lo=1)
         if not flush_every_s > 0:
             raise ValueError(f"flush_every_s={flush_every_s!r}; allowed: a positive number")
@@ -187,7 +213,7 @@ class Recorder:
         self.world = world
         self.path = Path(path)
         self.every_k_steps = int(every_k_steps)
-        self._single = penv is not env and len(penv.possible_agents) == 1
+        self._single = isinstance(env, gym.Env) and len(penv.possible_agents) == 1
         self.agents = list(penv.possible_agents)
         self._dt = float(penv.dt)
         self._textured_heads = textured_heads
@@ -214,11 +240,11 @@ class Recorder:
 
         import pyarrow.compute  # noqa: F401  (Arrow imports it at the first masked array: now)
 
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._rec = rr.RecordingStream(application_id, recording_id=uuid.uuid4())
-        self._rec.set_log_tick_enabled(False)
-        self._rec.set_log_time_enabled(False)
-        self._rec.save(self.path, default_blueprint=self.blueprint() if blueprint else None)
+        self._stream = FileStream(self.path, application_id,
+                                  self.blueprint() if blueprint else None, write_timeout_s)
+        self._rec = self._stream.rec
+        #: the Rerun recording id of the file (a new one per recorder)
+        self.recording_id = self._rec.get_recording_id()
         if recording_name:
             self._rec.send_recording_name(recording_name)
         self._closed = False
@@ -430,8 +456,7 @@ class Recorder:
         t0 = time.perf_counter()
         if not self._closed:
             self._flush()
-            self._rec.flush()
-            self.flushed_rows, self.flushed_step = self._sent_rows, self._sent_step
+            self._wait_written()
         self.overhead_s += time.perf_counter() - t0
 
     def _flush(self) -> None:
@@ -439,8 +464,7 @@ class Recorder:
         if self._sent_step > self.flushed_step:
             # what the last flush sent is written by Rerun's own thread meanwhile: wait for it
             # (it is long done: this costs ~0.5 ms), so everything up to there is on disk
-            self._rec.flush()
-            self.flushed_rows, self.flushed_step = self._sent_rows, self._sent_step
+            self._wait_written()
         if rows.n:
             self._rec.send_record_batch(self._record_batch(rows))
         if rows.texts or rows.images:
@@ -485,25 +509,44 @@ class Recorder:
             columns.append(optional_scalars(value, ~np.isnan(value)))
         return pa.RecordBatch.from_arrays(columns, schema=self._schema)
 
+    def _wait_written(self) -> None:
+        """Wait until all that was sent is in the file (a write failure closes the recorder)."""
+        try:
+            self._stream.wait_written()
+        except OSError:
+            self._detach()
+            raise
+        self.flushed_rows, self.flushed_step = self._sent_rows, self._sent_step
+
     # -- closing --------------------------------------------------------------------------------
     def _check_open(self):
+        if self._stream.failed is not None:
+            raise self._stream.failed
         if self._closed:
             raise RuntimeError(f"the recorder of {self.path} is closed")
 
+    def _detach(self) -> None:
+        self._closed = True
+        self._started = False
+        self._rec = None
+
     def close(self) -> None:
-        """Send what is buffered, finish the file (with its footer) and detach (idempotent)."""
+        """Send what is buffered, finish the file (with its footer), detach and free Rerun's
+        stream and its threads (idempotent). A write that failed is a ``RecordingFileError``."""
         if self._closed:
             return
         t0 = time.perf_counter()
         try:
             self._faces.commit(self._rows, self._global_step, everything=True)
             self._flush()
-        finally:
-            self._rec.flush()
+            self._rec = None                   # the stream's last reference is the FileStream's
+            self._stream.close()
             self.flushed_rows, self.flushed_step = self._sent_rows, self._sent_step
-            self._rec.disconnect()
-            self._closed = True
-            self._started = False
+        finally:
+            self._rec = None
+            if self._stream.rec is not None:   # an error before the stream was finished
+                self._stream.close()
+            self._detach()
             self.overhead_s += time.perf_counter() - t0
 
     @property
