@@ -188,8 +188,10 @@ if sys.argv[2] == "fsize":            # the file-size limit stands in for a disk
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     resource.setrlimit(resource.RLIMIT_FSIZE, (2_000_000, resource.RLIM_INFINITY))
 from mimo_social.envs import free_play_v0
-from mimo_social.recording import Recorder
-env = free_play_v0.parallel_env(n_agents=2)
+from mimo_social.recording import Recorder, record_episode, summarize
+from mimo_social.recording.streams import stuck_streams
+flush_each_step = sys.argv[3] == "1"      # a flush racing the writer's failure: Rerun's stream
+env = free_play_v0.parallel_env(n_agents=2)  # stays blocked (it is kept, the process exits)
 a = {ag: {"motors": np.zeros(env.action_space(ag)["motors"].shape, np.float32),
           "expression": 0} for ag in env.possible_agents}
 out = {"error": None}
@@ -202,6 +204,8 @@ try:
             env.reset()
         obs, rewards, *_ = env.step(a)
         rec.log_step(a, rewards, obs)
+        if flush_each_step:
+            rec.flush()
     rec.close()
 except OSError as e:
     out = {"error": str(e), "type": type(e).__name__, "errno": e.errno,
@@ -211,12 +215,16 @@ try:
 except OSError as e:
     out["again"] = str(e)
 rec.close()                                       # quiet once failed
+out["stuck"] = stuck_streams()
+after = record_episode(env, sys.argv[4], seed=0, max_steps=3)   # elsewhere, small: fits
+out["after_rows"] = summarize(after["path"])["pose_rows"]
 print(json.dumps(out))
 """
 
 
-def _run_fill(path: Path, how: str, wrap=()) -> dict:
-    proc = subprocess.run([*wrap, sys.executable, "-c", _FILL_SCRIPT, str(path), how],
+def _run_fill(path: Path, how: str, wrap=(), flush_each_step=False) -> dict:
+    proc = subprocess.run([*wrap, sys.executable, "-c", _FILL_SCRIPT, str(path), how,
+                           str(int(flush_each_step)), str(path.parent.parent / "after.rrd")],
                           capture_output=True, text=True, timeout=240, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr[-3000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -229,15 +237,21 @@ def _check_fill(out: dict, path: Path, cause: str):
     assert "prematurely" not in out["error"]
     assert out["again"] == out["error"]
     assert out["flushed_step"] > 0
+    assert out["after_rows"] == 4, "a recording after the failure does not work"
 
 
-def test_a_file_that_cannot_grow_fails_at_the_next_flush_naming_file_and_cause(tmp_path):
+@pytest.mark.parametrize("flush_each_step", [False, True], ids=["at-interval", "every-step"])
+def test_a_file_that_cannot_grow_fails_at_the_next_flush_naming_file_and_cause(
+        tmp_path, flush_each_step):
     """The process's file-size limit makes writes fail part-way like a full disk; the recorder
-    raises (no hang, no 'thread shut down prematurely'), later calls say the same and the process
-    exits (Rerun's exit hook would wait for the dead writer)."""
-    path = tmp_path / "big.rrd"
-    out = _run_fill(path, "fsize")
+    raises (no hang, no 'thread shut down prematurely'), later calls say the same, a new
+    recording works and the process exits (with a flush after every step, Rerun's stream is
+    mostly left blocked, and Rerun's own exit hook would wait for it forever)."""
+    path = tmp_path / "limited" / "big.rrd"     # the next recording goes to tmp_path
+    out = _run_fill(path, "fsize", flush_each_step=flush_each_step)
     _check_fill(out, path, "File too large")
+    if not flush_each_step:
+        assert out["stuck"] == 0
 
 
 def _unshare_tmpfs() -> bool:
