@@ -29,9 +29,12 @@ HAND_VERSIONS = ("mitten", "five_fingers")
 
 #: Allowed body size factors (every length times ``scale``; 1: the 18-month-old, 77.8 cm) and
 #: strength factors (every motor's maximum torque and muscle's maximum force, on top of the size
-#: law).
+#: law). Strength stops at 3: at the default physics, bang-bang actions (every motor at -1 or +1,
+#: redrawn each step) ran 60k steps without a divergence at 3 and 4 for the smallest body (scale
+#: 0.5) and at 6 for scale 1, but diverged every few thousand steps at 5 (scale 0.5) and 7
+#: (scale 1), and every ~160 steps at 10 (docs/reliability.md, "Instability").
 SCALE_RANGE = (0.5, 2.5)
-STRENGTH_RANGE = (0.1, 10.0)
+STRENGTH_RANGE = (0.1, 3.0)
 
 #: The exponent of ``scale`` each kind of table value is multiplied by (geometric similarity,
 #: constant density, and dynamic similarity under the same gravity: a body ``s`` times larger

@@ -380,25 +380,74 @@ class World:
     def initial_qpos(self) -> np.ndarray:
         return self._initial_qpos.copy()
 
+    #: Divergence bounds, checked after every physics step: a speed of any degree of freedom
+    #: (rad/s or m/s) above ``VEL_LIMIT``, an acceleration (rad/s^2 or m/s^2) above
+    #: ``ACC_LIMIT``, or a NaN/inf in either, is a simulation that went unstable. Measured
+    #: maxima: every catalogue env (random, bang-bang and scripted actions) at most 91 rad/s and
+    #: 1.0e4 rad/s^2; bang-bang actions (every motor at -1 or +1, redrawn each step) at every
+    #: allowed strength and scale at most 275 rad/s and 6.6e4 rad/s^2 (a finger); five-finger hands
+    #: 888 rad/s and 1.3e5 rad/s^2 (a fingertip). A diverging simulation grows about tenfold per
+    #: physics step from there, so it passes the limits within a step or two of leaving the
+    #: normal range, long before MuJoCo's own check (1e10).
+    VEL_LIMIT = 2e3
+    ACC_LIMIT = 1e6
+
     def step(self, n: int, before_substep=None) -> str | None:
-        """Advance ``n`` physics steps; return a reason string if the simulation went unstable."""
+        """Advance ``n`` physics steps; return a reason string if the simulation went unstable.
+
+        The state is checked after every physics step (:attr:`VEL_LIMIT`, :attr:`ACC_LIMIT`,
+        MuJoCo's warnings); at the first bad one the world stops there and is put back to its
+        initial pose at rest (the clock keeps running), so no diverged value is ever read."""
         m, d = self.model, self.data
+        qvel, qacc = d.qvel, d.qacc          # views: MjData arrays never move
+        v2, a2 = self.VEL_LIMIT ** 2, self.ACC_LIMIT ** 2
+        reason = None
         for _ in range(n):
             if before_substep is not None:
                 before_substep()
             mujoco.mj_step(m, d)
+            # a sum of squares within the square of a limit keeps every value within it (a
+            # NaN/inf fails the comparison): well under a microsecond; only past it is each
+            # value looked at
+            if not (qvel.dot(qvel) <= v2 and qacc.dot(qacc) <= a2):
+                reason = self._diverged()
+                if reason is not None:
+                    break
+        if reason is None:
+            reason = self._mujoco_reset()    # MuJoCo met a bad value and reset the data itself
+        if reason is not None:
+            self._restart()
         # mj_step leaves positions of the state before its last integration; bring body, geom,
         # site and camera poses up to date so tasks and senses read the state they are given.
         mujoco.mj_kinematics(m, d)
         mujoco.mj_camlight(m, d)
-        return self.instability()
+        return reason
 
     _BAD = np.array([mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
                      mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADCTRL], int)
 
     def instability(self) -> str | None:
-        """A reason string when the last steps diverged. MuJoCo resets the data when it meets a
-        NaN/inf or huge value; its warning counters tell that this happened."""
+        """A reason string when the simulation diverged: its speeds or accelerations now pass
+        :attr:`VEL_LIMIT` / :attr:`ACC_LIMIT` (or are NaN/inf), or MuJoCo met a NaN/inf or huge
+        value since the last check (and reset the data). Only reads the state (:meth:`step` checks
+        after every physics step and restarts a diverged world itself)."""
+        return self._diverged() or self._mujoco_reset()
+
+    def _diverged(self) -> str | None:
+        m, d = self.model, self.data
+        for values, limit, what in ((d.qvel, self.VEL_LIMIT, "speed"),
+                                    (d.qacc, self.ACC_LIMIT, "acceleration")):
+            bad = ~(np.abs(values) <= limit)                 # NaN counts as bad
+            if bad.any():
+                k = int(np.flatnonzero(bad)[np.argmax(np.nan_to_num(
+                    np.abs(values[bad]), nan=np.inf))])
+                joint = m.joint(int(m.dof_jntid[k])).name
+                return (f"the simulation diverged at t = {d.time:.4f} s: the {what} of {joint} "
+                        f"(dof {k}) is {values[k]:.3g}, beyond the limit {limit:g}; the world was "
+                        f"put back to its initial pose")
+        return None
+
+    def _mujoco_reset(self) -> str | None:
         d = self.data
         counts = d.warning.number[self._BAD]
         total = int(counts.sum())
@@ -406,8 +455,18 @@ class World:
             self._bad_count = total
             which = [mujoco.mjtWarning(w).name for w, c in zip(self._BAD, counts) if c]
             return (f"MuJoCo found NaN, inf or huge values ({', '.join(which)}) and reset the "
-                    f"simulation: it went unstable")
+                    f"simulation: it went unstable; the world was put back to its initial pose")
         return None
+
+    def _restart(self) -> None:
+        """The initial pose at rest, after a divergence (the clock keeps its time)."""
+        m, d = self.model, self.data
+        t = d.time
+        mujoco.mj_resetData(m, d)            # clears MuJoCo's warning counters too
+        d.qpos[:] = self._initial_qpos
+        d.time = t
+        mujoco.mj_forward(m, d)
+        self._bad_count = 0
 
     def set_expression(self, agent: int, expression: int) -> None:
         self.faces.show(self.model, self.agents[agent].head_material, expression)

@@ -338,8 +338,8 @@ def test_scaled_env_pickles_with_its_body():
 @pytest.mark.parametrize("key, value, allowed", [
     ("scale", 0.3, "0.5 to 2.5"), ("scale", 2.6, "0.5 to 2.5"), ("scale", "big", "0.5 to 2.5"),
     ("scale", float("nan"), "0.5 to 2.5"), ("scale", True, "0.5 to 2.5"),
-    ("strength", 0.05, "0.1 to 10"), ("strength", 11, "0.1 to 10"),
-    ("strength", None, "0.1 to 10")])
+    ("strength", 0.05, "0.1 to 3"), ("strength", 3.5, "0.1 to 3"),
+    ("strength", None, "0.1 to 3")])
 def test_out_of_range_scale_and_strength_name_the_allowed_range(key, value, allowed):
     with pytest.raises(ConfigError, match=f"{key}.*{allowed}"):
         AgentConfig(**{key: value})
