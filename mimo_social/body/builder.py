@@ -115,7 +115,8 @@ def build_infant(
         scale: body size factor, 0.5 to 2.5 (every length times ``scale``; masses, inertias,
             torques, passive joint parameters, muscles and touch spacing follow the scaling laws
             of :func:`~mimo_social.body.tables.scale_body`).
-        strength: factor on every motor's maximum torque and muscle's maximum force, 0.1 to 3 (:data:`~mimo_social.body.tables.STRENGTH_RANGE`).
+        strength: factor on every motor's maximum torque and muscle's maximum force, 0.1 to 3
+            (:data:`~mimo_social.body.tables.STRENGTH_RANGE`).
     """
     tables = load_body(hands, scale, strength)
     if base not in ("free", "fixed"):
