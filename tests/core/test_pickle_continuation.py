@@ -6,7 +6,8 @@ streams).
 Every env of the catalogue is run in each of its forms: every agent learning (random actions),
 the one-learner form with the scripted partner (social tasks), the task's catalogued controller
 driving ``infant_0`` (it reads MuJoCo's bias forces and mass matrix, so a copy whose last-step
-quantities were recomputed acts differently), and the Gymnasium id through ``gym.make``. Copies
+quantities were recomputed acts differently), and the Gymnasium id through ``gym.make``; and one
+free play with props, touch, three body sizes, five-fingered hands and muscles. Copies
 are taken at several steps of one run, one of them in the second episode (tasks write model
 fields at reset: the catch ball's size, mass and inertia, the standup rail's contact bits and
 weld stiffness, the faces' textures), and each replays the original's actions to the end.
@@ -69,9 +70,11 @@ def _difference(a, b) -> str | None:
 class _Run:
     """An env and everything that picks its actions (one object, so one copy takes it all)."""
 
-    def __init__(self, entry, form: str, seed: int):
+    def __init__(self, entry, form: str, seed: int, **kwargs):
         self.form = form
-        if form == "gym":
+        if kwargs:
+            self.env = entry.parallel_env(max_steps=MAX_STEPS, **kwargs)
+        elif form == "gym":
             register_envs()
             self.env = gym.make(entry.gym_id, max_steps=MAX_STEPS)
         elif form == "parallel":
@@ -129,9 +132,17 @@ def _cases():
             yield pytest.param(e, "controller", id=f"{e.name}-controller", marks=marks)
 
 
-@pytest.mark.parametrize("entry,form", list(_cases()))
+#: free play with a bit of everything: props, touch, bodies of three sizes, five-fingered hands,
+#: muscles
+VARIETY = dict(n_agents=3, touch=True, task_options={"props": True},
+               per_agent=[{"scale": 0.6, "hands": "five_fingers"}, {"actuation": "muscle"},
+                          {"scale": 2.0, "strength": 2.0, "expressions": False}])
+
+
+@pytest.mark.parametrize("entry,form", [*_cases(), pytest.param(
+    next(e for e in CATALOG if e.name == "free_play"), "variety", id="free_play-variety")])
 def test_a_copy_taken_at_any_step_continues_exactly(entry, form):
-    run = _Run(entry, form, seed=3)
+    run = _Run(entry, form, seed=3, **(VARIETY if form == "variety" else {}))
     results = [copy.deepcopy(run.result)]
     copies = []
     for t in range(TOTAL):
