@@ -246,12 +246,11 @@ def test_a_file_that_cannot_grow_fails_at_the_next_flush_naming_file_and_cause(
     """The process's file-size limit makes writes fail part-way like a full disk; the recorder
     raises (no hang, no 'thread shut down prematurely'), later calls say the same, a new
     recording works and the process exits (with a flush after every step, Rerun's stream is
-    mostly left blocked, and Rerun's own exit hook would wait for it forever)."""
+    mostly left blocked, sometimes with a flush per interval too, and Rerun's own exit hook would
+    wait for it forever)."""
     path = tmp_path / "limited" / "big.rrd"     # the next recording goes to tmp_path
     out = _run_fill(path, "fsize", flush_each_step=flush_each_step)
     _check_fill(out, path, "File too large")
-    if not flush_each_step:
-        assert out["stuck"] == 0
 
 
 def _unshare_tmpfs() -> bool:
