@@ -177,10 +177,24 @@ def python_numbers():
                                       np.float16(-0.0), np.float64("nan")]))
 
 
+class Hostile:
+    """An object whose array conversion raises (an error of its own kind)."""
+
+    def __array__(self, *args, **kwargs):
+        raise KeyError("no array here")
+
+
+class NoRepr(Hostile):
+    """... and whose repr raises too (hypothesis shows what it draws: used outside it)."""
+
+    def __repr__(self):
+        raise RuntimeError("no repr either")
+
+
 def not_numbers():
     return st.one_of(st.none(), st.booleans(), st.just(np.bool_(False)), st.text(max_size=4),
                      st.sampled_from(["0.5", "nan", "1e3", b"\x00", 1j, complex(0.5, 0),
-                                      object(), {"a": 1}, {0.5}, ...]))
+                                      object(), {"a": 1}, {0.5}, ..., Hostile()]))
 
 
 def torch_tensors(n: int):
@@ -289,7 +303,10 @@ def snapshot(value):
         return ("dict", type(value), [(k, snapshot(v)) for k, v in value.items()])
     if isinstance(value, (list, tuple)):
         return ("seq", type(value), [snapshot(v) for v in value])
-    return ("other", repr(value))
+    try:
+        return ("other", repr(value))
+    except Exception:  # noqa: BLE001  (NoRepr)
+        return ("other", id(value))
 
 
 def same(a, b) -> bool:
@@ -465,6 +482,28 @@ def test_the_rules_are_what_the_docstring_says():
     assert expression_rule(np.uint8(6)) == 6 and expression_rule(np.array([2])) == 2
     for bad in (7, -1, 2.0, True, "3", None, [[1], [2, 3]], np.array([1, 2])):
         assert expression_rule(bad) is None, bad
+    assert motor_rule(Hostile(), n) is None and expression_rule(Hostile()) is None
     snap = snapshot(np.zeros(2))
     assert same(snap, snapshot(np.zeros(2))) and not same(snap, snapshot(np.ones(2)))
     assert copy.deepcopy(snap)[0] == "array"
+
+
+@pytest.mark.parametrize("name", ["reach", "free_play"])
+def test_a_value_whose_conversion_and_repr_raise_is_refused_naming_agent_and_field(name):
+    env = make_env(name)
+    env.reset(seed=0)
+    agent = env.possible_agents[0]
+    n = motor_box(env, agent).shape[0]
+    dict_action = isinstance(env.action_space(agent), spaces.Dict)
+    cases = ([({"motors": NoRepr(), "expression": 0}, "'motors'"),
+              ({"motors": np.zeros(n), "expression": NoRepr()}, "expression"),
+              (NoRepr(), "'motors' and 'expression'")] if dict_action
+             else [(NoRepr(), "'motors'")])
+    others = {a: env.action_space(a).sample() for a in env.agents if a != agent}
+    for action, field in cases:
+        before = env_state(env)
+        with pytest.raises(ValueError) as e:
+            env.step({**others, agent: action})
+        assert agent in str(e.value) and field in str(e.value) and "repr" in str(e.value)
+        assert_state_unchanged(before, env_state(env))
+    env.close()
