@@ -90,9 +90,10 @@ def assert_bounded(threads, fds, rss):
     # that, a recording must give back all it took
     assert max(threads[2:]) <= threads[1], f"OS threads after each recording: {threads}"
     assert max(fds[2:]) <= fds[1], f"open file descriptors after each recording: {fds}"
-    # leaked streams kept ~3.5 MB each; what is left is the allocator's noise
-    growth = rss[-1] - min(rss[2:6])
-    assert growth < 0.5 * (len(rss) - 4), f"RSS (MB) after each recording: {rss}"
+    # leaked streams kept ~4 MB each (60 MB here); what is left is the allocator's sawtooth
+    # (~1 MB up per recording, ~10 MB down now and then)
+    growth = float(np.median(rss[-5:]) - np.median(rss[2:7]))
+    assert growth < 15, f"RSS (MB) after each recording: {rss}"
 
 
 def test_successive_recorders_keep_threads_descriptors_and_memory_bounded(env, tmp_path):
@@ -111,6 +112,7 @@ def test_successive_recorders_keep_threads_descriptors_and_memory_bounded(env, t
         threads.append(os_threads())
         fds.append(open_fds())
         rss.append(round(rss_mb(), 1))
+    print(f"after each recording: threads {threads}, fds {fds}, RSS (MB) {rss}")
     assert_bounded(threads, fds, rss)
     check_files(paths, ids)
 
@@ -149,6 +151,7 @@ def test_many_recorded_episodes_do_not_grow_memory(tmp_path):
             rss.append(round(rss_mb(), 1))
         os.remove(env.paths[-1])
     env.close()
+    print(f"RSS (MB) every 20 recorded episodes of 100 steps: {rss}")
     assert rss[-1] - rss[1] < 10, f"RSS (MB) every 20 episodes: {rss}"
 
 
