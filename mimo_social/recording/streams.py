@@ -178,10 +178,11 @@ def _mark_stuck(rec: rr.RecordingStream) -> None:
 def release_dropped() -> None:
     """Free the threads and buffers of every Rerun stream of this process that nobody refers to
     (blocking flush of the live ones first: Rerun's own cleanup). The global recording set by
-    the user (``rr.init``) stays. Nothing is done once a stream is stuck (it would block)."""
+    the user (``rr.init``) stays. Nothing is done once a stream is stuck, or while an open one
+    has lost its writer (that would block)."""
     with _LOCK:
-        if _STUCK:
-            return
+        if _STUCK or any(stream._writer_alive() is False for stream in list(_OPEN)):
+            return             # a writer died under an open recording: its flush could block
         previous = rr.get_global_data_recording()
         bindings.flush_and_cleanup_orphaned_recordings()
         if previous is not None:

@@ -155,6 +155,29 @@ def test_many_recorded_episodes_do_not_grow_memory(tmp_path):
     assert rss[-1] - rss[1] < 10, f"RSS (MB) every 20 episodes: {rss}"
 
 
+def test_closing_a_recorder_keeps_the_users_own_rerun_recording(env, tmp_path):
+    """The cleanup that frees closed streams (Rerun's, as ``rr.init`` runs it) must leave the
+    global recording the user made alone."""
+    import rerun as rr
+
+    rr.init("user_app", recording_id="user-recording")
+    rr.save(tmp_path / "user.rrd")
+    try:
+        a = zero(env)
+        for i in range(2):
+            with Recorder(env, tmp_path / f"r{i}.rrd") as rec:
+                obs, _ = env.reset(seed=i)
+                rec.log_reset(obs)
+                env.step(a)
+        user = rr.get_global_data_recording()
+        assert user is not None and user.get_recording_id() == "user-recording"
+        rr.log("/note", rr.TextLog("still here"))
+    finally:
+        rr.disconnect()
+        rr.set_global_data_recording(None)
+    assert "/note" in summarize(tmp_path / "user.rrd")["entities"]
+
+
 # -- paths that cannot be written ----------------------------------------------------------------
 
 def _unwritable_cases(tmp_path):
