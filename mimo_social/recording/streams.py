@@ -152,7 +152,9 @@ def _check_path(path: Path) -> None:
 # -- exit: Rerun's own hook would wait forever on a stuck stream ----------------------------------
 
 def _finish_open_streams() -> None:
-    for stream in list(_OPEN):
+    with _LOCK:
+        streams = list(_OPEN)
+    for stream in streams:
         try:
             stream.close()
         except Exception:   # noqa: BLE001  (at exit: finish what can be finished)
@@ -231,7 +233,8 @@ class FileStream:
             raise _error(self.path, "cannot write the file", code, cause or str(failure))
         new = (after - before) if before is not None and after is not None else set()
         self._writer = next(iter(new)) if len(new) == 1 else None
-        _OPEN.add(self)
+        with _LOCK:
+            _OPEN.add(self)
 
     def _writer_alive(self) -> bool | None:
         if self._writer is None:
@@ -266,7 +269,8 @@ class FileStream:
             cause += f" ({message})"
         size = _size(self.path)
         self.failed = _error(self.path, f"writing failed after {size} bytes", code, cause)
-        _OPEN.discard(self)
+        with _LOCK:
+            _OPEN.discard(self)
         if stuck:   # Rerun's forwarding thread waits for the dead writer: leave it alone
             _mark_stuck(self.rec)
             self.rec = None
@@ -284,7 +288,8 @@ class FileStream:
             return
         self.wait_written()
         self.rec.disconnect()          # the writer writes the footer and ends
-        _OPEN.discard(self)
+        with _LOCK:
+            _OPEN.discard(self)
         self._drop()
         if not bindings.check_for_rrd_footer(str(self.path)):
             code, cause = write_problem(self.path)
