@@ -88,6 +88,8 @@ class ScriptedPartners(ParallelWrapper):
     def step(self, actions: Mapping[str, Any]):
         if not isinstance(actions, Mapping):
             raise ValueError(f"actions must be a dict agent -> action, got {type(actions).__name__}")
+        if self.__dict__.get("_seeds") is None:   # the partners are set up by this reset
+            raise RuntimeError("step() called before reset(); call reset(seed=...) first")
         scripted = [a for a in actions if a in self.partners]
         if scripted:
             raise ValueError(f"actions given for scripted agent(s) {scripted}; their partners "

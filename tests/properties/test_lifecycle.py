@@ -42,9 +42,7 @@ RENDER_SIZE = (12, 16)
 #: partner scripted)
 ENVS = ([e.name for e in CATALOG] + ["mirror_8x8_eyes"]
         + [f"{e.name}/scripted" for e in CATALOG if e.social])
-#: the scripted partners of these act before the env checks that it was reset
-#: (an AttributeError inside the partner instead of the env's RuntimeError)
-PARTNER_BEFORE_RESET = {"high_five/scripted", "handover/scripted"}
+
 
 
 def make_env(name: str):
@@ -69,10 +67,7 @@ class Model:
         self.by_seed: dict[int, dict] = {}
 
 
-@pytest.fixture(scope="module", params=[
-    pytest.param(n, marks=pytest.mark.xfail(reason="a scripted partner acts before the env "
-                                                   "checks that it was reset", strict=False))
-    if n in PARTNER_BEFORE_RESET else n for n in ENVS])
+@pytest.fixture(scope="module", params=ENVS)
 def model(request):
     env = make_env(request.param)
     m = Model(env)
