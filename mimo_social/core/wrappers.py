@@ -205,8 +205,9 @@ def flat_action_space(space: spaces.Space) -> spaces.Space:
 # -- the PettingZoo wrapper ---------------------------------------------------------------------
 class ParallelWrapper(ParallelEnv):
     """Base of this package's ParallelEnv wrappers: holds ``env``, and passes ``unwrapped``,
-    ``metadata``, ``render_mode``, ``render``, ``close``, ``state``, ``state_space`` and every
-    other public attribute it does not define itself on to it."""
+    ``metadata``, ``render_mode``, the live ``agents``, the spaces, ``render``, ``close``,
+    ``state``, ``state_space`` and every other public attribute it does not define itself on to
+    it."""
 
     def __init__(self, env: ParallelEnv):
         if not isinstance(env, ParallelEnv):
@@ -219,6 +220,17 @@ class ParallelWrapper(ParallelEnv):
     @property
     def unwrapped(self):
         return self.env.unwrapped
+
+    # the live agents and the spaces are the wrapped env's unless a wrapper changes them
+    @property
+    def agents(self):
+        return self.env.agents
+
+    def observation_space(self, agent):
+        return self.env.observation_space(agent)
+
+    def action_space(self, agent):
+        return self.env.action_space(agent)
 
     def render(self, *args):
         # RLlib's ParallelPettingZooEnv passes a mode (see MimoParallelEnv.render)
@@ -255,11 +267,6 @@ class FlattenParallel(ParallelWrapper):
         self._act = {a: _ActionDecoder(env.action_space(a)) for a in self.possible_agents}
         self._obs_spaces = {a: f.space for a, f in self._obs.items()}
         self._act_spaces = {a: d.space for a, d in self._act.items()}
-
-    # the live agents are always the wrapped env's
-    @property
-    def agents(self):
-        return self.env.agents
 
     def observation_space(self, agent):
         try:
@@ -338,16 +345,6 @@ class NumericInfos(ParallelWrapper):
             _check_spec(a, spec)
             self._specs[a] = spec
         self._keys = {a: tuple(self._encode(a, {})) for a in self.possible_agents}
-
-    @property
-    def agents(self):
-        return self.env.agents
-
-    def observation_space(self, agent):
-        return self.env.observation_space(agent)
-
-    def action_space(self, agent):
-        return self.env.action_space(agent)
 
     def info_keys(self, agent) -> tuple[str, ...]:
         """The keys of ``agent``'s numeric infos, in order."""

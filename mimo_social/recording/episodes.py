@@ -118,17 +118,6 @@ class RecordingParallelEnv(ParallelWrapper):
         self.paths: list[Path] = []          # the files this wrapper (in this process) wrote
         self.possible_agents = list(env.possible_agents)
 
-    # the live agents and the spaces are the wrapped env's
-    @property
-    def agents(self):
-        return self.env.agents
-
-    def observation_space(self, agent):
-        return self.env.observation_space(agent)
-
-    def action_space(self, agent):
-        return self.env.action_space(agent)
-
     def _recorded_env(self):
         return self.env if hasattr(self.env, "world") else self.env.unwrapped
 
