@@ -17,9 +17,10 @@ from . import docs
 from . import bench_recording
 from . import baselines
 from . import soak
+from . import bench_engines
 
 SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, bench_vision, figure, docs,
-               bench_recording, baselines, soak)
+               bench_recording, baselines, soak, bench_engines)
 
 
 class UsageError(SystemExit):

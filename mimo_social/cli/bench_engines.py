@@ -1,0 +1,124 @@
+"""``mimo-social bench-engines``: SB3 and RLlib training throughput side by side.
+
+``mimo-social bench-engines --tasks high_five,mirror --workers 1,2 --seconds 30 --out DIR``
+    PPO with one shared policy (64x64 MLP) on each task, with SB3 (``workers`` spawned worker
+    processes) and with RLlib (``workers`` env runners), ``--seconds`` of training each after a
+    warm-up iteration; prints env steps per second and the scaling efficiency from 1 to n workers
+    and writes ``DIR/engines.json``, ``DIR/engines.md`` and ``DIR/engines.png``
+    (:mod:`mimo_social.bench.engines`, :mod:`mimo_social.train.throughput`). Needs RLlib
+    (``pip install -e '.[rllib]'``, see docs/scaling.md) unless ``--engines sb3``.
+    ``--address auto|HOST:PORT`` runs RLlib's side on an existing Ray cluster (default: a local
+    Ray with ``max(workers) + 1`` CPUs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import shlex
+from pathlib import Path
+
+from ..bench import engines as bench
+from ..train import MULTI_TASKS
+from ..train.throughput import ENGINES, rllib_throughput, sb3_throughput
+from ._args import comma_choices, output_dir, positive_float, positive_int, seed, write_file
+
+__all__ = ["add_parser", "run"]
+
+
+def _ints(text: str) -> list[int]:
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        values = []
+    if not values or min(values) < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected positive integers, e.g. 1,2")
+    return values
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    p = subparsers.add_parser(
+        "bench-engines", help="SB3 vs RLlib: env steps/s while training, 1 and 2 workers",
+        description="PPO training throughput (env steps per second) of SB3 (worker processes) "
+        "and RLlib (env runners) side by side on the same tasks with the same policy, and the "
+        "scaling efficiency from 1 worker to n.")
+    p.add_argument("--tasks", default="high_five,mirror",
+                   type=comma_choices(list(MULTI_TASKS), "task", as_text=True),
+                   help="social tasks, comma-separated (default: high_five,mirror)")
+    p.add_argument("--engines", default="sb3,rllib",
+                   type=comma_choices(list(ENGINES), "engine", as_text=True))
+    p.add_argument("--workers", default=[1, 2], type=_ints,
+                   help="worker processes / env runners to measure, e.g. 1,2 (default)")
+    p.add_argument("--seconds", type=positive_float, default=30.0,
+                   help="timed training per configuration, after one warm-up iteration")
+    p.add_argument("--rollout", type=positive_int, default=1024,
+                   help="env steps per training iteration (default 1024)")
+    p.add_argument("--minibatch", type=positive_int, default=256,
+                   help="samples (agent transitions) per minibatch (default 256)")
+    p.add_argument("--epochs", type=positive_int, default=4, help="passes per iteration")
+    p.add_argument("--hidden", default=[64, 64], type=_ints,
+                   help="policy and value MLP layer sizes (default 64,64)")
+    p.add_argument("--seed", type=seed, default=0)
+    p.add_argument("--torch-threads", type=positive_int, default=1,
+                   help="torch threads of the learner (this process), both engines (default 1)")
+    p.add_argument("--address", default=None, help="RLlib: join this Ray cluster (auto or "
+                   "HOST:PORT); default: start a local Ray")
+    p.add_argument("--out", required=True, type=output_dir,
+                   help="writes engines.json, engines.md and engines.png here")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    engines = args.engines.split(",")
+    kw = dict(seed=args.seed, rollout=args.rollout, minibatch=args.minibatch,
+              epochs=args.epochs, hidden=tuple(args.hidden))
+    measure = {}
+    if "sb3" in engines:
+        measure["sb3"] = functools.partial(sb3_throughput, **kw)
+    started = False
+    if "rllib" in engines:
+        try:
+            import ray
+        except ImportError:
+            raise RuntimeError("RLlib is not installed: pip install -e '.[rllib]' (docs/"
+                               "scaling.md), or measure SB3 alone with --engines sb3") from None
+        if not ray.is_initialized():
+            if args.address:
+                ray.init(address=args.address, log_to_driver=False)
+            else:
+                ray.init(num_cpus=max(args.workers) + 1, include_dashboard=False,
+                         log_to_driver=False)
+            started = True
+        measure["rllib"] = functools.partial(rllib_throughput, **kw)
+    import torch
+    torch.set_num_threads(args.torch_threads)      # the learner's threads, both engines alike
+    settings = {"algorithm": "PPO, one shared policy", "MLP": "x".join(map(str, args.hidden)),
+                "env steps per iteration": args.rollout, "minibatch": args.minibatch,
+                "epochs": args.epochs, "seed": args.seed,
+                "learner torch threads": args.torch_threads,
+                "one world per worker": "SB3 spawned worker processes, RLlib env runners"}
+    command = (f"mimo-social bench-engines --tasks {args.tasks} --engines {args.engines} "
+               f"--workers {','.join(map(str, args.workers))} --seconds {args.seconds:g} "
+               f"--rollout {args.rollout} --minibatch {args.minibatch} --epochs {args.epochs} "
+               f"--hidden {','.join(map(str, args.hidden))} --seed {args.seed} "
+               f"--torch-threads {args.torch_threads} "
+               + (f"--address {shlex.quote(args.address)} " if args.address else "")
+               + f"--out {shlex.quote(str(args.out))}")
+    try:
+        res = bench.run(measure, args.tasks.split(","), args.workers, args.seconds,
+                        command=command, settings=settings)
+    finally:
+        if started:
+            import ray
+            ray.shutdown()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    import json
+    write_file(out / "engines.json", json.dumps(res, indent=1))
+    table = bench.markdown(res)
+    write_file(out / "engines.md", table)
+    bench.plot(res, out / "engines.png")
+    print(table)
+    print(f"wrote {out}/engines.json, engines.md, engines.png")
+    return 0
