@@ -21,6 +21,8 @@
 
 from __future__ import annotations
 
+import argparse
+import json
 import math
 import sys
 from pathlib import Path
@@ -35,6 +37,18 @@ __all__ = ["add_parser"]
 
 
 _json_arg = json_object   # (kept for callers of the old name)
+
+
+def non_negative_float(text: str) -> float:
+    """A finite number >= 0."""
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; allowed: a finite number "
+                                         ">= 0") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"{text} not allowed; allowed: a finite number >= 0")
+    return value
 
 
 def _common(p, steps_required: bool = True):
@@ -61,20 +75,77 @@ def _common(p, steps_required: bool = True):
                    "policy (mimo_social.train.obs_norm.RunningNorm; saved in the model): for eye images")
 
 
+#: train options of --engine rllib only, with their defaults
+_RLLIB_OPTS = {"address": None, "num_env_runners": 1, "num_envs_per_runner": 1,
+               "num_cpus_per_learner": 1, "num_gpus_per_learner": 0.0}
+
+
+def ray_address(text: str) -> str:
+    """``auto``, ``HOST:PORT`` or ``ray://HOST:PORT`` (a Ray cluster to join)."""
+    allowed = "auto, HOST:PORT or ray://HOST:PORT"
+    rest = text[len("ray://"):] if text.startswith("ray://") else text
+    if text == "auto":
+        return text
+    host, sep, port = rest.rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise argparse.ArgumentTypeError(f"{text!r} not allowed; allowed: {allowed}")
+    return text
+
+
+def _engine_conflicts(args) -> str | None:
+    """Options of the other engine given with this one, as an error text (None if none)."""
+    given = lambda name, default: getattr(args, name) not in (None, default)  # noqa: E731
+    if args.engine == "sb3":
+        bad = [f"--{k.replace('_', '-')}" for k in _RLLIB_OPTS if given(k, None)]
+        if args.algo == "appo":
+            bad.append("--algo appo")
+        if bad:
+            return f"{', '.join(bad)}: for --engine rllib (the default engine is sb3)"
+        return None
+    bad = [f for f, k, d in (("--n-envs", "n_envs", 1), ("--n-cpus", "n_cpus", 0))
+           if given(k, d)]
+    if bad:
+        return (f"{', '.join(bad)}: for --engine sb3; with --engine rllib use --num-env-runners "
+                "and --num-envs-per-runner")
+    return None
+
+
+def _train_rllib(args) -> dict:
+    from ..train.rllib import require_ray
+    require_ray()
+    from ..train.rllib import train_rllib
+    opts = {k: (d if getattr(args, k) is None else getattr(args, k))
+            for k, d in _RLLIB_OPTS.items()}
+    return train_rllib(args.task, args.algo, args.steps, args.seed, args.out, mode=args.mode,
+                       eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+                       checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
+                       env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs,
+                       normalize_obs=args.normalize_obs, **opts)
+
+
 def _train_main(args) -> int:
+    conflict = _engine_conflicts(args)
+    if conflict:
+        print(f"mimo-social train: error: {conflict}", file=sys.stderr)
+        return 2
     try:
-        res = train(args.task, args.algo, args.steps, args.seed, args.out,
-                    eval_every=args.eval_every, eval_episodes=args.eval_episodes,
-                    checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
-                    env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs, mode=args.mode,
-                    n_envs=args.n_envs, n_cpus=args.n_cpus, normalize_obs=args.normalize_obs)
+        if args.engine == "rllib":
+            res = _train_rllib(args)
+        else:
+            res = train(args.task, args.algo, args.steps, args.seed, args.out,
+                        eval_every=args.eval_every, eval_episodes=args.eval_episodes,
+                        checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
+                        env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs,
+                        mode=args.mode, n_envs=args.n_envs, n_cpus=args.n_cpus,
+                        normalize_obs=args.normalize_obs)
     except TrainInputError as e:
         print(f"mimo-social train: error: {e}", file=sys.stderr)
         return 2
     last = res["last_eval"]
     success = last["eval_success_rate"]
     mode = f" ({res['mode']})" if res.get("mode") else ""
-    print(f"trained {args.algo.upper()} on {args.task}{mode} for {res['timesteps']} steps in "
+    engine = " with RLlib" if args.engine == "rllib" else ""
+    print(f"trained {args.algo.upper()}{engine} on {args.task}{mode} for {res['timesteps']} steps in "
           f"{res['wall_time_s']:.0f} s; last evaluation: return {last['eval_return_mean']:.3g}"
           + ("" if math.isnan(success) else f", success {success:.0%}"))
     for a in res.get("agents", ()):
@@ -87,12 +158,26 @@ def _train_main(args) -> int:
     return 0
 
 
-def _eval_main(args) -> int:
+def _run_engine(run) -> str:
+    """``rllib`` for a run of --engine rllib (its config.json says so), else ``sb3``."""
     try:
-        res = evaluate(args.dir, args.episodes, model=args.model, seed=args.seed,
-                       deterministic=not args.stochastic, record=args.record, video=args.video,
-                       frames=args.frames, frame_every=args.frame_every,
-                       env_kwargs=args.env_kwargs)
+        return json.loads((Path(run) / "config.json").read_text()).get("engine", "sb3")
+    except (OSError, ValueError, AttributeError):
+        return "sb3"   # (evaluate says what is missing)
+
+
+def _eval_main(args) -> int:
+    kwargs = dict(model=args.model, seed=args.seed, deterministic=not args.stochastic,
+                  record=args.record, video=args.video, frames=args.frames,
+                  frame_every=args.frame_every, env_kwargs=args.env_kwargs)
+    try:
+        if _run_engine(args.dir) == "rllib":
+            from ..train.rllib import require_ray
+            require_ray()
+            from ..train.rllib import evaluate_rllib
+            res = evaluate_rllib(args.dir, args.episodes, **kwargs)
+        else:
+            res = evaluate(args.dir, args.episodes, **kwargs)
     except (VideoUnavailable, FileNotFoundError, TrainInputError) as e:
         print(f"mimo-social eval: error: {e}", file=sys.stderr)
         return 2
@@ -125,7 +210,16 @@ def _compare_main(args) -> int:
 
 def _compare_steps(args, algos):
     """--steps for every algorithm, overridden per algorithm by --steps-per-algo."""
-    per = parse_steps_per_algo(args.steps_per_algo) if args.steps_per_algo else {}
+    per = {}
+    if args.steps_per_algo and args.engine == "rllib":   # (appo too)
+        for part in filter(None, (x.strip() for x in args.steps_per_algo.split(","))):
+            algo, _, value = part.partition("=")
+            if not value.strip().isdigit() or int(value) < 1:
+                raise TrainInputError(f"steps per algorithm {part!r}: expected ALGO=STEPS, "
+                                      "e.g. ppo=100000,appo=100000")
+            per[algo.strip()] = int(value)
+    elif args.steps_per_algo:
+        per = parse_steps_per_algo(args.steps_per_algo)
     unknown = [a for a in per if a not in algos]
     if unknown:
         raise TrainInputError(f"--steps-per-algo names {', '.join(unknown)}, which --algos "
@@ -137,8 +231,36 @@ def _compare_steps(args, algos):
     return {a: per.get(a, 1 if args.steps is None else args.steps) for a in algos}
 
 
+#: compare options of --engine rllib only, with their defaults
+_RLLIB_COMPARE_OPTS = {"address": None, "num_env_runners": 1, "num_envs_per_runner": 1,
+                       "num_cpus_per_learner": 1, "num_gpus_per_learner": 0.0,
+                       "max_concurrent": None, "num_cpus": None}
+
+
+def _compare_rllib(args, algos, steps):
+    from ..train.rllib import require_ray
+    require_ray()
+    from ..train.rllib.tune import compare_rllib
+    if args.jobs != 1:
+        raise TrainInputError("--jobs is for --engine sb3; with --engine rllib, Ray Tune runs as "
+                              "many runs at once as the cluster's CPUs hold (--max-concurrent "
+                              "caps it)")
+    opts = {k: (d if getattr(args, k) is None else getattr(args, k))
+            for k, d in _RLLIB_COMPARE_OPTS.items()}
+    return compare_rllib(args.task, algos, args.seeds, steps, args.out,
+                         plot_only=args.plot_only, mode=args.mode, eval_every=args.eval_every,
+                         eval_episodes=args.eval_episodes,
+                         checkpoint_every=args.checkpoint_every, env_kwargs=args.env_kwargs,
+                         algo_kwargs=args.algo_kwargs, normalize_obs=args.normalize_obs, **opts)
+
+
 def _compare_run(args, algos):
     steps = _compare_steps(args, algos)
+    if args.engine == "rllib":
+        return _compare_rllib(args, algos, steps)
+    bad = [f"--{k.replace('_', '-')}" for k in _RLLIB_COMPARE_OPTS if getattr(args, k) is not None]
+    if bad:
+        raise TrainInputError(f"{', '.join(bad)}: for --engine rllib (the default engine is sb3)")
     return compare(args.task, algos, args.seeds, steps, args.out, jobs=args.jobs,
                    plot_only=args.plot_only, mode=args.mode, eval_every=args.eval_every,
                    eval_episodes=args.eval_episodes, checkpoint_every=args.checkpoint_every,
@@ -150,9 +272,11 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser("train", help="train PPO or SAC on a one-agent or social task",
                               description="Train a Stable-Baselines3 policy (default "
                               "hyperparameters) with periodic evaluation, checkpoints and a "
-                              "learning curve (CSV and PNG).")
+                              "learning curve (CSV and PNG); --engine rllib trains with RLlib "
+                              "on Ray (a local Ray, or a cluster with --address).")
     _common(p)
-    p.add_argument("--algo", required=True, choices=ALGOS)
+    p.add_argument("--algo", required=True, choices=(*ALGOS, "appo"),
+                   help="ppo, sac; appo with --engine rllib")
     p.add_argument("--seed", type=seed, default=0)
     p.add_argument("--out", required=True, type=output_dir, help="output directory")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -161,6 +285,19 @@ def add_parser(subparsers) -> None:
     p.add_argument("--n-cpus", type=non_negative_int, default=0, help="--mode shared: worker "
                    "processes for "
                    "the worlds (0: all in this process)")
+    g = p.add_argument_group("RLlib engine (--engine rllib; needs the rllib extra)")
+    g.add_argument("--engine", choices=("sb3", "rllib"), default="sb3",
+                   help="sb3 (Stable-Baselines3, the default) or rllib (RLlib on Ray)")
+    g.add_argument("--address", type=ray_address, default=None,
+                   help="join this Ray cluster (auto or HOST:PORT; default: start a local Ray)")
+    g.add_argument("--num-env-runners", type=non_negative_int, default=None,
+                   help="env runner processes (default 1; 0: sample in this process)")
+    g.add_argument("--num-envs-per-runner", type=positive_int, default=None,
+                   help="envs stepped together in each runner (default 1)")
+    g.add_argument("--num-cpus-per-learner", type=positive_int, default=None,
+                   help="CPUs of the learner (default 1)")
+    g.add_argument("--num-gpus-per-learner", type=non_negative_float, default=None,
+                   help="GPUs of the learner (default 0; a fraction shares one)")
     p.set_defaults(func=_train_main)
 
     p = subparsers.add_parser("eval", help="run a trained policy (optionally record or film it)",
@@ -193,7 +330,8 @@ def add_parser(subparsers) -> None:
     p.add_argument("--steps-per-algo", default=None, metavar="ALGO=STEPS,...",
                    help="a step budget per algorithm over --steps, e.g. ppo=100000,sac=20000 "
                    "(SAC costs far more per step than PPO)")
-    p.add_argument("--algos", default="ppo,sac", help="comma-separated: ppo,sac")
+    p.add_argument("--algos", default="ppo,sac", help="comma-separated: ppo,sac (--engine "
+                   "rllib: ppo,appo,sac)")
     p.add_argument("--seeds", type=positive_int, default=3, help="seeds 0 .. n-1 per algorithm")
     p.add_argument("--out", required=True, type=output_dir,
                    help="output directory (one sub-directory a run)")
@@ -201,4 +339,24 @@ def add_parser(subparsers) -> None:
                    "process with torch on one thread (the runs' files are the same as with "
                    "--jobs 1, apart from wall times)")
     p.add_argument("--plot-only", action="store_true", help="only re-plot existing runs")
+    g = p.add_argument_group("RLlib engine (--engine rllib: each run a Ray Tune trial; needs "
+                             "the rllib extra, docs/scaling.md)")
+    g.add_argument("--engine", choices=("sb3", "rllib"), default="sb3",
+                   help="sb3 (Stable-Baselines3, the default) or rllib (RLlib, runs as Ray Tune "
+                   "trials in parallel across the Ray cluster)")
+    g.add_argument("--address", type=ray_address, default=None,
+                   help="join this Ray cluster (auto or HOST:PORT; default: start a local Ray); "
+                   "--out must then be on a file system every node writes to")
+    g.add_argument("--num-cpus", type=positive_int, default=None,
+                   help="CPUs of the local Ray started without --address (default: all)")
+    g.add_argument("--max-concurrent", type=positive_int, default=None,
+                   help="runs at a time at most (default: as many as the cluster's resources hold)")
+    g.add_argument("--num-env-runners", type=non_negative_int, default=None,
+                   help="env runner processes per run (default 1; 0: sample in the run's process)")
+    g.add_argument("--num-envs-per-runner", type=positive_int, default=None,
+                   help="envs stepped together in each runner (default 1)")
+    g.add_argument("--num-cpus-per-learner", type=positive_int, default=None,
+                   help="CPUs of each run's learner (default 1)")
+    g.add_argument("--num-gpus-per-learner", type=non_negative_float, default=None,
+                   help="GPUs of each run's learner (default 0; a fraction shares one)")
     p.set_defaults(func=_compare_main)

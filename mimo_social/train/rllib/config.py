@@ -24,8 +24,11 @@ num_gpus_per_learner=0, normalize_obs=False) -> AlgorithmConfig``
   and std, kept in the checkpoint), as ``--normalize-obs`` of the SB3 path; eye images are
   already scaled to [0, 1] by the flat env either way.
 
-``module_ids(task, mode, agents)``: agent -> RLModule id. The envs are made by the env creator
-of :mod:`mimo_social.train.rllib.env` (registered by :func:`build_config`).
+``module_ids(task, mode, agents)``: agent -> RLModule id. The envs are made in the env runners
+by :class:`~mimo_social.train.rllib.env.CatalogEnv` (the env creator of
+:mod:`mimo_social.train.rllib.env` as a class) from ``env_config = {"task", "mode",
+"env_kwargs"}``; ``config.environment(env_name(task))`` after ``register_rllib_envs()`` is the
+same env by its tune-registry name.
 """
 
 from __future__ import annotations
@@ -125,14 +128,13 @@ def build_config(task: str, mode: str | None = None, algo: str = "ppo", seed: in
                  num_cpus_per_learner: int = 1, num_gpus_per_learner: float = 0,
                  normalize_obs: bool = False, spaces: tuple | None = None):
     """The ``AlgorithmConfig`` (new API stack, torch) of a run; see the module docstring.
-    ``spaces``: :func:`flat_spaces`'s answer, when the caller has it already. Registers the
-    env creators (call after ``ray.init`` when joining a cluster)."""
+    ``spaces``: :func:`flat_spaces`'s answer, when the caller has it already."""
     from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
     from ray.rllib.core.rl_module.multi_rl_module import MultiRLModuleSpec
     from ray.rllib.core.rl_module.rl_module import RLModuleSpec
 
     from .callbacks import EpisodeLog
-    from .env import env_name, register_rllib_envs
+    from .env import CatalogEnv
 
     check_task(task)
     mode = check_mode(task, mode)
@@ -154,17 +156,16 @@ def build_config(task: str, mode: str | None = None, algo: str = "ppo", seed: in
             obs_space, act_space = per_agent[a]
             specs[ids[a]] = RLModuleSpec(observation_space=obs_space, action_space=act_space,
                                          model_config=model_config)
-    register_rllib_envs()
     config = (_algo_config_class(algo)()
               .api_stack(enable_rl_module_and_learner=True,
                          enable_env_runner_and_connector_v2=True)
               .framework("torch")
-              .environment(env_name(task),
+              .environment(CatalogEnv,
                            env_config={"task": task, "mode": mode, "env_kwargs": env_kwargs},
                            disable_env_checking=True)
               .env_runners(num_env_runners=int(num_env_runners),
                            num_envs_per_env_runner=int(num_envs_per_runner),
-                           num_cpus_per_env_runner=1, rollout_fragment_length="auto")
+                           num_cpus_per_env_runner=1)
               .learners(num_learners=0, num_cpus_per_learner=num_cpus_per_learner,
                         num_gpus_per_learner=num_gpus_per_learner)
               .multi_agent(policies=set(specs),
@@ -173,6 +174,8 @@ def build_config(task: str, mode: str | None = None, algo: str = "ppo", seed: in
               .rl_module(rl_module_spec=MultiRLModuleSpec(rl_module_specs=specs))
               .callbacks(EpisodeLog)
               .debugging(seed=int(seed)))
+    if algo != "appo":  # (APPO's minibatches are whole fragments: keep its 50)
+        config = config.env_runners(rollout_fragment_length="auto")
     if normalize_obs:
         from ray.rllib.connectors.env_to_module import MeanStdFilter
         config = config.env_runners(

@@ -8,7 +8,8 @@
     The env creator registered under those names. ``config`` (RLlib's ``env_config``, an
     ``EnvContext`` in a runner) holds ``task``, ``mode`` (``shared``, ``independent``,
     ``scripted``, or None for a one-agent task) and ``env_kwargs``. It returns a
-    :class:`MimoMultiAgentEnv` around :func:`flat_env`.
+    :class:`MimoMultiAgentEnv` around :func:`flat_env`. :class:`CatalogEnv` is the same as a
+    class (``CatalogEnv(env_config)``): what ``build_config`` hands RLlib.
 ``flat_env(task, mode, **env_kwargs)``
     ``FlattenParallel`` of the task's ParallelEnv: every agent (``shared``, ``independent``), the
     learner with its scripted partner (``scripted``: the module's ``scripted_env()``), or the
@@ -31,7 +32,7 @@ from ...core.wrappers import FlattenParallel
 from ...envs.catalog import entry
 from ..tasks import ALL_TASKS, TASKS, check_mode, task_module
 
-__all__ = ["EPISODE_KEY", "MimoMultiAgentEnv", "env_name", "flat_env", "make_rllib_env",
+__all__ = ["EPISODE_KEY", "CatalogEnv", "MimoMultiAgentEnv", "env_name", "flat_env", "make_rllib_env",
            "register_rllib_envs"]
 
 PREFIX = "mimo_social/"
@@ -105,13 +106,27 @@ class MimoMultiAgentEnv(MultiAgentEnv):
         self.par_env.close()
 
 
+def _flat_from_config(config: Mapping[str, Any] | None) -> FlattenParallel:
+    config = dict(config or {})
+    return flat_env(config["task"], config.get("mode"), render_mode=config.get("render_mode"),
+                    **dict(config.get("env_kwargs") or {}))
+
+
 def make_rllib_env(config: Mapping[str, Any] | None = None) -> MimoMultiAgentEnv:
     """The env creator of the tune registry: ``config`` holds ``task``, ``mode``, ``env_kwargs``
     (and optionally ``render_mode``)."""
-    config = dict(config or {})
-    return MimoMultiAgentEnv(flat_env(config["task"], config.get("mode"),
-                                      render_mode=config.get("render_mode"),
-                                      **dict(config.get("env_kwargs") or {})))
+    return MimoMultiAgentEnv(_flat_from_config(config))
+
+
+class CatalogEnv(MimoMultiAgentEnv):
+    """:func:`make_rllib_env` as a class (``CatalogEnv(env_config)``), what
+    :func:`~mimo_social.train.rllib.config.build_config` gives RLlib: a class travels to the
+    env runners by value, so it does not depend on the tune registry, whose names are kept per
+    Ray job (a process that joins a cluster a second time would look them up under the old
+    job)."""
+
+    def __init__(self, config: Mapping[str, Any] | None = None):
+        super().__init__(_flat_from_config(config))
 
 
 def register_rllib_envs() -> list[str]:
