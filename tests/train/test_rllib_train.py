@@ -86,11 +86,14 @@ def _cluster_pids(temp_dir: str) -> list[int]:
     return pids
 
 
-def _use_token(token: str) -> None:
-    """This process talks to the test's cluster with its token (Ray reads the mode and the
-    token once and caches them)."""
-    os.environ["RAY_AUTH_MODE"] = "token"
-    os.environ["RAY_AUTH_TOKEN"] = token
+def _set_auth(env: dict) -> None:
+    """Ray's authentication settings of this process (Ray reads the mode and the token once and
+    caches them: reload both)."""
+    for k, v in env.items():
+        if v is None:
+            os.environ.pop(k, None)
+        else:
+            os.environ[k] = v
     from ray._raylet import AuthenticationTokenLoader, Config
     Config.initialize("")
     AuthenticationTokenLoader.instance().reset_cache()
@@ -114,7 +117,7 @@ def cluster():
          "--disable-usage-stats"], env=env, capture_output=True, text=True, timeout=120)
     try:
         assert start.returncode == 0, start.stderr[-2000:]
-        _use_token(token)
+        _set_auth({"RAY_AUTH_MODE": "token", "RAY_AUTH_TOKEN": token})  # the test's own token
         yield f"127.0.0.1:{port}"
     finally:
         if ray.is_initialized():
@@ -128,11 +131,7 @@ def cluster():
             deadline = time.time() + 3
             while _cluster_pids(temp_dir) and time.time() < deadline:
                 time.sleep(0.2)
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
+        _set_auth(saved)
         shutil.rmtree(temp_dir, ignore_errors=True)
 
 
