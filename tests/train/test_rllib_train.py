@@ -250,3 +250,58 @@ def test_vision_task_steps_in_an_env_runner(cluster, tmp_path):
             algo.stop()
     finally:
         ray.shutdown()
+
+
+def test_one_agent_task_with_sac_sampling_in_the_driver(cluster, tmp_path, capsys):
+    """reach (one agent) with SAC, no env runner process (--num-env-runners 0): the summary
+    columns only, as the SB3 path writes them for a one-agent task; eval --model best."""
+    out = tmp_path / "reach"
+    sac = {"train_batch_size_per_learner": 32, "num_steps_sampled_before_learning_starts": 50,
+           "fcnet_hiddens": [16]}
+    rc = main(["train", "--engine", "rllib", "--address", cluster, "--task", "reach", "--algo",
+               "sac", "--steps", "100", "--num-env-runners", "0", "--env-kwargs",
+               json.dumps(SHORT), "--algo-kwargs", json.dumps(sac), "--eval-episodes", "1",
+               "--out", str(out), "--no-progress"])
+    assert rc == 0, capsys.readouterr().err
+    rows = _rows(out / "progress.csv")
+    assert int(rows[-1]["timesteps"]) >= 100
+    assert not any(k.startswith("eval_return_mean_") for k in rows[0])
+    assert json.loads((out / "config.json").read_text())["modules"] == {"infant_0": "infant_0"}
+    assert main(["eval", str(out), "--episodes", "1", "--model", "best"]) == 0
+    assert "reach SAC best_checkpoint: 1 episodes" in capsys.readouterr().out
+
+
+def _modes():
+    from mimo_social.train import MULTI_TASKS, TASKS
+    return ([(t, None) for t in TASKS]
+            + [(t, m) for t in MULTI_TASKS for m in ("shared", "scripted")])
+
+
+@pytest.mark.parametrize("task, mode", _modes())
+def test_the_env_creator_makes_every_task_of_the_catalogue(task, mode):
+    pytest.importorskip("ray.rllib")
+    from mimo_social.train.rllib import env_name, make_rllib_env, register_rllib_envs
+    from mimo_social.train.rllib.env import EPISODE_KEY, CatalogEnv
+
+    assert env_name(task) in register_rllib_envs()
+    env = CatalogEnv({"task": task, "mode": mode, "env_kwargs": {"max_steps": 3}})
+    try:
+        obs, infos = env.reset(seed=0)
+        assert set(obs) == set(env.agents) == set(env.possible_agents)
+        for a in env.agents:
+            env.action_spaces[a].seed(0)
+        for step in range(3):
+            actions = {a: env.action_spaces[a].sample() for a in env.agents}
+            obs, rewards, terms, truncs, infos = env.step(actions)
+            for a, o in obs.items():
+                assert env.observation_spaces[a].contains(o), (a, step)
+        assert truncs["__all__"] or terms["__all__"]
+        assert all(EPISODE_KEY in infos[a] for a in env.possible_agents)
+        assert not env.agents
+    finally:
+        env.close()
+    made = make_rllib_env({"task": task, "mode": mode})   # the registered creator: the same env
+    try:
+        assert made.observation_spaces.keys() == env.observation_spaces.keys()
+    finally:
+        made.close()

@@ -138,8 +138,10 @@ def evaluate_rllib(run: str | Path, episodes: int = 10, *, model: str = "final",
     import torch
 
     from ..evaluation import _motor_slicer
+    from .runner import quiet_rllib
 
     torch.set_num_threads(1)
+    quiet_rllib()
     run = Path(run)
     config = json.loads((run / "config.json").read_text())
     if config.get("engine") != "rllib":

@@ -36,7 +36,7 @@ from ..runlog import RunLog, Schedule
 from ..tasks import TrainInputError, check_mode, check_task
 from .config import build_config, check_algo, flat_spaces, module_ids
 
-__all__ = ["train_rllib", "init_ray", "filter_state"]
+__all__ = ["train_rllib", "init_ray", "filter_state", "quiet_rllib"]
 
 
 def init_ray(address: str | None = None, num_cpus: int | None = None) -> bool:
@@ -55,8 +55,25 @@ def init_ray(address: str | None = None, num_cpus: int | None = None) -> bool:
             ray.init(num_cpus=num_cpus, **kwargs)
     except (ConnectionError, ValueError, RuntimeError) as e:
         where = f"the Ray cluster at {address!r}" if address else "a local Ray"
-        raise TrainInputError(f"cannot start or join {where}: {e}".splitlines()[0]) from None
+        hint = ""
+        if address and address != "auto":
+            hint = (" (is it up: 'ray status --address ...'? A cluster with token authentication "
+                    "also needs RAY_AUTH_MODE=token and its token in RAY_AUTH_TOKEN or "
+                    "~/.ray/auth_token here)")
+        raise TrainInputError(f"cannot start or join {where}: "
+                              f"{str(e).splitlines()[0] if str(e) else type(e).__name__}"
+                              + hint) from None
     return True
+
+
+def quiet_rllib() -> None:
+    """RLlib's notices about its new API stack and deprecations off in this process."""
+    import logging
+    import warnings
+
+    for name in ("ray.rllib", "ray.tune", "ray._common.deprecation"):
+        logging.getLogger(name).setLevel(logging.ERROR)
+    warnings.filterwarnings("ignore", category=DeprecationWarning, module=r"ray\..*")
 
 
 def _steps_of(result: Mapping) -> int:
@@ -97,6 +114,7 @@ def train_rllib(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     from ray import __version__ as ray_version
 
     torch.set_num_threads(1)
+    quiet_rllib()
     config = {"engine": "rllib", "task": task, "env_id": env_id, "algo": algo, "steps": steps,
               "seed": seed, "mode": mode, "normalize_obs": bool(normalize_obs),
               "env_kwargs": env_kwargs, "algo_kwargs": algo_kwargs, "eval_every": eval_every,
