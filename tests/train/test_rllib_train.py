@@ -63,7 +63,7 @@ def test_without_ray_one_line_says_how_to_install_it(tmp_path, capsys, monkeypat
     monkeypatch.setattr(rllib, "ray_available", lambda: False)
     assert _train(tmp_path, "--engine", "rllib") == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "mimo_social[rllib]" in err and "setup_rllib.sh" in err
+    assert err.count("\n") == 1 and '.[rllib]' in err and "setup_rllib.sh" in err
 
 
 # -- on a Ray cluster ----------------------------------------------------------------------------

@@ -1,8 +1,8 @@
 """RLlib (Ray) engine of ``mimo-social train --engine rllib`` and ``eval`` of its runs.
 
 Importing this package does not import ray: the names below are loaded on first use (ray is
-the ``rllib`` extra: ``pip install "mimo_social[rllib]"``, or ``scripts/setup_rllib.sh`` for a
-second venv). :func:`require_ray` raises a :class:`~mimo_social.train.tasks.TrainInputError`
+the ``rllib`` extra: ``pip install -e ".[rllib]"``, or ``scripts/setup_rllib.sh`` for a second
+venv). :func:`require_ray` raises a :class:`~mimo_social.train.tasks.TrainInputError`
 saying how to install it.
 
 ``build_config(task, mode=None, algo="ppo", seed=0, *, num_env_runners=1,
@@ -31,8 +31,8 @@ __all__ = ["build_config", "module_ids", "flat_spaces", "RLLIB_ALGOS", "make_rll
            "env_name", "register_rllib_envs", "flat_env", "train_rllib", "evaluate_rllib",
            "require_ray", "ray_available", "INSTALL_HINT"]
 
-INSTALL_HINT = ('install the rllib extra: pip install "mimo_social[rllib]" (ray[rllib]==2.60.0; '
-                "or scripts/setup_rllib.sh for a separate .venv-rllib)")
+INSTALL_HINT = ('install the rllib extra: pip install -e ".[rllib]" (ray[rllib]==2.60.0, which pins '
+                "gymnasium 1.2.2), or scripts/setup_rllib.sh for a separate .venv-rllib")
 
 _WHERE = {"build_config": "config", "module_ids": "config", "flat_spaces": "config",
           "RLLIB_ALGOS": "config", "make_rllib_env": "env", "env_name": "env",
