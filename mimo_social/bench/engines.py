@@ -87,6 +87,8 @@ def markdown(results: dict) -> str:
             lines.append("| " + " | ".join(cells) + " |")
     m = results["machine"]
     s = results.get("settings", {})
+    if not results["rows"]:
+        lines = []
     text = [
         f"Measured {results['measured']} on {m['cpu']} ({m['usable_cores']} usable cores), "
         f"{m['memory_gb']} GB, Python {m['python']}, MuJoCo {m['mujoco']}; "
@@ -99,6 +101,17 @@ def markdown(results: dict) -> str:
         "Env steps are world steps (each gives one sample per agent). Efficiency: "
         "steps/s with n workers / (n x steps/s with 1 worker).",
     ]
+    if results.get("to_success"):
+        text += ["", "| task | engine | workers | wall time to success | env steps then | "
+                 "best success |", "|---|---|---|---|---|---|"]
+        for t in results["to_success"]:
+            when = (f"**{t['wall_time_s']:.0f} s** ({t['wall_time_s'] / 60:.1f} min)"
+                    if t["reached"] else f"not reached in {t['steps_budget']} steps "
+                    f"({t['run_wall_time_s']:.0f} s)")
+            text.append(f"| `{t['task']}` | {t['engine']} | {t['workers']} | {when} | "
+                        f"{t['timesteps'] if t['reached'] else '-'} | {t['best_success']:.0%} |")
+        text.append(f"(success threshold {results['to_success'][0]['threshold']:.0%}: the first "
+                    "evaluation at or above it; each engine's own PPO defaults, 64x64 tanh MLP)")
     if results.get("command"):
         text += ["", "```", results["command"], "```"]
     return "\n".join(text) + "\n"

@@ -9,6 +9,10 @@
     (``pip install -e '.[rllib]'``, see docs/scaling.md) unless ``--engines sb3``.
     ``--address auto|HOST:PORT`` runs RLlib's side on an existing Ray cluster (default: a local
     Ray with ``max(workers) + 1`` CPUs).
+
+``--to-success 0.8 [--success-steps 300000]``
+    Also trains high five with each engine (PPO, each engine's defaults, ``--success-workers``
+    workers, 1 by default) and reports the wall time to the first evaluation with that success rate (long).
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ from pathlib import Path
 
 from ..bench import engines as bench
 from ..train import MULTI_TASKS
-from ..train.throughput import ENGINES, rllib_throughput, sb3_throughput
+from ..train.throughput import ENGINES, rllib_throughput, sb3_throughput, time_to_success
 from ._args import comma_choices, output_dir, positive_float, positive_int, seed, write_file
 
 __all__ = ["add_parser", "run"]
@@ -63,6 +67,19 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="torch threads of the learner (this process), both engines (default 1)")
     p.add_argument("--address", default=None, help="RLlib: join this Ray cluster (auto or "
                    "HOST:PORT); default: start a local Ray")
+    p.add_argument("--to-success", type=positive_float, default=None, metavar="RATE",
+                   help="also train high five with each engine (--success-workers workers, "
+                   "each engine's PPO defaults) and report the wall time to this evaluation success "
+                   "rate, e.g. 0.8 (long: minutes to hours)")
+    p.add_argument("--success-steps", type=positive_int, default=300_000,
+                   help="--to-success: step budget per engine (default 300000)")
+    p.add_argument("--success-eval-every", type=positive_int, default=10_000,
+                   help="--to-success: steps between evaluations (default 10000)")
+    p.add_argument("--success-workers", type=positive_int, default=1,
+                   help="--to-success: worker processes / env runners (default 1: both engines "
+                   "then update on 2048 env steps at a time)")
+    p.add_argument("--no-throughput", action="store_true",
+                   help="skip the steps/s measurements (with --to-success)")
     p.add_argument("--out", required=True, type=output_dir,
                    help="writes engines.json, engines.md and engines.png here")
     p.set_defaults(func=run)
@@ -71,6 +88,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     engines = args.engines.split(",")
+    if args.to_success is not None and args.to_success > 1:
+        raise ValueError(f"--to-success {args.to_success:g}: a success rate from 0 to 1, "
+                         "e.g. 0.8")
     kw = dict(seed=args.seed, rollout=args.rollout, minibatch=args.minibatch,
               epochs=args.epochs, hidden=tuple(args.hidden))
     measure = {}
@@ -87,7 +107,8 @@ def run(args: argparse.Namespace) -> int:
             if args.address:
                 ray.init(address=args.address, log_to_driver=False)
             else:
-                ray.init(num_cpus=max(args.workers) + 1, include_dashboard=False,
+                ray.init(num_cpus=max(*args.workers, args.success_workers) + 1,
+                         include_dashboard=False,
                          log_to_driver=False)
             started = True
         measure["rllib"] = functools.partial(rllib_throughput, **kw)
@@ -105,9 +126,24 @@ def run(args: argparse.Namespace) -> int:
                f"--torch-threads {args.torch_threads} "
                + (f"--address {shlex.quote(args.address)} " if args.address else "")
                + f"--out {shlex.quote(str(args.out))}")
+    if args.to_success is not None:
+        command += (f" --to-success {args.to_success:g} --success-steps {args.success_steps} "
+                    f"--success-eval-every {args.success_eval_every} "
+                    f"--success-workers {args.success_workers}")
+    if args.no_throughput:
+        command += " --no-throughput"
     try:
-        res = bench.run(measure, args.tasks.split(","), args.workers, args.seconds,
-                        command=command, settings=settings)
+        res = bench.run({} if args.no_throughput else measure, args.tasks.split(","),
+                        args.workers, args.seconds, command=command, settings=settings)
+        if args.to_success is not None:
+            res["to_success"] = []
+            for engine in engines:
+                print(f"high_five: {engine} until {args.to_success:.0%} success ...")
+                res["to_success"].append(time_to_success(
+                    engine, "high_five", Path(args.out) / f"to_success_{engine}",
+                    threshold=args.to_success, steps=args.success_steps,
+                    workers=args.success_workers, seed=args.seed,
+                    eval_every=args.success_eval_every))
     finally:
         if started:
             import ray
@@ -118,7 +154,8 @@ def run(args: argparse.Namespace) -> int:
     write_file(out / "engines.json", json.dumps(res, indent=1))
     table = bench.markdown(res)
     write_file(out / "engines.md", table)
-    bench.plot(res, out / "engines.png")
+    if res["rows"]:
+        bench.plot(res, out / "engines.png")
     print(table)
-    print(f"wrote {out}/engines.json, engines.md, engines.png")
+    print(f"wrote {out}/engines.json, engines.md" + (", engines.png" if res["rows"] else ""))
     return 0

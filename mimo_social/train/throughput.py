@@ -27,7 +27,7 @@ from typing import Any, Mapping, Sequence
 
 from .tasks import MULTI_TASKS, TrainInputError, task_module
 
-__all__ = ["sb3_throughput", "rllib_throughput", "ENGINES"]
+__all__ = ["sb3_throughput", "rllib_throughput", "time_to_success", "ENGINES"]
 
 ENGINES = ("sb3", "rllib")
 
@@ -140,3 +140,37 @@ def rllib_throughput(task: str, workers: int, seconds: float, *, seed: int = 0,
     timers = result.get("timers", {})
     return _result(env_steps, elapsed, iters, warm, timers.get("env_runner_sampling_timer", 0.0),
                    timers.get("learner_update_timer", 0.0))
+
+
+def time_to_success(engine: str, task: str, out, *, threshold: float = 0.8,
+                    steps: int = 300_000, workers: int = 2, seed: int = 0,
+                    eval_every: int = 10_000, eval_episodes: int = 10) -> dict:
+    """Train PPO (shared policy, each engine's defaults, 64x64 tanh MLP in both) on ``task`` for
+    ``steps`` env steps with ``workers`` worker processes / env runners, evaluating every
+    ``eval_every`` steps, into ``out``; the wall time and steps at the first evaluation whose
+    success rate reaches ``threshold`` (None where none did). Long: minutes to hours."""
+    import math
+    from pathlib import Path
+
+    from .progress import read_progress
+
+    if engine not in ENGINES:
+        raise TrainInputError(f"engine {engine!r}; allowed: {', '.join(ENGINES)}")
+    common = dict(mode="shared", eval_every=eval_every, eval_episodes=eval_episodes,
+                  checkpoint_every=0, progress=False)
+    if engine == "sb3":
+        from .runner import train
+        res = train(task, "ppo", steps, seed, out, n_envs=workers, n_cpus=workers, **common)
+    else:
+        from .rllib import train_rllib
+        res = train_rllib(task, "ppo", steps, seed, out, num_env_runners=workers, **common)
+    p = read_progress(Path(out) / "progress.csv")
+    hit = [i for i, s in enumerate(p["eval_success_rate"]) if not math.isnan(s) and s >= threshold]
+    first = hit[0] if hit else None
+    return {"engine": engine, "task": task, "threshold": threshold, "workers": workers,
+            "steps_budget": steps, "reached": first is not None,
+            "wall_time_s": None if first is None else float(p["wall_time_s"][first]),
+            "timesteps": None if first is None else int(p["timesteps"][first]),
+            "run_wall_time_s": float(res["wall_time_s"]),
+            "best_success": float(max((s for s in p["eval_success_rate"] if not math.isnan(s)),
+                                      default=float("nan"))), "out": str(out)}
