@@ -39,7 +39,7 @@ from typing import Any, Mapping
 from ..tasks import TrainInputError, check_mode, check_task
 
 __all__ = ["RLLIB_ALGOS", "SHARED", "build_config", "module_ids", "flat_spaces",
-           "split_algo_kwargs"]
+           "split_algo_kwargs", "quiet_rllib"]
 
 RLLIB_ALGOS = ("ppo", "appo", "sac")
 SHARED = "shared"
@@ -57,6 +57,16 @@ _DEFAULTS = {
              "replay_buffer_config": {"type": "MultiAgentEpisodeReplayBuffer",
                                       "capacity": 1_000_000}}),
 }
+
+
+def quiet_rllib() -> None:
+    """RLlib's notices about its new API stack and deprecations off in this process."""
+    import logging
+    import warnings
+
+    for name in ("ray.rllib", "ray.tune", "ray._common.deprecation"):
+        logging.getLogger(name).setLevel(logging.ERROR)
+    warnings.filterwarnings("ignore", category=DeprecationWarning, module=r"ray\..*")
 
 
 def _to_shared(agent_id, episode=None, **kwargs):

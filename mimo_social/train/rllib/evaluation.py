@@ -138,7 +138,7 @@ def evaluate_rllib(run: str | Path, episodes: int = 10, *, model: str = "final",
     import torch
 
     from ..evaluation import _motor_slicer
-    from .runner import quiet_rllib
+    from .config import quiet_rllib
 
     torch.set_num_threads(1)
     quiet_rllib()

@@ -34,9 +34,9 @@ from ..progress import write_config
 from ..rollouts import evaluate_agents
 from ..runlog import RunLog, Schedule
 from ..tasks import TrainInputError, check_mode, check_task
-from .config import build_config, check_algo, flat_spaces, module_ids
+from .config import build_config, check_algo, flat_spaces, module_ids, quiet_rllib
 
-__all__ = ["train_rllib", "init_ray", "filter_state", "quiet_rllib"]
+__all__ = ["train_rllib", "init_ray", "filter_state"]
 
 
 def init_ray(address: str | None = None, num_cpus: int | None = None) -> bool:
@@ -64,16 +64,6 @@ def init_ray(address: str | None = None, num_cpus: int | None = None) -> bool:
                               f"{str(e).splitlines()[0] if str(e) else type(e).__name__}"
                               + hint) from None
     return True
-
-
-def quiet_rllib() -> None:
-    """RLlib's notices about its new API stack and deprecations off in this process."""
-    import logging
-    import warnings
-
-    for name in ("ray.rllib", "ray.tune", "ray._common.deprecation"):
-        logging.getLogger(name).setLevel(logging.ERROR)
-    warnings.filterwarnings("ignore", category=DeprecationWarning, module=r"ray\..*")
 
 
 def _steps_of(result: Mapping) -> int:
