@@ -87,20 +87,17 @@ def markdown(results: dict) -> str:
             lines.append("| " + " | ".join(cells) + " |")
     m = results["machine"]
     s = results.get("settings", {})
-    if not results["rows"]:
-        lines = []
     text = [
         f"Measured {results['measured']} on {m['cpu']} ({m['usable_cores']} usable cores), "
-        f"{m['memory_gb']} GB, Python {m['python']}, MuJoCo {m['mujoco']}; "
-        f"{results['seconds']:g} s of timed training per configuration after one warm-up "
-        f"iteration; load average before: {results['load_before']}.",
-        "",
-        *lines,
-        "",
-        "Setting: " + ", ".join(f"{k} {v}" for k, v in s.items()) + ". "
-        "Env steps are world steps (each gives one sample per agent). Efficiency: "
-        "steps/s with n workers / (n x steps/s with 1 worker).",
-    ]
+        f"{m['memory_gb']} GB, Python {m['python']}, MuJoCo {m['mujoco']}; load average "
+        f"before: {results['load_before']}."]
+    if results["rows"]:
+        text += [
+            f"{results['seconds']:g} s of timed training per configuration after one warm-up "
+            "iteration.", "", *lines, "",
+            "Setting: " + ", ".join(f"{k} {v}" for k, v in s.items()) + ". "
+            "Env steps are world steps (each gives one sample per agent). Efficiency: "
+            "steps/s with n workers / (n x steps/s with 1 worker)."]
     if results.get("to_success"):
         text += ["", "| task | engine | workers | wall time to success | env steps then | "
                  "best success |", "|---|---|---|---|---|---|"]
