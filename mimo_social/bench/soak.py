@@ -255,6 +255,12 @@ def plot(result: dict, path: str | Path) -> None:
     after the warm-up and its growth per 100k steps in the title."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+    from matplotlib.ticker import FuncFormatter
+
+    def short(x, _pos=None):           # 250000 -> 250k, 1000000 -> 1M
+        if abs(x) >= 1e6:
+            return f"{x / 1e6:g}M"
+        return f"{x / 1e3:g}k" if abs(x) >= 1e3 else f"{x:g}"
 
     phases = list(result["phases"])
     fig = Figure(figsize=(5.0 * len(phases), 7.5), layout="constrained")
@@ -277,6 +283,7 @@ def plot(result: dict, path: str | Path) -> None:
             ax.set_title(f"{phase}: {label}\ngrowth {g:+.2f} per 100k steps", fontsize=9)
             ax.set_ylabel(label, fontsize=8)
             ax.tick_params(labelsize=7)
+            ax.xaxis.set_major_formatter(FuncFormatter(short))
             if np.isfinite(y).any() and np.nanmax(y) - np.nanmin(y) < 1e-9:
                 ax.set_ylim(np.nanmin(y) - 1, np.nanmax(y) + 1)   # flat: show it flat
             if i == len(METRICS) - 1:
