@@ -33,7 +33,6 @@ import time
 from pathlib import Path
 from typing import Callable
 
-import numpy as np
 
 from .envs import make_env, make_parallel_env, make_scripted_env
 from .independent import train_independent
@@ -53,9 +52,8 @@ def check_shared_spaces(env, task: str) -> None:
     for a in agents[1:]:
         for kind, space in (("observation", env.observation_space), ("action", env.action_space)):
             s0, s1 = space(first), space(a)
-            if s0.shape != s1.shape or not (np.array_equal(s0.low, s1.low)
-                                            and np.array_equal(s0.high, s1.high)):
-                what = (f"shape {s0.shape} vs {s1.shape}" if s0.shape != s1.shape
+            if s0 != s1:   # gymnasium's space equality: kind, shape, dtype and bounds (or n)
+                what = (f"{s0} vs {s1}" if type(s0) is not type(s1) or s0.shape != s1.shape
                         else f"same shape {s0.shape}, different bounds")
                 raise TrainInputError(
                     f"--mode shared needs every agent to have the same observation and action "

@@ -413,3 +413,25 @@ def test_bad_mode_task_and_options_say_what_is_allowed(tmp_path, monkeypatch, ca
     with pytest.raises(SystemExit):
         cli.main(["train", "--task", "high_five", "--algo", "ppo", "--steps", "64", "--out",
                   str(tmp_path / "h"), "--mode", "bogus"])
+
+
+def test_shared_mode_space_check_takes_discrete_actions():
+    """Mirror's face-only agents act with Discrete(7): one shared policy is allowed (it crashed
+    on ``Discrete.low``); two different Discrete spaces are still refused."""
+    from gymnasium import spaces
+    from mimo_social.core.wrappers import FlattenParallel
+    from mimo_social.envs import mirror_v0
+    from mimo_social.train.multi import check_shared_spaces
+    env = FlattenParallel(mirror_v0.parallel_env())
+    check_shared_spaces(env, "mirror")
+
+    class Uneven:
+        possible_agents = ["a", "b"]
+
+        def observation_space(self, agent):
+            return spaces.Box(0, 1, (3,))
+
+        def action_space(self, agent):
+            return spaces.Discrete(7 if agent == "a" else 5)
+    with pytest.raises(TrainInputError, match="flat action spaces of a and b differ"):
+        check_shared_spaces(Uneven(), "toy")
