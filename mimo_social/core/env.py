@@ -27,7 +27,7 @@ from ..body.actuation import MODELS as ACTUATION_MODELS
 from ..expressions.faces import EXPRESSIONS
 from ..render.scene import make_renderer
 from ..senses import SENSES
-from ..util.checks import check_seed
+from ..util.checks import check_seed, number_array, show
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
 from .task import Task, agent_user_settings, check_start_poses
 from .world import World
@@ -247,7 +247,7 @@ class MimoParallelEnv(ParallelEnv):
                 if not isinstance(action, Mapping) or set(action) != {"motors", "expression"}:
                     raise ValueError(f"{a}: action must be a dict with keys 'motors' and "
                                      f"'expression' (expressions are on), got "
-                                     f"{self._shown(action)}")
+                                     f"{show(action, 120)}")
                 motors, given = action["motors"], action["expression"]
                 try:        # an integer id, also as a numpy or tensor scalar or 1-element array
                     e = np.asarray(given)
@@ -257,7 +257,7 @@ class MimoParallelEnv(ParallelEnv):
                     ok = False
                 if not ok:
                     raise ValueError(
-                        f"{a}: expression={self._shown(given)} not allowed; allowed: an integer "
+                        f"{a}: expression={show(given, 120)} not allowed; allowed: an integer "
                         f"0..{len(EXPRESSIONS) - 1}: "
                         + ", ".join(f"{k}={n}" for k, n in enumerate(EXPRESSIONS)))
                 expression = int(e.reshape(()))
@@ -275,15 +275,6 @@ class MimoParallelEnv(ParallelEnv):
             act.apply(w.model, w.data, c)
 
     @staticmethod
-    def _shown(value, limit: int = 120) -> str:
-        """``repr(value)`` for an error message: shortened, and never an error itself."""
-        try:
-            text = repr(value)
-        except Exception:  # noqa: BLE001
-            text = f"<{type(value).__name__} without a repr>"
-        return text if len(text) <= limit else text[:limit - 5] + " ..."
-
-    @staticmethod
     def _motor_values(agent: str, act, motors) -> np.ndarray:
         """The motor commands as a float array of the right shape, finite; else a ValueError
         naming the agent, the field, the value and what is allowed.
@@ -297,33 +288,10 @@ class MimoParallelEnv(ParallelEnv):
         allowed = (f"allowed: {act.n_controls} finite numbers in [{lo}, {hi}] (motors "
                    f"{list(act.control_names)[:4]}{' ...' if act.n_controls > 4 else ''})")
         field = f"{agent}: action field 'motors'"
-        shown = MimoParallelEnv._shown
-        if isinstance(motors, np.ma.MaskedArray) and np.ma.is_masked(motors):
-            raise ValueError(f"{field} = {shown(motors)} has masked entries; {allowed}")
-        try:
-            raw = np.asarray(motors)
-        except Exception as e:  # noqa: BLE001  (ragged lists, tensors that need grad ...)
-            raise ValueError(f"{field} = {shown(motors)} is not an array of numbers "
-                             f"({type(e).__name__}: {e}); {allowed}") from None
-        if raw.dtype.kind == "O" and all(
-                isinstance(v, (int, float, np.integer, np.floating))
-                and not isinstance(v, (bool, np.bool_)) for v in raw.flat):
-            # Python ints beyond 64 bits (and the like) are numbers all the same
-            values = []
-            for v in raw.flat:
-                try:
-                    values.append(float(v))
-                except OverflowError:               # beyond float64: not finite
-                    values.append(float("inf"))
-            raw = np.array(values, dtype=np.float64).reshape(raw.shape)
-        if raw.dtype.kind not in "iuf":
-            raise ValueError(f"{field} = {shown(motors)} has {raw.dtype} values, not numbers; "
-                             f"{allowed}")
-        if raw.shape != (act.n_controls,):
-            raise ValueError(f"{field} has shape {raw.shape}; expected ({act.n_controls},) "
+        u = number_array(motors, field, allowed[len("allowed: "):])
+        if u.shape != (act.n_controls,):
+            raise ValueError(f"{field} has shape {u.shape}; expected ({act.n_controls},) "
                              f"for motors {act.control_names}")
-        with np.errstate(over="ignore", invalid="ignore"):   # longdouble beyond float64: inf
-            u = raw.astype(np.float64, copy=False)
         if not np.isfinite(u).all():
             bad = [act.control_names[k] for k in np.flatnonzero(~np.isfinite(u))]
             raise ValueError(f"{field} has NaN/inf (or values beyond float64) for {bad}; "

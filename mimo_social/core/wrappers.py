@@ -42,6 +42,8 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
+from ..util.checks import number_array
+
 __all__ = ["ParallelWrapper", "FlattenParallel", "NumericInfos", "INFO_KINDS", "FlatActionWrapper", "FlatObservationWrapper",
            "ExpressionActionWrapper", "is_expression_only", "flat_action_space",
            "flat_observation_space"]
@@ -164,7 +166,8 @@ class _ActionDecoder:
                   if self.n_expressions else f"{self.n_motors} motors")
         a = _numbers(action, who, "action", f"{self.space.shape[0]} numbers ({layout})")
         if a.shape != self.space.shape:
-            raise ValueError(f"{who}: flat action has shape {a.shape}; expected "
+            raise ValueError(f"{who}: action field 'action' (the flat action) has shape "
+                             f"{a.shape}; expected "
                              f"{self.space.shape} ({layout})")
         # clipped in float64: a finite value beyond float32's range is clipped, not made inf
         # (NaN and inf motors go on to the env, whose error names the motors)
@@ -184,16 +187,8 @@ class _ActionDecoder:
 
 def _numbers(action, who: str, field: str, allowed: str) -> np.ndarray:
     """``action`` as a float64 array, else a ValueError naming the agent, the field, the value
-    and what is allowed (strings, ragged lists, dicts, None ... are not numbers)."""
-    try:
-        raw = np.asarray(action)
-    except (TypeError, ValueError) as e:        # ragged nested lists and the like
-        raise ValueError(f"{who}: action field {field!r} = {action!r:.120} is not an array of "
-                         f"numbers ({e}); allowed: {allowed}") from None
-    if raw.dtype.kind not in "iuf":
-        raise ValueError(f"{who}: action field {field!r} = {action!r:.120} has {raw.dtype} "
-                         f"values, not numbers; allowed: {allowed}")
-    return raw.astype(np.float64)
+    and what is allowed (:func:`mimo_social.util.checks.number_array`)."""
+    return number_array(action, f"{who}: action field {field!r}", allowed)
 
 
 def flat_action_space(space: spaces.Space) -> spaces.Space:

@@ -9,7 +9,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["ConfigError", "check_number", "check_int", "check_bool", "check_choice",
+__all__ = ["number_array", "ConfigError", "check_number", "check_int", "check_bool", "check_choice",
            "check_numbers", "check_names", "check_seed"]
 
 
@@ -23,8 +23,12 @@ def _who(owner: str) -> str:
 
 
 def show(value: Any, limit: int = 80) -> str:
-    """``repr(value)``, shortened in the middle past ``limit`` characters (for error messages)."""
-    text = repr(value)
+    """``repr(value)``, shortened in the middle past ``limit`` characters (for error messages);
+    never an error itself (an object whose repr raises is shown by its type)."""
+    try:
+        text = repr(value)
+    except Exception:  # noqa: BLE001
+        text = f"<{type(value).__name__} without a repr>"
     if len(text) <= limit:
         return text
     return text[: limit // 2] + " ... " + text[-limit // 2 + 5:]
@@ -139,3 +143,36 @@ def check_seed(value: Any, owner: str = "") -> int | None:
         raise ConfigError(f"{_who(owner)}seed={show(value)} not allowed; allowed: None or an "
                           f"integer >= 0")
     return int(value)
+
+
+def number_array(value: Any, field: str, allowed: str) -> np.ndarray:
+    """``value`` (an action, say) as a float64 array of any shape, else a ValueError
+    ``"<field> = <value> ...; allowed: <allowed>"`` (``field`` names the owner too, e.g.
+    ``"infant_0: action field 'motors'"``).
+
+    Numbers are anything numpy reads as integers or floats of any width (Python ints beyond 64
+    bits too); values beyond float64 become inf (the caller decides about non-finite values).
+    Refused: bools, complex numbers, strings, bytes, dates, objects, ragged lists, masked
+    entries, tensors that need a gradient."""
+    if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
+        raise ValueError(f"{field} = {show(value)} has masked entries; allowed: {allowed}")
+    try:
+        raw = np.asarray(value)
+    except Exception as e:  # noqa: BLE001  (ragged lists, tensors that need grad ...)
+        raise ValueError(f"{field} = {show(value)} is not an array of numbers "
+                         f"({type(e).__name__}: {e}); allowed: {allowed}") from None
+    if raw.dtype.kind == "O" and all(
+            isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_))
+            for v in raw.flat):
+        values = []          # Python ints beyond 64 bits (and the like) are numbers all the same
+        for v in raw.flat:
+            try:
+                values.append(float(v))
+            except OverflowError:                   # beyond float64: not finite
+                values.append(math.inf if v > 0 else -math.inf)
+        raw = np.array(values, dtype=np.float64).reshape(raw.shape)
+    if raw.dtype.kind not in "iuf":
+        raise ValueError(f"{field} = {show(value)} has {raw.dtype} values, not numbers; "
+                         f"allowed: {allowed}")
+    with np.errstate(over="ignore", invalid="ignore"):   # longdouble beyond float64: inf
+        return raw.astype(np.float64)

@@ -142,6 +142,23 @@ def test_non_numbers_name_the_agent_and_the_field(bad):
         env.step({"infant_0": np.zeros(n), "infant_1": bad})
 
 
+def test_flat_actions_take_what_the_env_takes_and_refuse_the_rest_naming_the_field():
+    """FlattenParallel reads actions as the env does (one reader of numbers): masked entries,
+    tensors that need a gradient and a wrong shape are refused naming the agent and the field;
+    Python ints beyond 64 bits and long doubles beyond float64 are numbers, clipped."""
+    import torch
+    env = _flat(expressions=False)
+    n = env.action_space("infant_1").shape[0]
+    masked = np.ma.masked_array(np.zeros(n), mask=[True] + [False] * (n - 1))
+    for bad, why in ((masked, "masked entries"), (torch.zeros(n, requires_grad=True), "grad"),
+                     (np.zeros(n + 1), "shape")):
+        with pytest.raises(ValueError, match=f"(?s)infant_1: action field 'action'.*{why}"):
+            env.step({"infant_0": np.zeros(n), "infant_1": bad})
+    huge = [2 ** 70] + [-(2 ** 70)] + [0] * (n - 2)
+    env.step({"infant_0": np.zeros(n), "infant_1": huge})
+    assert list(env.unwrapped.controls[1][:2]) == [1.0, -1.0]
+
+
 def test_expression_only_agents_and_logits_name_the_field():
     env = FlattenParallel(mirror_v0.parallel_env(max_steps=SHORT, vision=False))
     env.reset(seed=0)
