@@ -305,3 +305,58 @@ def test_the_env_creator_makes_every_task_of_the_catalogue(task, mode):
         assert made.observation_spaces.keys() == env.observation_spaces.keys()
     finally:
         made.close()
+
+
+def _first_module(task, mode):
+    """The RLModule PPO starts with (built from build_config's spec, as RLlib builds it) and
+    observations of a few zero-action steps of the task."""
+    from mimo_social.train.rllib import build_config
+    from mimo_social.train.rllib.config import flat_spaces
+    from mimo_social.train.rllib.env import flat_env
+
+    spaces = flat_spaces(task, mode)
+    config = build_config(task, mode, "ppo", seed=0, spaces=spaces)
+    mid, spec = sorted(config.rl_module_spec.rl_module_specs.items())[0]
+    agent = next(a for a in spaces[0] if mid in ("shared", a))
+    env = flat_env(task, mode)
+    try:
+        obs, _ = env.reset(seed=0)
+        seen = []
+        for _ in range(20):
+            seen.append(obs[agent])
+            obs, *_ = env.step({a: np.zeros_like(env.action_space(a).sample())
+                                for a in env.agents})
+            if not env.agents:
+                obs, _ = env.reset()
+    finally:
+        env.close()
+    return spec.build(), np.asarray(seen, dtype=np.float32), spaces[1][agent][1]
+
+
+def test_ppo_starts_as_sb3_mean_actions_near_zero_and_unit_std():
+    pytest.importorskip("ray.rllib")
+    import torch
+
+    module, obs, act_space = _first_module("high_five", "shared")
+    with torch.no_grad():
+        out = module.forward_inference({"obs": torch.from_numpy(obs)})["action_dist_inputs"]
+    n = act_space.shape[0]
+    assert out.shape == (len(obs), 2 * n)        # means, then log stds
+    assert float(out[:, :n].abs().max()) < 0.05  # SB3's gain 0.01: RLlib's own init gives ~0.35
+    assert torch.equal(out[:, n:], torch.zeros(len(obs), n))   # std 1, the same in every state
+    assert isinstance(module.pi.log_std, torch.nn.Parameter)
+    assert hasattr(module.encoder, "critic_encoder")   # the value net shares no layer
+    with torch.no_grad():
+        values = module.compute_values({"obs": torch.from_numpy(obs)})
+    assert values.shape == (len(obs),) and float(values.abs().max()) < 10
+
+
+def test_ppo_with_discrete_actions_starts_near_uniform():
+    pytest.importorskip("ray.rllib")
+    import torch
+
+    module, obs, act_space = _first_module("mirror", "independent")
+    with torch.no_grad():
+        logits = module.forward_inference({"obs": torch.from_numpy(obs)})["action_dist_inputs"]
+    assert logits.shape == (len(obs), act_space.n)
+    assert float(logits.abs().max()) < 0.05
