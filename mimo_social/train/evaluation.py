@@ -199,17 +199,12 @@ def _load_policies(run: Path, config: dict, model: str) -> tuple[dict, dict]:
     return {a: loaded[p] for a, p in paths.items()}, {a: str(p) for a, p in paths.items()}
 
 
-def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed: int,
-                   deterministic: bool, record, video, frames, frame_every: int,
-                   env_kwargs: Mapping[str, Any] | None) -> dict:
-    """The multi-agent part of :func:`evaluate`."""
-    policies, paths = _load_policies(run, config, model)
-    kw = dict(config.get("env_kwargs", {}))
-    kw.update(env_kwargs or {})
-    want_frames = video is not None or frames is not None
-    make = make_scripted_env if config["mode"] == "scripted" else make_parallel_env
-    env = make(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
-    inner = env.unwrapped
+def evaluate_with_outputs(policies: Mapping[str, Any], env, inner, episodes: int, seed: int,
+                          deterministic: bool, record, video, frames, frame_every: int) -> dict:
+    """Run :func:`evaluate_agents` on ``env`` (its MimoParallelEnv: ``inner``) while recording,
+    filming or saving frames as asked; close both; the results with ``wall_time_s`` and the
+    ``record`` / ``video`` / ``frames`` paths given. The multi-agent evaluation of either
+    engine."""
     outputs = EvalOutputs(env, inner, record, video, frames, frame_every)
     motors = _motor_slicer(env)
 
@@ -225,12 +220,27 @@ def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed:
     finally:
         outputs.close()
         env.close()
-    res.update({"task": config["task"], "algo": config["algo"], "mode": config["mode"],
-                "model": paths[next(iter(paths))], "models": paths, "episodes": episodes,
-                "deterministic": deterministic, "seed": seed,
-                "wall_time_s": round(time.perf_counter() - t0, 2)})
+    res["wall_time_s"] = round(time.perf_counter() - t0, 2)
     for key, value in (("record", record), ("video", video), ("frames", frames)):
         if value is not None:
             res[key] = str(value)
+    return res
+
+
+def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed: int,
+                   deterministic: bool, record, video, frames, frame_every: int,
+                   env_kwargs: Mapping[str, Any] | None) -> dict:
+    """The multi-agent part of :func:`evaluate`."""
+    policies, paths = _load_policies(run, config, model)
+    kw = dict(config.get("env_kwargs", {}))
+    kw.update(env_kwargs or {})
+    want_frames = video is not None or frames is not None
+    make = make_scripted_env if config["mode"] == "scripted" else make_parallel_env
+    env = make(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
+    res = evaluate_with_outputs(policies, env, env.unwrapped, episodes, seed, deterministic,
+                                record, video, frames, frame_every)
+    res.update({"task": config["task"], "algo": config["algo"], "mode": config["mode"],
+                "model": paths[next(iter(paths))], "models": paths, "episodes": episodes,
+                "deterministic": deterministic, "seed": seed})
     (run / "eval_results.json").write_text(json.dumps(res, indent=2, default=float))
     return res

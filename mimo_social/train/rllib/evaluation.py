@@ -14,15 +14,13 @@ from __future__ import annotations
 
 import json
 import pickle
-import time
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 from gymnasium import spaces
 
-from ..evaluation import EvalOutputs
-from ..rollouts import evaluate_agents
+from ..evaluation import evaluate_with_outputs
 from ..tasks import TrainInputError
 from .env import flat_env
 
@@ -137,7 +135,6 @@ def evaluate_rllib(run: str | Path, episodes: int = 10, *, model: str = "final",
     """Reload an RLlib run's RLModules and run ``episodes`` episodes (module docstring)."""
     import torch
 
-    from ..evaluation import _motor_slicer
     from .config import quiet_rllib
 
     torch.set_num_threads(1)
@@ -157,30 +154,13 @@ def evaluate_rllib(run: str | Path, episodes: int = 10, *, model: str = "final",
     except BaseException:
         env.close()
         raise
-    outputs = EvalOutputs(env, env.unwrapped, record, video, frames, frame_every)
-    motors = _motor_slicer(env)
-
-    def on_step(actions, rewards, obs, reset):
-        if reset:
-            outputs.on_reset()
-        else:
-            outputs.on_step({a: motors(a, act) for a, act in actions.items()}, rewards)
-
-    t0 = time.perf_counter()
-    try:
-        res = evaluate_agents(policies, env, episodes, seed, deterministic, on_step)
-    finally:
-        outputs.close()
-        env.close()
+    res = evaluate_with_outputs(policies, env, env.unwrapped, episodes, seed, deterministic,
+                                record, video, frames, frame_every)
     paths = {a: str(module_dir(checkpoint, mid)) for a, mid in config["modules"].items()}
     if config.get("mode") is None:
         res.pop("agents", None)
     res.update({"task": config["task"], "algo": config["algo"], "engine": "rllib",
                 "mode": config.get("mode"), "model": str(checkpoint), "models": paths,
-                "episodes": episodes, "deterministic": deterministic, "seed": seed,
-                "wall_time_s": round(time.perf_counter() - t0, 2)})
-    for key, value in (("record", record), ("video", video), ("frames", frames)):
-        if value is not None:
-            res[key] = str(value)
+                "episodes": episodes, "deterministic": deterministic, "seed": seed})
     (run / "eval_results.json").write_text(json.dumps(res, indent=2, default=float))
     return res
