@@ -22,8 +22,8 @@ num_gpus_per_learner=0, normalize_obs=False) -> AlgorithmConfig``
   gradient once it is off by more than ~3, and high five's returns are in the hundreds). With
   RLlib's own settings for these five, PPO never reached 80 % success on high five in 70k env
   steps where SB3 does in 60k; with them it does in ~51k. Putting any one of them back alone
-  (RLlib's init, a shared encoder, or ``vf_clip_param=10``) still learned it in 20-51k (one
-  seed each): no single one is the cause, hence all SB3's. RLlib standardises the advantages
+  (RLlib's init, a shared encoder, a state-dependent log std or ``vf_clip_param=10``) still
+  learned it in 20-51k (one seed each): no single one is the cause, hence all SB3's. RLlib standardises the advantages
   over the whole train batch, SB3 per minibatch: left as is. SAC with two ReLU layers of
   256, lr 3e-4, batch 256, learning from step 100; APPO with RLlib's defaults and two tanh
   layers of 64. ``algo_kwargs`` override: keys of RLlib's ``DefaultModelConfig``
