@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 from ..bench import soak as soak_lib
+from ._args import non_negative_int
 
 __all__ = ["add_parser", "run"]
 
@@ -44,16 +45,6 @@ def _eye_size(text: str) -> int:
     return value
 
 
-def _seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: give an integer >= 0") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: give an integer >= 0")
-    return value
-
-
 def _fraction(text: str) -> float:
     try:
         value = float(text)
@@ -80,7 +71,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                              "0 skips it)")
     parser.add_argument("--out", default="soak", metavar="DIR",
                         help="folder for soak.csv, soak.json, soak.png (default: ./soak)")
-    parser.add_argument("--seed", type=_seed, default=0, help="seed of actions and resets")
+    parser.add_argument("--seed", type=non_negative_int, default=0, help="seed of actions and resets")
     parser.add_argument("--sample-every", type=_positive, default=10_000, metavar="N",
                         help="steps between samples (default: 1e4; at least 20 samples a phase)")
     parser.add_argument("--episode-steps", type=_positive, default=1000, metavar="N",
