@@ -44,14 +44,16 @@ def _per_algo(name: str, value, algos: list[str], per_algo: bool) -> dict:
     return {a: value[a] for a in algos}
 
 
-def _kwargs_per_algo(kwargs: Mapping[str, Any]) -> bool:
-    """Whether ``algo_kwargs`` is keyed by algorithm (``{"ppo": {...}, "sac": {...}}``)."""
-    named = [k for k in kwargs if k in ALGOS]
+def _kwargs_per_algo(kwargs: Mapping[str, Any], algos=ALGOS,
+                     example: str = '{"ppo": {"n_steps": 512}, "sac": {"batch_size": 128}}'
+                     ) -> bool:
+    """Whether ``algo_kwargs`` is keyed by algorithm (``{"ppo": {...}, "sac": {...}}``), the
+    algorithms being ``algos`` (SB3's by default; the RLlib sweep passes its own)."""
+    named = [k for k in kwargs if k in algos]
     if named and (len(named) < len(kwargs)
                   or not all(isinstance(kwargs[k], Mapping) for k in named)):
         raise TrainInputError(f"algo_kwargs {dict(kwargs)}: give either keyword arguments for "
-                              "every algorithm or one object per algorithm, e.g. "
-                              '{"ppo": {"n_steps": 512}, "sac": {"batch_size": 128}}')
+                              f"every algorithm or one object per algorithm, e.g. {example}")
     return bool(named)
 
 

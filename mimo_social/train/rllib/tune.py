@@ -36,7 +36,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..comparison import _per_algo
+from ..comparison import _kwargs_per_algo, _per_algo
 from ..plots import plot_compare
 from ..tasks import TrainInputError, check_mode, check_task
 from .config import RLLIB_ALGOS, check_algo
@@ -52,17 +52,6 @@ def trial_resources(num_env_runners: int = 1, num_cpus_per_learner: float = 1,
     if num_gpus_per_learner:
         learner["GPU"] = float(num_gpus_per_learner)
     return [learner] + [{"CPU": 1.0} for _ in range(int(num_env_runners))]
-
-
-def _kwargs_per_algo(kwargs: Mapping[str, Any]) -> bool:
-    """Whether ``algo_kwargs`` is keyed by algorithm (``{"ppo": {...}, "appo": {...}}``)."""
-    named = [k for k in kwargs if k in RLLIB_ALGOS]
-    if named and (len(named) < len(kwargs)
-                  or not all(isinstance(kwargs[k], Mapping) for k in named)):
-        raise TrainInputError(f"algo_kwargs {dict(kwargs)}: give either keyword arguments for "
-                              "every algorithm or one object per algorithm, e.g. "
-                              '{"ppo": {"num_epochs": 5}, "appo": {}}')
-    return bool(named)
 
 
 def _trial(config: dict) -> None:
@@ -110,7 +99,8 @@ def compare_rllib(task: str, algos=("ppo",), seeds: int = 3,
     steps = _per_algo("steps", steps, algos, isinstance(steps, Mapping))
     algo_kwargs = dict(algo_kwargs or {})
     kwargs = _per_algo("algo_kwargs", algo_kwargs, algos,
-                       _kwargs_per_algo(algo_kwargs))
+                       _kwargs_per_algo(algo_kwargs, RLLIB_ALGOS,
+                                        '{"ppo": {"num_epochs": 5}, "appo": {}}'))
     runs = {f"{a}_seed{s}": dict(task=task, algo=a, steps=steps[a], seed=s,
                                  out=str(out / f"{a}_seed{s}"), mode=mode,
                                  algo_kwargs=kwargs[a], progress=False,
