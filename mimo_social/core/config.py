@@ -28,13 +28,22 @@ from ..util.checks import (ConfigError, check_bool, check_choice, check_int, che
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig", "AgentConfig",
     "PhysicsConfig", "ConfigError", "resolve_agents", "parse_physics", "ACTUATION_MODELS",
-    "POSTURES", "env_settings", "RENDER_SIZE_RANGE", "MAX_STEPS_LIMIT",
+    "POSTURES", "BODIES", "AGE_RANGE", "DELAY_CHANNELS", "DELAY_LIMIT_MS", "env_settings", "RENDER_SIZE_RANGE", "MAX_STEPS_LIMIT",
 ]
 
-ACTUATION_MODELS = ("spring_damper", "muscle")
+ACTUATION_MODELS = ("spring_damper", "muscle", "positional")
 FLOOR_HALF = 10.0      # m: the floor plane's half size (an agent placed beyond it falls forever)
 FACING_LIMIT = 100.0   # m: how far the point an agent faces may be
-POSTURES = ("standing", "sitting", "lying")
+POSTURES = ("standing", "sitting", "kneeling", "lying")
+#: body kinds: the infant (its age from ``age_months``) and an adult caregiver
+BODIES = ("infant", "adult")
+#: infant ages the growth curves carry, in months (body/data/growth_curves.csv: the survey's mean
+#: ages reach 33 months)
+AGE_RANGE = (0.0, 33.0)
+#: what can be delayed (``delays``): each sense and the motor command
+DELAY_CHANNELS = ("proprioception", "vestibular", "touch", "vision", "motor")
+#: the longest delay allowed per channel, milliseconds
+DELAY_LIMIT_MS = 1000.0
 
 
 def _from_mapping(cls, what: str, value: Mapping[str, Any]):
@@ -66,6 +75,15 @@ class AgentConfig:
     scale: float = 1.0
     # Multiplies every motor's maximum torque (muscles: maximum force) on top of the size law.
     strength: float = 1.0
+    # "infant" or "adult" (a caregiver from adult anthropometry, docs/bodies.md)
+    body: str = "infant"
+    # The infant's age in months (0 to 33): every segment from the growth curves; None: the
+    # published 18-month-old, unchanged. Only for body="infant".
+    age_months: float | None = None
+    # Sensorimotor delays: None (none), "developmental" (published figures for the agent's age,
+    # docs/bodies.md) or a mapping channel -> milliseconds for channels of DELAY_CHANNELS
+    # (missing channels: 0); applied in whole control steps.
+    delays: Any = None
 
     def __post_init__(self):
         put = partial(object.__setattr__, self)
@@ -89,6 +107,36 @@ class AgentConfig:
                                               "to 1"))
         put("scale", check_number("", "scale", self.scale, *SCALE_RANGE))
         put("strength", check_number("", "strength", self.strength, *STRENGTH_RANGE))
+        check_choice("", "body", self.body, BODIES)
+        if self.age_months is not None:
+            if self.body != "infant":
+                raise ConfigError(f"age_months={show(self.age_months)} is for infant bodies; "
+                                  f"body={self.body!r} takes None")
+            put("age_months", check_number("", "age_months", self.age_months, *AGE_RANGE))
+        put("delays", _parse_delays(self.delays))
+
+    @property
+    def age(self) -> float | None:
+        """The age in months the senses and delays follow: ``age_months``, 18 for the
+        published infant (``age_months=None``), None for an adult."""
+        if self.body == "adult":
+            return None
+        return 18.0 if self.age_months is None else self.age_months
+
+
+def _parse_delays(value):
+    """None, "developmental", or a dict channel -> milliseconds (float) for the channels given."""
+    if value is None or (isinstance(value, str) and value == "developmental"):
+        return value
+    if not isinstance(value, Mapping):
+        raise ConfigError(f"delays={show(value)} not allowed; allowed: None, 'developmental' or a "
+                          f"mapping of {list(DELAY_CHANNELS)} to milliseconds, each from 0 to "
+                          f"{DELAY_LIMIT_MS:g}")
+    unknown = sorted((k for k in value if k not in DELAY_CHANNELS), key=str)
+    if unknown:
+        raise ConfigError(f"delays: unknown channel(s) {unknown}; allowed: {list(DELAY_CHANNELS)}")
+    return {k: check_number("delays", k, value[k], 0.0, DELAY_LIMIT_MS)
+            for k in DELAY_CHANNELS if k in value}
 
 
 _NO_FIELD = sorted(set(SENSES) - {f.name for f in fields(AgentConfig)})

@@ -66,7 +66,7 @@ class TaskOptions:
         allowed = sorted(f.name for f in dataclasses.fields(cls))
         unknown = sorted(set(given) - set(allowed), key=str)
         if unknown:
-            raise ConfigError(f"{cls.task}: unknown task option(s) {unknown}; allowed: {allowed}")
+            raise ConfigError(f"{cls.task}: task_options: unknown task option(s) {unknown}; allowed: {allowed}")
         return cls(**given)
 
     def as_dict(self) -> dict[str, Any]:
