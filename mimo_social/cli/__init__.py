@@ -18,9 +18,10 @@ from . import bench_recording
 from . import baselines
 from . import soak
 from . import bench_engines
+from . import bench_development
 
 SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, bench_vision, figure, docs,
-               bench_recording, baselines, soak, bench_engines)
+               bench_recording, baselines, soak, bench_engines, bench_development)
 
 
 class UsageError(SystemExit):

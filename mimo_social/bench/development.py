@@ -1,0 +1,143 @@
+"""What the developing body costs: build time per age (and for the adult), and the cost per step
+of sensorimotor delays and of the acuity filter, each measured against the same env without it.
+
+``mimo-social bench-development`` runs it (:mod:`mimo_social.cli.bench_development`); the numbers
+go to BENCHMARKS.md. Variants that are compared run in turns (``rounds`` turns of ``steps`` steps
+each, under the same smooth random actions), so a change of the machine's speed touches them alike;
+each figure is the median over the turns.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..body.tables import load_body
+from ..core.random_actions import smooth_random_actions
+from ..envs import free_play_v0
+
+__all__ = ["BUILD_BODIES", "ALL_DELAYS_MS", "build_times", "step_costs", "delay_cost",
+           "acuity_cost", "measure", "format_results"]
+
+#: The bodies whose build time is measured: (label, agent settings).
+BUILD_BODIES = (
+    ("0 months", {"age_months": 0.0}),
+    ("6 months", {"age_months": 6.0}),
+    ("12 months", {"age_months": 12.0}),
+    ("18 months (published)", {}),
+    ("24 months", {"age_months": 24.0}),
+    ("adult", {"body": "adult"}),
+)
+
+#: Every channel delayed by 100 ms (10 control steps at the default 10 ms control step).
+ALL_DELAYS_MS = {"proprioception": 100.0, "vestibular": 100.0, "touch": 100.0, "vision": 100.0,
+                 "motor": 100.0}
+
+
+def build_times(hands: Sequence[str] = ("mitten", "five_fingers"), repeats: int = 3) -> list[dict]:
+    """Per body of :data:`BUILD_BODIES` and hand version: seconds to compute its tables from the
+    CSV files (cache cleared first) and seconds to build a one-agent free-play env from cached
+    tables (the MjSpec, its compile, the senses), median of ``repeats``."""
+    out = []
+    for hand in hands:
+        for label, settings in BUILD_BODIES:
+            tables_s, env_s = [], []
+            for _ in range(repeats):
+                load_body.cache_clear()
+                t0 = time.perf_counter()
+                load_body(hand, age_months=settings.get("age_months"),
+                          body=settings.get("body", "infant"))
+                tables_s.append(time.perf_counter() - t0)
+                t0 = time.perf_counter()
+                env = free_play_v0.parallel_env(n_agents=1, hands=hand, **settings)
+                env_s.append(time.perf_counter() - t0)
+                env.close()
+            out.append({"hands": hand, "body": label, "tables_ms": 1e3 * float(np.median(tables_s)),
+                        "env_ms": 1e3 * float(np.median(env_s))})
+    return out
+
+
+def step_costs(variants: dict[str, Callable[[], object]], steps: int = 300, rounds: int = 5,
+               seed: int = 0) -> dict[str, float]:
+    """Milliseconds per env step of each variant (a function making the env), median over
+    ``rounds`` turns of ``steps`` steps each; the variants take turns, under the same actions."""
+    envs = {name: make() for name, make in variants.items()}
+    actions = {}
+    for name, env in envs.items():
+        env.reset(seed=seed)
+        acts = {}
+        for i, a in enumerate(env.possible_agents):
+            n = env.action_space(a)["motors"].shape[0]
+            acts[a] = (0.5 * smooth_random_actions(steps, n, seed + i)[0]).astype(np.float32)
+        actions[name] = acts
+    times: dict[str, list[float]] = {name: [] for name in envs}
+    for _ in range(rounds):
+        for name, env in envs.items():
+            env.reset(seed=seed)
+            acts = actions[name]
+            t0 = time.perf_counter()
+            for k in range(steps):
+                env.step({a: {"motors": acts[a][k], "expression": 0} for a in env.agents})
+            times[name].append((time.perf_counter() - t0) / steps)
+    for env in envs.values():
+        env.close()
+    return {name: 1e3 * float(np.median(t)) for name, t in times.items()}
+
+
+def delay_cost(steps: int = 300, rounds: int = 5) -> dict[str, float]:
+    """ms per step of two infants with touch, no delays vs every channel delayed 100 ms, and with
+    vision (64x64 eyes) too."""
+    def make(delays, vision):
+        return lambda: free_play_v0.parallel_env(n_agents=2, touch=True, delays=delays,
+                                                 vision={"width": 64, "height": 64}
+                                                 if vision else False)
+    return step_costs({"touch": make(None, False), "touch + delays": make(ALL_DELAYS_MS, False),
+                       "touch + vision": make(None, True),
+                       "touch + vision + delays": make(ALL_DELAYS_MS, True)}, steps, rounds)
+
+
+def acuity_cost(sizes: Sequence[int] = (128, 256), steps: int = 200,
+                rounds: int = 5) -> dict[str, float]:
+    """ms per step of two newborns with vision, acuity off vs on (the newborn's blur), per eye
+    image size."""
+    variants = {}
+    for size in sizes:
+        for acuity in (None, "age"):
+            label = f"{size}x{size} eyes, acuity {'on' if acuity else 'off'}"
+            vision = {"width": size, "height": size, "acuity": acuity}
+            variants[label] = (lambda v=vision: free_play_v0.parallel_env(
+                n_agents=2, age_months=0.0, vision=v))
+    return step_costs(variants, steps, rounds)
+
+
+def measure(steps: int = 300, rounds: int = 5, repeats: int = 3) -> dict:
+    """Every figure of this module, as a dict for JSON."""
+    return {"build": build_times(repeats=repeats), "delays": delay_cost(steps, rounds),
+            "acuity": acuity_cost(steps=max(steps * 2 // 3, 1), rounds=rounds)}
+
+
+def _relative(costs: dict[str, float], base_of: Callable[[str], str]) -> list[str]:
+    lines = []
+    for name, ms in costs.items():
+        base = base_of(name)
+        extra = "" if base == name else f" ({100 * (ms / costs[base] - 1):+.1f} % vs {base})"
+        lines.append(f"| {name} | {ms:.2f}{extra} |")
+    return lines
+
+
+def format_results(results: dict) -> str:
+    """Markdown tables of :func:`measure`'s results."""
+    lines = ["Build time per body (tables from CSV, cache cleared; one-agent free-play env from "
+             "cached tables), median ms:", "", "| hands | body | tables | env |",
+             "| --- | --- | --- | --- |"]
+    for r in results["build"]:
+        lines.append(f"| {r['hands']} | {r['body']} | {r['tables_ms']:.1f} | {r['env_ms']:.1f} |")
+    lines += ["", "Delays (every channel 100 ms), two infants, ms per step:", "",
+              "| env | ms/step |", "| --- | --- |"]
+    lines += _relative(results["delays"], lambda n: n.replace(" + delays", ""))
+    lines += ["", "Acuity filter (newborns, age 0), two infants, ms per step:", "",
+              "| env | ms/step |", "| --- | --- |"]
+    lines += _relative(results["acuity"], lambda n: n.replace("acuity on", "acuity off"))
+    return "\n".join(lines)
