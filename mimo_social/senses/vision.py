@@ -9,6 +9,15 @@ vertical, +-8 torsional). Observation keys per agent with vision on:
   float32)``, the distance in metres from the eye along its viewing axis (z-depth; nothing
   in view reads as the far clipping distance, ``model.vis.map.zfar * model.stat.extent``).
 
+Visual development (``acuity``, :mod:`mimo_social.senses.acuity`): None (the default) leaves the
+images as rendered; ``"age"`` blurs them to the grating acuity of the agent's age
+(:attr:`AgentConfig.age`; none from 24 months on nor for adults); a number is a cut-off in cycles
+per degree. The blur is applied right after rendering, before anything reads the images: the
+observations, :func:`eye_images`, anaglyphs and recordings all see the blurred images (depth
+images stay sharp). ``VisionSystem.cutoffs`` holds each agent's cut-off (None: no blur), and
+:class:`AcuityBlur` is the identity where the cut-off is at or above the image's Nyquist
+frequency (e.g. 18 months' 12.4 cycles per degree needs eyes 1640 pixels tall to act).
+
 One :class:`VisionSystem` per world renders every agent's eyes once per control step, after the
 physics and before any agent observes, every ``every``-th step (``every=1``: every step; the
 images of the steps between are the last ones rendered), and at once after a reset. All eyes
@@ -38,6 +47,7 @@ from gymnasium import spaces
 from ..render.eye_renderer import Tile, TileRenderer
 from ..render.png import write_png
 from ..util.checks import check_bool, check_int
+from .acuity import acuity_blur, check_acuity, cutoff_for
 from .base import SenseEntry
 
 __all__ = ["VisionConfig", "VisionSystem", "VisionSense", "build_vision", "vision_system",
@@ -54,12 +64,14 @@ class VisionConfig:
     height: int = 256
     depth: bool = False
     every: int = 1          # render every k-th control step, holding the last images between
+    acuity: float | str | None = None   # None | "age" | cut-off in cycles per degree
 
     def __post_init__(self):
         for key in ("width", "height"):
             object.__setattr__(self, key, check_int("vision", key, getattr(self, key), 8, 2048))
         object.__setattr__(self, "depth", check_bool("vision", "depth", self.depth))
         object.__setattr__(self, "every", check_int("vision", "every", self.every, 1, 1000))
+        object.__setattr__(self, "acuity", check_acuity(self.acuity))
 
 
 class VisionSystem:
@@ -71,11 +83,14 @@ class VisionSystem:
         self.configs = list(configs)
         self.agents = [i for i, c in enumerate(self.configs) if c]
         tiles, groups, self._tile_of = [], [], {}
-        self.cameras = {}
+        self.cameras, self.cutoffs, self._blur = {}, {}, {}
         for i in self.agents:
             cfg = self.configs[i]
             right, left = (int(c) for c in world.agents[i].eye_cameras)
             self.cameras[i] = {"left": left, "right": right}
+            self.cutoffs[i] = cutoff_for(cfg.acuity, world.agent_setups[i].config.age)
+            self._blur[i] = acuity_blur(self.cutoffs[i], cfg.height, cfg.width,
+                                        float(world.model.cam_fovy[left]))
             group = []
             for eye in EYES:
                 self._tile_of[i, eye] = len(tiles)
@@ -114,10 +129,10 @@ class VisionSystem:
         jobs = [(self._tile_of[i, e], self.cameras[i][e]) for i in agents for e in EYES]
         result = self.renderer.render(model, data, jobs)
         for i in agents:
-            imgs = {}
+            imgs, blur = {}, self._blur[i]
             for e in EYES:
                 rgb, depth = result[self._tile_of[i, e]]
-                imgs[f"eye_{e}"] = rgb
+                imgs[f"eye_{e}"] = rgb if blur is None else blur(rgb)
                 if depth is not None:
                     imgs[f"depth_{e}"] = depth
             self.images[i] = imgs
