@@ -235,3 +235,54 @@ def test_pickled_copy_continues_identically():
                                       o2["infant_0"]["proprioception"])
         assert i1["infant_0"]["cost"] == i2["infant_0"]["cost"]
     np.testing.assert_array_equal(env.world.data.qpos, clone.world.data.qpos)
+
+
+# -- the figures of docs/bodies.md: `python tests/body/test_positional.py` ------------------------
+def step_response(joint, to_deg, hands="mitten"):
+    """One joint of a fixed-base standing infant stepped to ``to_deg``, the rest held, control
+    every physics step (5 ms): rise time (10-90 %), overshoot (% of the step), the time after
+    which it stays within 2 deg, the error (deg) at 1 s, and the step (deg)."""
+    env = positional_env("standing", hands, fixed=True, physics={"frame_skip": 1})
+    env.reset(seed=0)
+    act, m, d = env.actuation[0], env.world.model, env.world.data
+    step_checked(env, positional_controls(env, 0, "standing"), 100)
+    k = act.control_names.index(joint)
+    q_adr = m.jnt_qposadr[m.actuator_trnid[act.actuator_ids[k], 0]]
+    start = d.qpos[q_adr]
+    v = positional_controls(env, 0, dict(POSTURES["standing"]["joints"], **{joint: to_deg}),
+                            degrees=True)
+    goal = act.targets(v)[k]
+    trace = []
+    for _ in range(200):                                            # 1 s
+        step_checked(env, v, 1)
+        trace.append(d.qpos[q_adr])
+    trace = np.array(trace)
+    x = (trace - start) / (goal - start)
+    t = env.dt * np.arange(1, len(x) + 1)
+    rise = t[np.argmax(x >= 0.9)] - t[np.argmax(x >= 0.1)]
+    err = np.rad2deg(np.abs(trace - goal))
+    outside = np.flatnonzero(err > 2.0)
+    settle = t[outside[-1] + 1] if len(outside) else 0.0
+    return rise, 100 * max(0.0, x.max() - 1), settle, err[-1], np.rad2deg(goal - start)
+
+
+def report():
+    for posture, hands, fixed in (("sitting", "mitten", False), ("sitting", "five_fingers", False),
+                                  ("standing", "mitten", True), ("lying", "mitten", False)):
+        env = positional_env(posture, hands, fixed=fixed)
+        env.reset(seed=0)
+        u = positional_controls(env, 0, posture)
+        info = step_checked(env, u, 200)
+        err = joint_errors_deg(env, u)
+        worst = env.actuation[0].control_names[int(err.argmax())]
+        print(f"hold {posture:8s} {hands:12s} {'fixed' if fixed else 'free '} base, 2 s: max "
+              f"{err.max():.2f} deg ({worst}), mean {err.mean():.2f} deg, cost {info['cost']:.4f}")
+    for joint, to in (("right_elbow", -90), ("right_shoulder_abduction", 90), ("right_knee", -60),
+                      ("head_swivel", 45), ("right_wrist_flexion", 45), ("right_fingers", -120)):
+        rise, over, settle, final, size = step_response(joint, to)
+        print(f"step {joint:25s} {size:+6.1f} deg: rise {1000 * rise:4.0f} ms, overshoot "
+              f"{over:4.1f} %, within 2 deg after {1000 * settle:5.0f} ms, error at 1 s {final:.2f} deg")
+
+
+if __name__ == "__main__":
+    report()
