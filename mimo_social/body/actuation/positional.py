@@ -149,6 +149,10 @@ class Positional(SpringDamper):
         self._u = np.clip(2.0 * (q - self.lo) / (self.hi - self.lo) - 1.0, -1.0, 1.0)
         data.ctrl[self.actuator_ids] = self.targets(self._u)
 
+    def torque(self, u):
+        raise TypeError("positional controls are target angles, not torques; the servo's torques "
+                        "are torques(data)")
+
     def torques(self, data=None) -> np.ndarray:
         """The servo torques of the last physics step (Nm, within the limits)."""
         data = self._data if data is None else data
@@ -193,7 +197,7 @@ def positional_controls(env, agent, pose, degrees: bool = False) -> np.ndarray:
     raise a ValueError. Use it per control step to hold a pose, or with a sequence of poses to
     move through them."""
     names = list(env.possible_agents)
-    i = agent if isinstance(agent, (int, np.integer)) else (
+    i = agent if isinstance(agent, (int, np.integer)) and not isinstance(agent, bool) else (
         names.index(agent) if agent in names else None)
     if i is None or not 0 <= i < len(names):
         raise ValueError(f"agent={agent!r} not in this env; allowed: {names} or 0..{len(names) - 1}")
