@@ -9,7 +9,8 @@ of its segment, its rotation is folded into the segment's orientation and the jo
 from the model (no degree of freedom, no cost); otherwise it is held by an equality constraint.
 Motors of frozen joints are not built.
 
-A larger or stronger body (``scale``, ``strength``) is built from the scaled tables of
+A larger or stronger body (``scale``, ``strength``), an infant of another age
+(``age_months``) or the adult (``body``) is built from the tables of
 :func:`~mimo_social.body.tables.load_body`; nothing here depends on the size.
 """
 
@@ -102,6 +103,8 @@ def build_infant(
     clothes_rgba=DEFAULT_CLOTHES_RGBA,
     scale: float = 1.0,
     strength: float = 1.0,
+    age_months: float | None = None,
+    body: str = "infant",
 ) -> InfantBuild:
     """Build one infant.
 
@@ -117,8 +120,11 @@ def build_infant(
             of :func:`~mimo_social.body.tables.scale_body`).
         strength: factor on every motor's maximum torque and muscle's maximum force, 0.1 to 3
             (:data:`~mimo_social.body.tables.STRENGTH_RANGE`).
+        age_months: the infant's age, 0 to 33 months (segments from growth curves, see
+            :mod:`~mimo_social.body.growth`); None: the published 18-month body.
+        body: ``"infant"`` or ``"adult"`` (the adult caregiver's tables, ``body/adult.py``).
     """
-    tables = load_body(hands, scale, strength)
+    tables = load_body(hands, scale, strength, age_months, body)
     if base not in ("free", "fixed"):
         raise ValueError(f"base={base!r}; allowed: 'free', 'fixed'")
     by_name = {j.name: j for j in tables.joints}

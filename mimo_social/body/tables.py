@@ -20,8 +20,8 @@ from importlib import resources
 import numpy as np
 
 __all__ = ["Segment", "GeomSpec", "JointSpec", "SiteSpec", "BodyTables", "load_body",
-           "scale_body", "HAND_VERSIONS", "SCALE_RANGE", "STRENGTH_RANGE", "SCALING_EXPONENTS",
-           "DEFAULT_FRICTION", "subtree", "arm_joints"]
+           "scale_body", "HAND_VERSIONS", "BODY_KINDS", "AGE_RANGE", "SCALE_RANGE",
+           "STRENGTH_RANGE", "SCALING_EXPONENTS", "DEFAULT_FRICTION", "subtree", "arm_joints"]
 
 #: ``mitten``: the published v1 body (one-piece fingers, 44 motors); ``five_fingers``: the
 #: published v2 body (five articulated fingers per hand, two toes per foot, 88 motors).
@@ -131,6 +131,8 @@ class BodyTables:
     sites: tuple[SiteSpec, ...] = ()
     scale: float = 1.0      # the size factor these tables were scaled by (see scale_body)
     strength: float = 1.0   # the strength factor on top of the size law
+    age_months: float | None = None  # the age grown to (body/growth.py); None: the 18-month body
+    body: str = "infant"    # "infant" or "adult" (body/adult.py)
 
     @property
     def total_mass(self) -> float:
@@ -139,6 +141,12 @@ class BodyTables:
     @property
     def actuated_joints(self) -> tuple[JointSpec, ...]:
         return tuple(j for j in self.joints if j.actuator)
+
+    @property
+    def standing_height(self) -> float:
+        """Top of the head to the soles (m) with every joint at 0 (standing straight): the
+        vertical extent of all geoms, from the segments' positions and orientations."""
+        return _vertical_extent(self)
 
 
 def _floats(text: str) -> tuple[float, ...]:
@@ -197,22 +205,59 @@ def _factor(name: str, value, allowed: tuple[float, float]) -> float:
     return value
 
 
-def load_body(hands: str = "mitten", scale: float = 1.0, strength: float = 1.0) -> BodyTables:
-    """The measurement tables of one hand version with the mirrored left side, scaled to a body
-    ``scale`` times the infant's size and ``strength`` times its strength (see
-    :func:`scale_body`). ``scale=1, strength=1`` gives the published tables unchanged.
+#: Body kinds: the infant (of an age, ``body/growth.py``) and the adult (``body/adult.py``).
+BODY_KINDS = ("infant", "adult")
+#: Infant ages (months) the growth curves cover (``body/growth.py``).
+AGE_RANGE = (0.0, 33.0)
+
+
+def load_body(hands: str = "mitten", scale: float = 1.0, strength: float = 1.0,
+              age_months: float | None = None, body: str = "infant") -> BodyTables:
+    """The measurement tables of one hand version with the mirrored left side: the infant grown
+    to ``age_months`` (0 to 33; None: the published 18-month body; see ``body/growth.py``) or,
+    for ``body="adult"``, the adult caregiver (``body/adult.py``); then scaled to a body
+    ``scale`` times that size and ``strength`` times its strength (see :func:`scale_body`).
+    ``scale=1, strength=1, age_months=None`` gives the published tables unchanged, and so does
+    ``age_months=18``, bit for bit.
 
     Cached: the same arguments give the same (immutable) object.
     """
     if hands not in HAND_VERSIONS:
         raise ValueError(f"hands={hands!r} is not a known hand version; allowed: {HAND_VERSIONS}")
+    if body not in BODY_KINDS:
+        raise ValueError(f"body={body!r} is not a known body; allowed: {BODY_KINDS}")
+    if age_months is not None:
+        if body != "infant":
+            raise ValueError(f"age_months={age_months!r} is for infant bodies; body={body!r} "
+                             "takes age_months=None")
+        age_months = _factor("age_months", age_months, AGE_RANGE)
     return _load(hands, _factor("scale", scale, SCALE_RANGE),
-                 _factor("strength", strength, STRENGTH_RANGE))
+                 _factor("strength", strength, STRENGTH_RANGE), age_months, body)
+
+
+#: The makers of the bodies other than the published infant: ``"grow"`` ->
+#: ``grow_body(tables, age_months)`` (body/growth.py) and ``"adult"`` -> ``adult_tables(hands)``
+#: (body/adult.py). They build on this module, so it cannot import them (no import cycle):
+#: ``body/__init__.py`` wires them in when the package is imported.
+MAKERS: dict = {}
+
+
+def _maker(name: str):
+    if name not in MAKERS:
+        raise ValueError(f"the {name!r} body maker is not available (body/__init__.py wires it "
+                         f"in); available: {sorted(MAKERS)}")
+    return MAKERS[name]
 
 
 @functools.lru_cache(maxsize=None)
-def _load(hands: str, scale: float, strength: float) -> BodyTables:
-    tables = _published(hands)
+def _load(hands: str, scale: float, strength: float, age_months: float | None = None,
+          body: str = "infant") -> BodyTables:
+    if body == "adult":
+        tables = replace(_maker("adult")(hands), body="adult")
+    elif age_months is not None:
+        tables = _maker("grow")(_published(hands), age_months)
+    else:
+        tables = _published(hands)
     if scale == 1.0 and strength == 1.0:
         return tables
     return scale_body(tables, scale, strength)
@@ -268,8 +313,9 @@ def scale_body(tables: BodyTables, scale: float, strength: float = 1.0) -> BodyT
         fmax_pos=opt(j.fmax_pos, f("muscle_fmax") * k)) for j in tables.joints)
     sites = tuple(replace(t, pos=vec(t.pos)) for t in tables.sites)
     spacing = {b: v * f("touch_spacing") for b, v in tables.touch_spacing.items()}
-    return BodyTables(tables.hands, segments, geoms, joints, spacing, sites,
-                      scale=tables.scale * s, strength=tables.strength * k)
+    return replace(tables, segments=segments, geoms=geoms, joints=joints,
+                   touch_spacing=spacing, sites=sites, scale=tables.scale * s,
+                   strength=tables.strength * k)
 
 
 @functools.lru_cache(maxsize=None)
@@ -343,6 +389,48 @@ def _published(hands: str) -> BodyTables:
     if len(order) != len(segments):
         raise ValueError("body table: a segment's parent is missing")
     return BodyTables(hands, tuple(order), geoms_all, joints_all, spacing, sites_all)
+
+
+def _quat_rotate(q, v) -> np.ndarray:
+    w, u = q[0], np.asarray(q[1:], float)
+    v = np.asarray(v, float)
+    return v + 2.0 * np.cross(u, np.cross(u, v) + w * v)
+
+
+def _quat_mul(a, b) -> tuple:
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return (aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw)
+
+
+_GEOM_AXIS = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+def _vertical_extent(tables: BodyTables) -> float:
+    """Highest minus lowest point of every geom with the segments at their table pose."""
+    frames = {}
+    for seg in tables.segments:  # tree order
+        if seg.parent is None:
+            frames[seg.name] = (np.asarray(seg.pos, float), tuple(seg.quat))
+        else:
+            p, q = frames[seg.parent]
+            frames[seg.name] = (p + _quat_rotate(q, seg.pos), _quat_mul(q, seg.quat))
+    lo, hi = np.inf, -np.inf
+    for g in tables.geoms:
+        p, q = frames[g.body]
+        centre = (p + _quat_rotate(q, g.pos))[2]
+        ez = np.array([_quat_rotate(q, e)[2] for e in np.eye(3)])  # segment axes' z parts
+        if g.type == "sphere":
+            half = g.size[0]
+        elif g.type in ("capsule", "cylinder"):
+            c = abs(float(np.dot(ez, _GEOM_AXIS[g.axis])))
+            across = g.size[0] * np.sqrt(max(0.0, 1.0 - c * c))
+            half = g.size[1] * c + (g.size[0] if g.type == "capsule" else across)
+        else:  # box, ellipsoid (its bounding box); sizes on the segment's axes (axis "z")
+            half = float(np.dot(np.abs(ez), g.size[:3]))
+        lo, hi = min(lo, centre - half), max(hi, centre + half)
+    return float(hi - lo)
 
 
 def joint_limits_rad(tables: BodyTables) -> np.ndarray:

@@ -15,6 +15,7 @@ from gymnasium import spaces
 
 from ..util.checks import (ConfigError, check_bool, check_choice, check_int, check_number,
                            check_numbers)
+from ..body.tables import load_body
 from .config import AgentConfig
 from .world import AgentSetup, Prop
 
@@ -231,16 +232,28 @@ class Task:
     HALF_WIDTH = 0.2
     CLEARANCE = 0.14
 
+    @staticmethod
+    def body_size(config: AgentConfig) -> float:
+        """The agent's size relative to the published 18-month infant: its ``scale`` times its
+        body's standing height (of its age, or the adult's) over the infant's (1 for the
+        published infant, exactly)."""
+        c = config
+        own = load_body(c.hands, age_months=c.age_months, body=c.body).standing_height
+        return c.scale * (own / load_body(c.hands).standing_height)
+
     def placement(self, i: int, configs: Sequence[AgentConfig] = ()) -> tuple:
         """Agents on a circle around the origin, each facing the centre.
 
         The radius leaves room for the largest agent's reach and half width (both times its
-        ``scale``)."""
+        size, :meth:`body_size`: its ``scale``, age and body; a posture without a reach of its
+        own, e.g. kneeling, takes the largest)."""
         if self.n_agents == 1:
             return (0.0, 0.0), (1.0, 0.0)
-        reach = max((self.POSTURE_REACH[c.posture] * c.scale for c in configs),
-                    default=self.POSTURE_REACH["standing"])
-        half = max((self.HALF_WIDTH * c.scale for c in configs), default=self.HALF_WIDTH)
+        far = max(self.POSTURE_REACH.values())
+        reach = max((self.POSTURE_REACH.get(c.posture, far) * self.body_size(c)
+                     for c in configs), default=self.POSTURE_REACH["standing"])
+        half = max((self.HALF_WIDTH * self.body_size(c) for c in configs),
+                   default=self.HALF_WIDTH)
         sin = np.sin(np.pi / self.n_agents)
         radius = max(0.3, reach + self.CLEARANCE / sin, half / sin)
         angle = np.pi + 2 * np.pi * i / self.n_agents
