@@ -166,7 +166,8 @@ class World:
             cfg = setup.config
             rgba = cfg.clothes_rgba or CLOTHES_PALETTE[i % len(CLOTHES_PALETTE)]
             build = build_infant(cfg.hands, setup.frozen, setup.base, rgba,
-                                 scale=cfg.scale, strength=cfg.strength)
+                                 scale=cfg.scale, strength=cfg.strength,
+                                 age_months=cfg.age_months, body=cfg.body)
             unknown = sorted(set(setup.actuated or ()) - set(build.actuated))
             if unknown:
                 raise ValueError(f"{self.names[i]}: cannot actuate {unknown}: not motor joints "
