@@ -11,6 +11,13 @@ allowed. A simulation that goes unstable ends the episode for every agent with t
 The senses come from the registry :data:`mimo_social.senses.SENSES`: for each registered sense
 that an agent has on, a sense of its own, or one shared system for the world (the skin reads the
 contacts once for everyone, the eyes of everyone share one renderer) with a sense per agent.
+
+Sensorimotor delays (``AgentConfig.delays``, :mod:`mimo_social.core.delays`): a sense delayed by
+``k`` control steps observes at step ``t`` what it read at ``t - k`` (the reading at reset before
+that); the controls applied at step ``t`` are those given at ``t - k`` (before that, those in force
+at reset). ``env.controls``, the actuation part of proprioception and the infos' ``cost`` describe
+the applied controls; task observations, sense infos and the expression are not delayed.
+:meth:`MimoParallelEnv.delay_steps` gives each agent's delays in steps.
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ from ..render.scene import make_renderer
 from ..senses import SENSES
 from ..util.checks import check_seed, number_array, show
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
+from .delays import MotorDelay, SenseDelay, delay_steps, fill_sensor_history
 from .task import Task, agent_user_settings, check_start_poses
 from .world import World
 
@@ -47,7 +55,7 @@ class MimoParallelEnv(ParallelEnv):
       skin of every agent, ``"vision"``: the eyes of every agent), only for senses some agent
       has on; ``env.system(name)`` returns one or raises a ValueError saying how to turn it on;
     * ``env.controls``: per agent (index order) the motor controls applied at the last step,
-      after clipping;
+      after clipping (with a motor delay of k steps: those given k steps before);
     * ``env.steps``: control steps since the last reset;
     * ``env.agent_configs``, ``env.physics``, ``env.dt``, ``env.timing`` (seconds per
       component, keys :data:`TIMING_KEYS`).
@@ -73,6 +81,8 @@ class MimoParallelEnv(ParallelEnv):
         self.frame_skip = self.physics.frame_skip
         self.dt = self.physics.timestep * self.frame_skip
         self.metadata = dict(self.metadata, render_fps=int(round(1.0 / self.dt)))
+        # each agent's delays in control steps (vestibular: MuJoCo's sensor delay, set by World)
+        self._delays = [delay_steps(cfg, self.dt) for cfg in self.agent_configs]
         task.configs = tuple(self.agent_configs)
         setups = [task.setup(i, cfg) for i, cfg in enumerate(self.agent_configs)]
         self.world = World(setups, task.props(), self.physics)
@@ -132,6 +142,17 @@ class MimoParallelEnv(ParallelEnv):
                                       if self.agent_configs[i].expressions else motors)
         self._expression = np.zeros(len(self.possible_agents), dtype=np.int64)
         self.controls = [np.zeros(act.n_controls) for act in self.actuation]
+        # ring buffers: per agent one per sense (None: undelayed; vestibular is MuJoCo's), motor
+        self._sense_delays = [[SenseDelay(k) if (k := self._delays[i][s.name]) and
+                               s.name != "vestibular" else None for s in self.senses[i]]
+                              for i in range(len(self.possible_agents))]
+        self._motor_delays = [MotorDelay(k, act.n_controls) if (k := self._delays[i]["motor"])
+                              else None for i, act in enumerate(self.actuation)]
+
+    def delay_steps(self, agent) -> dict[str, int]:
+        """The delays of ``agent`` (name) in control steps, channel -> k (``round(ms / (1000 *
+        dt))``, halves up; 0: undelayed)."""
+        return dict(self._delays[self._index[self._check_agent(agent)]])
 
     def system(self, name: str):
         """The shared system of a sense (``"touch"``: the skin of every agent, ``"vision"``: the
@@ -166,13 +187,17 @@ class MimoParallelEnv(ParallelEnv):
             c[:] = 0.0
         self.task.reset(self, self._rng)
         mujoco.mj_forward(w.model, w.data)
+        fill_sensor_history(w.model, w.data, w.delayed_sensors)   # delayed vestibular sensors
         for system in self.systems.values():
             system.reset(w.model, w.data)
         self._update_shared()
         self.agents = list(self.possible_agents)
         self.steps = 0
         self._was_reset = True
-        obs = {a: self._observe(i) for i, a in enumerate(self.agents)}
+        for c, ring in zip(self.controls, self._motor_delays):
+            if ring is not None:
+                ring.reset(c)
+        obs = {a: self._observe(i, reset=True) for i, a in enumerate(self.agents)}
         infos = {a: self._info(i) for i, a in enumerate(self.agents)}
         return obs, infos
 
@@ -271,7 +296,12 @@ class MimoParallelEnv(ParallelEnv):
                 w.set_expression(i, expression)
             # the env's own buffer: the caller's array is never written to nor kept
             c = self.controls[i]
-            np.clip(u, act.control_low, act.control_high, out=c)
+            ring = self._motor_delays[i]
+            if ring is None:
+                np.clip(u, act.control_low, act.control_high, out=c)
+            else:   # the controls given k steps ago are applied
+                np.clip(u, act.control_low, act.control_high, out=ring.slot())
+                np.copyto(c, ring.advance())
             act.apply(w.model, w.data, c)
 
     @staticmethod
@@ -298,13 +328,18 @@ class MimoParallelEnv(ParallelEnv):
                              f"values must be finite, in [{lo}, {hi}]")
         return u
 
-    def _observe(self, i: int) -> dict:
+    def _observe(self, i: int, reset: bool = False) -> dict:
         m, d = self.world.model, self.world.data
         out = {}
         timing = self.timing
         t = time.perf_counter()
-        for sense in self.senses[i]:
-            sense.observe(m, d, out)
+        for sense, ring in zip(self.senses[i], self._sense_delays[i]):
+            if ring is None:
+                sense.observe(m, d, out)
+            else:
+                reading = {}
+                sense.observe(m, d, reading)
+                out.update(ring.reset(reading) if reset else ring.push(reading))
             t2 = time.perf_counter()
             timing[sense.name] += t2 - t
             t = t2

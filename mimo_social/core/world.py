@@ -24,6 +24,7 @@ from ..body.builder import axis_angle_quat, build_infant, quat_mul
 from ..body.postures import POSTURES
 from ..expressions.switch import FaceTextures
 from .config import AgentConfig, PhysicsConfig
+from .delays import delay_sensors, delay_steps, fill_sensor_history
 
 __all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE"]
 
@@ -177,6 +178,9 @@ class World:
                 pos=[setup.position[0], setup.position[1], height], quat=root_quat)
             prefix = f"{self.names[i]}/"
             spec.attach(build.spec, prefix=prefix, frame=frame)
+            k = delay_steps(cfg, physics.timestep * physics.frame_skip)["vestibular"]
+            if k and cfg.vestibular:    # MuJoCo's own sensor delay (core/delays.py)
+                delay_sensors(spec, prefix, k, physics.timestep, physics.frame_skip)
             mat = spec.add_material(name=f"{prefix}face")
             self.faces.bind_material(mat)
             spec.geom(f"{prefix}head").material = f"{prefix}face"
@@ -186,6 +190,7 @@ class World:
         self.spec = spec
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
+        self.delayed_sensors = np.flatnonzero(self.model.sensor_delay > 0)
         self._index(builds)
         self._initial_qpos = self.model.qpos0.copy()
         for a, (build, pose_q) in zip(self.agents, builds):
@@ -362,6 +367,7 @@ class World:
         for a in self.agents:
             self.faces.show(self.model, a.head_material, 0)
         mujoco.mj_forward(self.model, self.data)
+        fill_sensor_history(self.model, self.data, self.delayed_sensors)
         self._bad_count = 0
 
     def hold_welds(self) -> None:
@@ -467,6 +473,7 @@ class World:
         d.qpos[:] = self._initial_qpos
         d.time = t
         mujoco.mj_forward(m, d)
+        fill_sensor_history(m, d, self.delayed_sensors)
         self._bad_count = 0
 
     def set_expression(self, agent: int, expression: int) -> None:
