@@ -218,18 +218,25 @@ def test_every_age_holds_a_posture_and_plays_stably(age):
         assert not any("instability" in i for i in infos.values())
 
 
-def test_newborn_at_full_strength_survives_bang_bang_actions():
-    """Every motor at -1 or +1, redrawn each step, for the smallest body at the largest allowed
-    strength (3): no divergence in 3000 control steps (30 s)."""
-    env = free_play_v0.parallel_env(n_agents=1, age_months=0, strength=3.0, max_steps=3000)
+@pytest.mark.parametrize("hands, actuation", [
+    ("mitten", "spring_damper"), ("five_fingers", "spring_damper"), ("mitten", "muscle"),
+    pytest.param("five_fingers", "muscle", marks=pytest.mark.xfail(
+        reason="diverges about once per 3000-6000 steps (a toe, the thumb or a shoulder; "
+               "docs/bodies.md, Bodies that grow): a smaller timestep is the remedy"))])
+def test_newborn_at_full_strength_survives_bang_bang_actions(hands, actuation):
+    """Every motor at its lowest or highest control, redrawn each step, for the smallest body
+    at the largest allowed strength (3): no divergence in 3000 control steps (30 s)."""
+    env = free_play_v0.parallel_env(n_agents=1, age_months=0, strength=3.0, max_steps=3000,
+                                     hands=hands, actuation=actuation)
     env.reset(seed=0)
     rng = np.random.default_rng(0)
     agent = env.agents[0]
     space = env.action_space(agent)
     dict_space = hasattr(space, "spaces")
-    n = (space["motors"] if dict_space else space).shape[0]
+    motors = space["motors"] if dict_space else space
     for _ in range(3000):
-        motors = rng.choice([-1.0, 1.0], n).astype(np.float32)
-        action = {"motors": motors, "expression": 0} if dict_space else motors
+        u = np.where(rng.random(motors.shape[0]) < 0.5, motors.low, motors.high)
+        u = u.astype(np.float32)
+        action = {"motors": u, "expression": 0} if dict_space else u
         _, _, _, _, infos = env.step({agent: action})
         assert "instability" not in infos[agent]
