@@ -21,7 +21,7 @@ import mujoco
 import numpy as np
 
 from ..body.builder import axis_angle_quat, build_infant, quat_mul
-from ..body.postures import POSTURES
+from ..body.postures import posture_joints, posture_pitch
 from ..expressions.switch import FaceTextures
 from .config import AgentConfig, PhysicsConfig
 from .delays import delay_sensors, delay_steps, fill_sensor_history
@@ -268,7 +268,7 @@ class World:
         model = spec.compile()
         data = mujoco.MjData(model)
         by_name = {j.name: j for j in build.tables.joints}
-        wanted = POSTURES[posture]["joints"]
+        wanted = posture_joints(posture, build.tables.body)
         pose = {}
         for name in build.joints:
             j = by_name[name]
@@ -281,7 +281,7 @@ class World:
                 pose[name] = float(np.clip(pose[j.coupled_to] * j.coupling, lo, hi))
         for name in build.locked:
             pose[name] = build.frozen[name]
-        pitch = axis_angle_quat((0, 1, 0), np.deg2rad(POSTURES[posture]["pitch_deg"]))
+        pitch = axis_angle_quat((0, 1, 0), np.deg2rad(posture_pitch(posture, build.tables.body)))
         root_quat = quat_mul(_yaw_quat(setup.position, setup.facing), pitch)
         data.qpos[model.joint("root").qposadr[0] + 3:][:4] = root_quat
         for name, angle in pose.items():
