@@ -25,8 +25,11 @@ slightly finer there in degrees. Where the cut-off is at or above the image's Ny
 newborn's 0.66 cycles per degree blurs images of 88 pixels and taller, 6 months' 7.4 only images
 of 985 pixels and taller (:func:`blur_acts_from_height`).
 
-**Cost**: two matrix products per image in float32 (``rows @ image @ columns^T``, the Gaussian
-weights cut at 4 sigma, which also keeps float32 denormals out of the products), uint8 out. Depth
+**Cost**: per colour channel, two products of a band matrix (the Gaussian weights, cut at 4
+sigma) with the channel in float32 (``rows @ channel @ columns^T``), uint8 out. The band matrices are sparse (scipy CSR): their
+products run in one thread; dense products through a multithreaded BLAS were as fast alone but
+fought the software renderer's threads for the cores inside an env (10 times slower per step on a
+2-core machine), and the cut keeps float32 denormals (100 times slower) out of the sums. Depth
 images are not blurred: a depth image is the distance along each pixel's ray, not light on a
 retina, and averaging distances across an occluding edge would make surfaces that are not there.
 """
@@ -40,6 +43,7 @@ from importlib import resources
 from numbers import Real
 
 import numpy as np
+from scipy import sparse
 
 from ..body.builder import EYE_FOVY_DEG
 from ..util.checks import ConfigError, show
@@ -105,8 +109,8 @@ def blur_acts_from_height(cutoff_cpd: float, fovy_deg: float = EYE_FOVY_DEG) -> 
     return int(math.floor(2.0 * cutoff_cpd / per_px)) + 1
 
 
-def _blur_matrix(n: int, sigma: float) -> np.ndarray:
-    """``(n, n)`` float32: row i holds the Gaussian weights of pixel i's neighbours, reflected at
+def _blur_matrix(n: int, sigma: float) -> sparse.csr_matrix:
+    """``(n, n)`` float32, sparse: row i holds the Gaussian weights of pixel i's neighbours, reflected at
     the image's edges (``..., 2, 1 | 0, 1, 2, ...``) and summing to 1."""
     radius = max(1, int(math.ceil(_KERNEL_SIGMAS * sigma)))
     offsets = np.arange(-radius, radius + 1)
@@ -120,7 +124,7 @@ def _blur_matrix(n: int, sigma: float) -> np.ndarray:
         cols = np.abs(cols) % period                # reflect about 0 and n - 1
         cols = np.where(cols > n - 1, period - cols, cols)
         np.add.at(out, (rows, cols), w)
-    return out.astype(np.float32)
+    return sparse.csr_matrix(out.astype(np.float32))
 
 
 class AcuityBlur:
@@ -138,7 +142,7 @@ class AcuityBlur:
         self.identity = self.sigma_px == 0.0
         if not self.identity:
             self._rows = _blur_matrix(self.height, self.sigma_px)                 # (H, H)
-            self._cols_t = np.ascontiguousarray(_blur_matrix(self.width, self.sigma_px).T)
+            self._cols = _blur_matrix(self.width, self.sigma_px)                  # (W, W)
 
     def modulation(self, cpd: float) -> float:
         """The filter's modulation transfer at ``cpd`` cycles per degree on the line of sight
@@ -154,13 +158,14 @@ class AcuityBlur:
         h, w = self.height, self.width
         if image.shape[:2] != (h, w) or image.ndim not in (2, 3):
             raise ValueError(f"acuity blur for {h}x{w} images got shape {image.shape}")
-        c = 1 if image.ndim == 2 else image.shape[2]
-        # channels before columns: (H, C, W), so both products are plain 2-D matrix products
-        x = image.reshape(h, w, c).transpose(0, 2, 1).astype(np.float32).reshape(h * c, w)
-        y = (x @ self._cols_t).reshape(h, c * w)           # blur along each row
-        z = (self._rows @ y).reshape(h, c, w)                # then along each column
-        z += np.float32(0.5)                                 # round (weights >= 0, sum 1)
-        out = z.transpose(0, 2, 1).astype(np.uint8, order="C")
+        planes = image[..., None] if image.ndim == 2 else image
+        out = np.empty(planes.shape, np.uint8)
+        for k in range(planes.shape[2]):        # channel by channel: each product cache-sized
+            x = planes[:, :, k].astype(np.float32)
+            y = self._rows @ x                           # blur along each column
+            z = (self._cols @ y.T).T                     # then along each row
+            z += np.float32(0.5)                         # round (weights >= 0, sum 1)
+            out[:, :, k] = z
         return out.reshape(image.shape)
 
 
