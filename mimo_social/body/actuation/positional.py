@@ -50,7 +50,7 @@ from typing import Mapping
 import mujoco
 import numpy as np
 
-from ..postures import POSTURES
+from ..postures import POSTURES, posture_joints
 from .spring_damper import SpringDamper
 
 __all__ = ["Positional", "positional_controls", "SATURATION_ANGLE", "OMEGA_DT", "ZETA"]
@@ -189,8 +189,9 @@ class Positional(SpringDamper):
 def positional_controls(env, agent, pose, degrees: bool = False) -> np.ndarray:
     """The controls of a positional ``agent`` (name or index) of ``env`` that target ``pose``.
 
-    ``pose``: a posture name of :data:`~mimo_social.body.postures.POSTURES` (its joint angles;
-    the rest at their spring reference, as the world places a posture), or a mapping joint name
+    ``pose``: a posture name of :data:`~mimo_social.body.postures.POSTURES` (its joint angles for
+    the agent's body, :func:`~mimo_social.body.postures.posture_joints`; the rest at their spring
+    reference, as the world places a posture), or a mapping joint name
     -> angle in rad (``degrees=True``: in degrees), e.g. the held angles of a task. Motors not
     named target their spring reference; joints of the body that are not motors of this agent
     (coupled, held or left out of the action) are skipped; names that are not joints of its body
@@ -208,7 +209,7 @@ def positional_controls(env, agent, pose, degrees: bool = False) -> np.ndarray:
     if isinstance(pose, str):
         if pose not in POSTURES:
             raise ValueError(f"{names[i]}: posture {pose!r} unknown; allowed: {sorted(POSTURES)}")
-        pose, degrees = POSTURES[pose]["joints"], True
+        pose, degrees = posture_joints(pose, env.world.tables[i].body), True
     if not isinstance(pose, Mapping):
         raise ValueError(f"{names[i]}: pose={pose!r} not allowed; allowed: a posture name "
                          f"{sorted(POSTURES)} or a mapping joint name -> angle")
