@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import mimo_social  # noqa: F401  (chooses the headless OpenGL backend before mujoco loads)
+import mimo_social  # noqa: F401 (chooses the headless OpenGL backend before mujoco loads)
 import mujoco
 import numpy as np
 
@@ -93,7 +93,8 @@ def main(argv=None) -> None:
     dpi = 100
     fig, axes = plt.subplots(2, len(rows), figsize=(len(rows) * args.crop / dpi,
                                                     2 * args.crop / dpi + 0.9), dpi=dpi)
-    crop_deg = args.crop / args.size * 60
+    focal = (args.size / 2) / np.tan(np.radians(60) / 2)       # pixels
+    crop_deg = 2 * np.degrees(np.arctan(args.crop / 2 / focal))
     for col, (label, view, centre) in enumerate(rows):
         axes[0, col].imshow(view, interpolation="none")
         axes[0, col].set_title(label, fontsize=9)
