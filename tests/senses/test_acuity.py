@@ -2,6 +2,7 @@
 cycles per degree through the eye's geometry, and the blur in an env's eye images."""
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -130,6 +131,9 @@ def test_the_young_eye_sees_less_fine_detail_and_18_months_at_128_px_is_untouche
         assert abs(blurred.astype(float).mean() - sharp.astype(float).mean()) < 1.0
         # the 18-month-old's cut-off is above 128 px's Nyquist: its images bit for bit
         assert np.array_equal(obs_on[old][eye], obs_off[old][eye])
+    copy = pickle.loads(pickle.dumps(vision_system(on)))      # the blur travels with the env
+    assert copy.cutoffs == {0: 0.66, 1: 12.39} and copy._blur[1] is None
+    assert np.array_equal(copy._blur[0](obs_off[young]["eye_left"]), obs_on[young]["eye_left"])
     for agent in (young, old):  # depth stays sharp
         for eye in ("depth_left", "depth_right"):
             assert np.array_equal(obs_on[agent][eye], obs_off[agent][eye])
