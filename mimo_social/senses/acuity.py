@@ -26,8 +26,8 @@ newborn's 0.66 cycles per degree blurs images of 88 pixels and taller, 6 months'
 of 985 pixels and taller (:func:`blur_acts_from_height`).
 
 **Cost**: per colour channel, two products of a band matrix (the Gaussian weights, cut at 4
-sigma) with the channel in float32 (``rows @ channel @ columns^T``), uint8 out. The band matrices are sparse (scipy CSR): their
-products run in one thread; dense products through a multithreaded BLAS were as fast alone but
+sigma) with the channel in float32 (``rows @ channel @ columns^T``), uint8 out. The band
+matrices are sparse (scipy CSR): their products run in one thread; dense products through a multithreaded BLAS were as fast alone but
 fought the software renderer's threads for the cores inside an env (12 times slower per step on a
 2-core machine), and the cut keeps float32 denormals (20-30 times slower) out of the sums. Depth
 images are not blurred: a depth image is the distance along each pixel's ray, not light on a
@@ -110,8 +110,8 @@ def blur_acts_from_height(cutoff_cpd: float, fovy_deg: float = EYE_FOVY_DEG) -> 
 
 
 def _blur_matrix(n: int, sigma: float) -> sparse.csr_matrix:
-    """``(n, n)`` float32, sparse: row i holds the Gaussian weights of pixel i's neighbours, reflected at
-    the image's edges (``..., 2, 1 | 0, 1, 2, ...``) and summing to 1."""
+    """``(n, n)`` float32, sparse: row i holds the Gaussian weights of pixel i's neighbours,
+    reflected at the image's edges (``..., 2, 1 | 0, 1, 2, ...``) and summing to 1."""
     radius = max(1, int(math.ceil(_KERNEL_SIGMAS * sigma)))
     offsets = np.arange(-radius, radius + 1)
     weights = np.exp(-0.5 * (offsets / sigma) ** 2)
