@@ -27,9 +27,10 @@ of 985 pixels and taller (:func:`blur_acts_from_height`).
 
 **Cost**: per colour channel, two products of a band matrix (the Gaussian weights, cut at 4
 sigma) with the channel in float32 (``rows @ channel @ columns^T``), uint8 out. The band
-matrices are sparse (scipy CSR): their products run in one thread; dense products through a multithreaded BLAS were as fast alone but
-fought the software renderer's threads for the cores inside an env (12 times slower per step on a
-2-core machine), and the cut keeps float32 denormals (20-30 times slower) out of the sums. Depth
+matrices are sparse (scipy CSR): their products run in one thread; dense products through a
+multithreaded BLAS were as fast alone but fought the software renderer's threads for the cores
+inside an env (12 times slower per step on a 2-core machine), and the cut keeps float32
+denormals (20-30 times slower) out of the sums. Depth
 images are not blurred: a depth image is the distance along each pixel's ray, not light on a
 retina, and averaging distances across an occluding edge would make surfaces that are not there.
 """
