@@ -14,9 +14,10 @@
 3. joint ranges from ``adult_ranges.csv`` (AAOS); motor torques from ``adult_torques.csv`` where
    measured, elsewhere the infant's torque times the ratio of adult to infant torque at the
    reference joint of its region (elbow flexion for the head and arms, the knee for the trunk
-   and legs: the rule MIMo's authors used to fill their own table); the muscle ``fmax``, joint
-   stiffness, damping, friction loss and armature follow the torque (see
-   :func:`~mimo_social.body.resize.resize_body`); the eyes keep the volume law.
+   and legs: the rule MIMo's authors used to fill their own table); the muscle ``fmax``
+   follows each direction's torque, the joint stiffness, damping and friction loss the
+   region's ratio; the armature (an inertia) and the eyes' motors keep the volume law of
+   :func:`~mimo_social.body.resize.resize_body`.
 
 The result is unscaled (``scale`` 1 means this adult); :func:`~mimo_social.body.tables.load_body`
 applies ``scale`` and ``strength`` on top.
@@ -267,8 +268,12 @@ def adult_tables(hands: str = "mitten") -> BodyTables:
     ratios = region_ratios(infant)
     region = {j.name: _region(infant, j) for j in infant.joints}
     torque_factors = {n: ratios[r] for n, r in region.items() if r is not None}
-    resized = resize_body(infant, _factors(infant, radial, axial), torque_factors)
+    factors = _factors(infant, radial, axial)
+    resized = resize_body(infant, factors, torque_factors)
+    # the armature is an inertia: it follows the mass and length moved (the volume law), not
+    # the strength
+    armature = {j.name: j.armature for j in resize_body(infant, factors).joints}
     before = {j.name: j for j in infant.joints}
-    joints = tuple(_adult_joint(j, before[j.name], ratios.get(region[j.name]))
-                   for j in resized.joints)
+    joints = tuple(_adult_joint(replace(j, armature=armature[j.name]), before[j.name],
+                                ratios.get(region[j.name])) for j in resized.joints)
     return replace(resized, joints=joints, body="adult")

@@ -211,3 +211,74 @@ def test_the_adult_survives_bang_bang_actions():
                        "expression": 0}
         _, _, _, _, infos = env.step(acts)
         assert not any("instability" in i for i in infos.values())
+
+
+def figures(hands="mitten"):
+    """The adult as built: stature, mass, landmark fractions, group mass fractions, eye heights
+    in the held postures (printed by ``python tests/body/test_adult.py``)."""
+    m, d = standing_model(hands)
+    z, H = heights(m, d), STATURE
+    t = load_body(hands, body="adult")
+    head = next(g for g in t.geoms if g.name == "head")
+    print(f"{hands}: stature {z['top']:.4f} m, mass {t.total_mass:.3f} kg, "
+          f"head circumference {2 * math.pi * head.size[0]:.3f} m")
+    for name in ("right_upper_arm", "right_lower_arm", "right_upper_leg", "right_lower_leg",
+                 "right_foot", "right_eye"):
+        print(f"  {name} height {z[name]:.4f} m = {z[name] / H:.4f} H")
+    print("  hand, foot, ankle (fractions of H):",
+          {k: round(v / H, 4) for k, v in adult._lengths(t).items()})
+    mass = {}
+    for g in t.geoms:
+        mass[g.body] = mass.get(g.body, 0.0) + g.mass
+    for group, names in adult._groups(load_body(hands)).items():
+        extra = ("right_eye", "left_eye") if group == "head" else ()
+        print(f"  {group}: {sum(mass[n] for n in names + list(extra)):.3f} kg = "
+              f"{sum(mass[n] for n in names + list(extra)) / BODY_MASS:.4f} "
+              f"(de Leva {MASS_FRACTIONS[group][1]})")
+    for body, posture in (("adult", "standing"), ("adult", "sitting"), ("adult", "kneeling"),
+                          ("infant", "standing"), ("infant", "sitting"), ("infant", "kneeling")):
+        world = held_world(body, posture, hands)
+        eye = world.model.body("infant_0/right_eye").id
+        mujoco.mj_forward(world.model, world.data)
+        start = world.data.xpos[eye, 2]
+        world.step(int(round(2.0 / world.model.opt.timestep)))
+        print(f"  {body} {posture} (held): eyes at {start:.3f} m, after 2 s "
+              f"{world.data.xpos[eye, 2]:.3f} m")
+
+
+def stress(hands="mitten", actuation="spring_damper", strength=1.0, posture="standing",
+           steps=5000, body="adult", seed=0):
+    """Bang-bang actions for one agent in free play: prints the instabilities (the env resets
+    after each) and the fastest hinge (``python tests/body/test_adult.py stress five_fingers
+    spring_damper 3 standing 50000``)."""
+    env = free_play_v0.parallel_env(n_agents=1, body=body, hands=hands, actuation=actuation,
+                                    strength=float(strength), posture=posture,
+                                    max_steps=int(steps))
+    env.reset(seed=int(seed))
+    rng = np.random.default_rng(int(seed))
+    m, d = env.world.model, env.world.data
+    agent = env.agents[0]
+    n = env.action_space(agent)["motors"].shape[0]
+    fastest, unstable = np.zeros(m.nv), []
+    for t in range(int(steps)):
+        u = rng.choice([-1.0, 1.0], n).astype(np.float32)
+        _, _, term, trunc, infos = env.step({agent: {"motors": u, "expression": 0}})
+        fastest = np.maximum(fastest, np.abs(d.qvel))
+        if "instability" in infos[agent]:
+            unstable.append((t, infos[agent]["instability"].split(":")[1][:60]))
+        if term[agent] or trunc[agent]:
+            env.reset(seed=t)
+    dof = int(np.argmax(fastest[6:])) + 6
+    joint = next(m.joint(j).name for j in range(m.njnt) if m.jnt_dofadr[j] == dof)
+    print(f"{body} {hands} {actuation} strength {strength} {posture}: {steps} steps, "
+          f"{len(unstable)} instabilities {unstable}; fastest hinge {joint} "
+          f"{fastest[dof]:.0f} rad/s")
+
+
+if __name__ == "__main__":
+    import sys
+
+    if sys.argv[1:2] == ["stress"]:
+        stress(*sys.argv[2:])
+    else:
+        figures()
