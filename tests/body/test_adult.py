@@ -3,6 +3,7 @@ tables with adult proportions (Drillis & Contini 1966 via Winter 2009 Fig. 4.1),
 (de Leva 1996, female), ranges (AAOS 1965) and torques (body/data/adult_*.csv, README)."""
 
 import math
+import pickle
 
 import mujoco
 import numpy as np
@@ -194,6 +195,22 @@ def test_an_adult_kneels_face_to_face_with_an_infant_in_free_play():
     for _ in range(int(round(2.0 / env.dt))):
         _, _, _, _, infos = env.step(zero)
         assert not any("instability" in i for i in infos.values())
+
+
+def test_an_env_with_an_adult_pickles_and_continues_exactly():
+    env = free_play_v0.parallel_env(n_agents=2, per_agent=[{}, {"body": "adult",
+                                                                "posture": "sitting"}])
+    env.reset(seed=0)
+    act = {a: {"motors": np.full(env.action_space(a)["motors"].shape, 0.3, np.float32),
+               "expression": 2} for a in env.agents}
+    for _ in range(5):
+        env.step(act)
+    copy = pickle.loads(pickle.dumps(env))
+    assert copy.world.model.body_subtreemass[copy.world.agents[1].root_body] == \
+        pytest.approx(59.994)
+    a, b = env.step(act)[0], copy.step(act)[0]
+    for agent in a:
+        np.testing.assert_array_equal(a[agent]["proprioception"], b[agent]["proprioception"])
 
 
 def test_the_adult_survives_bang_bang_actions():
