@@ -252,6 +252,11 @@ def figures(hands="mitten"):
         print(f"  {group}: {sum(mass[n] for n in names + list(extra)):.3f} kg = "
               f"{sum(mass[n] for n in names + list(extra)) / BODY_MASS:.4f} "
               f"(de Leva {MASS_FRACTIONS[group][1]})")
+    env = free_play_v0.parallel_env(n_agents=2, touch=True, hands=hands,
+                                    per_agent=[{}, {"body": "adult"}])
+    obs, _ = env.reset(seed=0)
+    print(f"  touch points: adult {obs['infant_1']['touch'].size}, infant "
+          f"{obs['infant_0']['touch'].size}")
     for body, posture in (("adult", "standing"), ("adult", "sitting"), ("adult", "kneeling"),
                           ("infant", "standing"), ("infant", "sitting"), ("infant", "kneeling")):
         world = held_world(body, posture, hands)
