@@ -35,7 +35,7 @@ from .resize import resize_body
 from .tables import BodyTables, GeomSpec, load_body, subtree
 
 __all__ = ["adult_tables", "ANTHROPOMETRY", "MASS_FRACTIONS", "ADULT_RANGES", "ADULT_TORQUES",
-           "STATURE", "BODY_MASS", "HEAD_CIRCUMFERENCE", "region_ratios"]
+           "STATURE", "BODY_MASS", "HEAD_CIRCUMFERENCE", "HEAD_RADIUS", "region_ratios"]
 
 
 def _rows(name: str) -> list[dict]:
@@ -59,6 +59,8 @@ ADULT_TORQUES = {r["joint"]: tuple(float(v) if v.strip() else None
 STATURE = ANTHROPOMETRY["stature"]
 BODY_MASS = ANTHROPOMETRY["body_mass"]
 HEAD_CIRCUMFERENCE = ANTHROPOMETRY["head_circumference"]
+#: the head sphere's radius (m), from the circumference
+HEAD_RADIUS = HEAD_CIRCUMFERENCE / (2.0 * math.pi)
 
 _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 _GEOM_TO_SEGMENT = {"z": "xyz", "x": "zyx", "y": "xzy"}  # as in resize.py
@@ -146,12 +148,8 @@ def _axial_factors(t: BodyTables, built: dict, axial: dict | None = None) -> dic
     hip_joint = a["hip_height"] * H
     neck = hip_joint + (z["lower_body"] + z["upper_body"] + z["head"]
                         - _seg(t, "right_upper_leg").pos[2]) * f["trunk"]
-    f["head"] = (H - _head_radius(t) - neck) / head.pos[2]
+    f["head"] = (H - HEAD_RADIUS - neck) / head.pos[2]
     return f
-
-
-def _head_radius(t: BodyTables) -> float:
-    return HEAD_CIRCUMFERENCE / (2.0 * math.pi)
 
 
 def _groups(t: BodyTables) -> dict:
@@ -171,7 +169,7 @@ def _factors(t: BodyTables, radial: dict, axial: dict) -> dict:
     eye = ANTHROPOMETRY["eye_radius"] / next(g for g in t.geoms if g.name == "right_eye").size[0]
     out = {"right_eye": (eye, eye)}
     head_g = next(g for g in t.geoms if g.name == "head")
-    out["head"] = (_head_radius(t) / head_g.size[0], axial["head"])
+    out["head"] = (HEAD_RADIUS / head_g.size[0], axial["head"])
     for group, names in groups.items():
         if group == "head":
             continue
