@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 
 from mimo_social.body.joint_groups import held_posture
-from mimo_social.body.postures import POSTURES
+from mimo_social.body.postures import posture_joints
 from mimo_social.body.tables import load_body
 from mimo_social.core.env import MimoParallelEnv
 from mimo_social.core.world import AgentSetup
@@ -32,7 +32,7 @@ class Lineup(FreePlay):
 
     def setup(self, i, config):
         tables = load_body(config.hands, age_months=config.age_months, body=config.body)
-        frozen = held_posture(tables, keep=(), angles=POSTURES["standing"]["joints"])
+        frozen = held_posture(tables, keep=(), angles=posture_joints("standing", config.body))
         return AgentSetup(config, position=(0.0, SPOTS[i]), facing=(5.0, SPOTS[i]),
                           frozen=frozen, base="fixed")
 
