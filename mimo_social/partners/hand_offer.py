@@ -11,6 +11,7 @@ nothing to release.
 | | |
 |---|---|
 | target | ``posture`` (joint -> degrees; default :data:`OFFER_POSTURE_DEG`: upper arm forward, elbow half bent, palm up) or, with ``target=(forward, left, up)`` (m, from the right shoulder in the infant's heading frame), the posture whose palm centre reaches that point; the wrist is then solved for ``palm``: ``"up"`` (default: the palm faces up, leaning 0.15 toward the thumb and 0.1 toward the fingers, a pocket a ball rests in), ``"forward"`` (facing ahead as far as the wrist's range allows, about 25 deg off at the default posture; for a high five) or ``"posture"`` (the posture's wrist angles); see :func:`offer_posture` (damped least squares, solved once per reset on a scratch copy of the state) |
+| adult | an agent with the adult body (or with an arm over 5 % longer than the other's: the larger of two infants) offers where the other agent's hand reaches: its palm centre at ``adult_reach_to`` from the other's right shoulder (default :data:`REACH_TO`, where the high five's 18-month-old partner holds its palm for the other; scaled with the other's arm), its own shoulder, elbow and wrist solved for it; ``reach_to`` does the same for any body |
 | arm | PD control per joint toward the target angles, gains from the joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio ``damping`` 1), plus gravity / Coriolis and passive-spring compensation read from MuJoCo (``qfrc_bias``, ``qfrc_spring``); the torque becomes the agent's controls: spring-damper motors ``u = tau / T_max`` (clipped to [-1, 1]); muscles: the agonist's activation giving ``tau`` at the current length on top of the passive muscle forces (isometric curve, clipped to [0, 1], antagonist off) |
 | fingers | closed (``grip`` and not released): a constant flexing command ``grip_strength`` (0.03 of the motor's strength or of full activation) on the four fingers' flexors (mcp, pip, dip, the little finger's cup; mitten: the one finger joint), ``thumb_strength`` (0: the thumb held at rest by the PD) on the thumb's; spread and pivot held by the PD. Open: PD toward straight fingers, the thumb at its rest angles. A gentle grip holds a ball lying in the palm; a strong one squeezes it out (measured: 0.3 and above lose a 3 cm ball within 6 s) |
 | release | ``None``: never (the fingers stay as ``grip`` says). ``"on_hold"`` (default): *present*: while another agent holds an open right hand out next to the giver's (its palm centre within ``ready_radius`` 8 cm of the giver's, lower than the object's centre, facing up within 45 deg) for ``ready_time`` (0.3 s), the palm tips toward its little-finger side (the palm's lean toward the thumb lowered by ``present``, 0.75, over ``present_time`` 0.5 s; it levels again when that hand goes away), so the object rolls toward that hand; *let go*: once the right hand of another agent, its palm facing the object, touches the object with >= ``hold_parts`` (2) segments and carries >= ``hold_load`` (0.5) of its weight (the upward component of that hand's contact forces on it, :meth:`HandOffer.carried`) for ``hold_time`` (0.2 s), the fingers open and the arm goes to a posture with the palm ``withdraw`` (3 cm back, 8 cm down) from the offer, shoulder and elbow solved, the wrist kept (at the handover's offer the arm gets the palm 1.9 cm back and 3.7 cm down). A touch of the back of the hand or a one-finger poke neither presents nor lets go. ``"on_touch"``: open once a geom of another agent's hand (either hand) touches the object ``prop`` (a contact with dist <= 0), ``release_delay`` s later; with ``pour`` > 0 the wrist then also tips the palm over the fingertips (slope ``pour``) so the object rolls toward the partner |
@@ -41,7 +42,9 @@ from ..util.checks import (ConfigError, check_bool, check_choice, check_int, che
 from .base import (Partner, agent_index, check_angles, motor_action, pd_gains, require_motors,
                    require_prop)
 
-__all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors", "offer_posture"]
+__all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "REACH_TO", "REF_ARM",
+           "SIZE_TOLERANCE", "finger_flexors", "offer_posture", "reach_target", "is_adult",
+           "arm_length", "nearest_other", "adapts"]
 
 # The right arm forward, the hand in front of the chest, elbow half bent, palm up (degrees): the
 # palm centre ~16 cm ahead of the right shoulder, 6 cm toward the midline, 10 cm lower.
@@ -58,6 +61,76 @@ RELEASES = (None, "on_touch", "on_hold")
 PALMS = ("up", "forward", "posture")
 # mitten: the finger joint closes towards its lower limit (-160 deg)
 MITTEN_CLOSE_SIGN = -1.0
+#: where an adult offers its palm centre by default: (forward, left, up) m from the other
+#: agent's right shoulder, in that agent's heading frame: where the high five's scripted partner
+#: (an 18-month-old, 0.35 m away) holds its palm for the other 18-month-old (measured on
+#: ``high_five_v0.scripted_env()``: HandOffer.target_position minus infant_0's shoulder)
+REACH_TO = (0.205, 0.152, -0.099)
+
+
+#: a partner whose arm is longer than the other's by more than this fraction offers where the
+#: other reaches (:func:`adapts`)
+SIZE_TOLERANCE = 0.05
+#: m: the 18-month-old's right arm, shoulder to palm centre along the segments (arm_length)
+REF_ARM = 0.2157
+
+
+def arm_length(world, i: int) -> float:
+    """Agent ``i``'s right arm in the world, m: shoulder to elbow, elbow to wrist, wrist to
+    palm centre (the segments' origins and the palm site), whatever its posture."""
+    m, d = world.model, world.data
+    a = world.agents[i]
+    pts = [d.xpos[m.body(f"{a.name}/right_{s}").id] for s in ("upper_arm", "lower_arm", "hand")]
+    pts.append(d.site_xpos[a.palm_sites[0]])
+    return float(sum(np.linalg.norm(q - p) for p, q in zip(pts, pts[1:])))
+
+
+def is_adult(world, i: int) -> bool:
+    """Whether agent ``i`` of ``world`` has the adult caregiver's body."""
+    return getattr(world.tables[i], "body", "infant") == "adult"
+
+
+def nearest_other(world, i: int) -> int:
+    """The index of the agent nearest to agent ``i`` (hip to hip)."""
+    d = world.data
+    me = world.agents[i]
+    others = [j for j in range(len(world.agents)) if j != i]
+    if not others:
+        raise ValueError(f"HandOffer: {me.name} has no other agent to offer to")
+    return min(others, key=lambda k: np.linalg.norm(d.xpos[world.agents[k].root_body]
+                                                     - d.xpos[me.root_body]))
+
+
+def adapts(world, i: int) -> bool:
+    """Whether agent ``i`` offers where the other reaches (:func:`reach_target`): an adult, or
+    any body whose arm is longer than the nearest other agent's by more than
+    :data:`SIZE_TOLERANCE` (the larger of two infants comes to the smaller)."""
+    if is_adult(world, i):
+        return True
+    return arm_length(world, i) > (1.0 + SIZE_TOLERANCE) * arm_length(world,
+                                                                      nearest_other(world, i))
+
+
+def reach_target(world, i: int, point) -> tuple[float, float, float]:
+    """``point`` (forward, left, up: m from the right shoulder of the agent nearest to agent
+    ``i``, in that agent's heading frame, for an 18-month-old's arm; times that agent's
+    :func:`arm_length` over :data:`REF_ARM`) as a target of agent ``i``'s own right shoulder
+    (forward, left, up in ``i``'s heading frame), for :func:`offer_posture`."""
+    m, d = world.model, world.data
+    me = world.agents[i]
+    j = nearest_other(world, i)
+
+    def frame(a):
+        R = d.xmat[a.root_body].reshape(3, 3)
+        h = np.arctan2(R[1, 0], R[0, 0])
+        c, s = np.cos(h), np.sin(h)
+        sh = d.xpos[m.body(f"{a.name}/right_upper_arm").id].copy()
+        return sh, np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+    sh_j, R_j = frame(world.agents[j])
+    sh_i, R_i = frame(me)
+    goal = sh_j + R_j @ np.asarray(point, float) * arm_length(world, j) / REF_ARM
+    return tuple(float(x) for x in R_i.T @ (goal - sh_i))
 
 
 def finger_flexors(names) -> np.ndarray:
@@ -184,7 +257,13 @@ class HandOffer(Partner):
     the fingertips with this slope (0: keep it level); ``palm``: ``"up"`` (hold an object),
     ``"forward"`` (facing the partner, e.g. for a high five) or ``"posture"`` (the wrist angles
     of ``posture``), see :func:`offer_posture`; ``palm_tilt``: the upturned palm's lean (slopes
-    toward the thumb, toward the wrist).
+    toward the thumb, toward the wrist); ``reach_to``: ``(forward, left, up)`` m from the
+    *other* (nearest) agent's right shoulder, in its heading frame, for an 18-month-old's arm
+    (scaled with that agent's arm): the palm centre goes there instead of ``target``, for any
+    body; ``adult_reach_to`` (default :data:`REACH_TO`) is that point for an agent with the
+    adult body, or an arm over :data:`SIZE_TOLERANCE` longer than the other's, when
+    ``reach_to`` is None (a caregiver, or the larger infant, offers where the other reaches,
+    whatever its own size); ``adult_present``: ``present`` for an adult (None: the same).
     """
 
     def __init__(self, posture: Mapping[str, float] | None = None, target=None,
@@ -194,7 +273,8 @@ class HandOffer(Partner):
                  pour: float = 0.0, palm: str = "up", hold_parts: int = 2,
                  hold_load: float = 0.5, hold_time: float = 0.2, present: float = 0.75,
                  present_time: float = 0.5, ready_time: float = 0.3, ready_radius: float = 0.08,
-                 palm_tilt=(0.15, -0.1), withdraw=(0.03, 0.08)):
+                 palm_tilt=(0.15, -0.1), withdraw=(0.03, 0.08), reach_to=None,
+                 adult_reach_to=REACH_TO, adult_present=None):
         if posture is not None:
             posture = check_angles("HandOffer", "posture", posture, ARM)
         if target is not None:
@@ -204,6 +284,14 @@ class HandOffer(Partner):
             if np.linalg.norm(target) > 0.5:
                 raise ConfigError(f"HandOffer: target={show(target)} not allowed; allowed: "
                                   f"{where}")
+        if reach_to is not None:
+            reach_to = check_numbers("HandOffer", "reach_to", reach_to, 3, -1.0, 1.0,
+                                     "None or (forward, left, up) in metres from the other "
+                                     "agent's right shoulder, each from -1 to 1")
+        self.reach_to = reach_to
+        self.adult_reach_to = check_numbers("HandOffer", "adult_reach_to", adult_reach_to, 3,
+                                            -1.0, 1.0, "(forward, left, up) in metres from "
+                                            "the other agent's right shoulder, each from -1 to 1")
         grip = check_bool("HandOffer", "grip", grip)
         check_choice("HandOffer", "release", release, RELEASES)
         if not isinstance(prop, str) or not prop:
@@ -229,6 +317,8 @@ class HandOffer(Partner):
         self.hold_load = _number("hold_load", hold_load, 0.0, 2.0)
         self.hold_time = _number("hold_time", hold_time, 0.0, 5.0)
         self.present = _number("present", present, 0.0, 2.0)
+        self.adult_present = None if adult_present is None else \
+            _number("adult_present", adult_present, 0.0, 2.0)
         self.present_time = _number("present_time", present_time, 0.01, 5.0)
         self.ready_time = _number("ready_time", ready_time, 0.0, 5.0)
         self.ready_radius = _number("ready_radius", ready_radius, 0.01, 0.5)
@@ -261,7 +351,17 @@ class HandOffer(Partner):
         self._strength = np.where(thumb, self.thumb_strength, self.grip_strength)
         self._gripping = (self._flex != 0) & (self._strength > 0)
         self._is_finger = np.array([n not in ARM for n in names])
-        arm = offer_posture(w, i, self.posture_deg, self.target, self.palm, self.palm_tilt)
+        # an adult (or any agent given reach_to) offers where the other agent reaches
+        adult = is_adult(w, i)
+        present = self.adult_present if adult and self.adult_present is not None \
+            else self.present
+        target = self.target
+        if self.reach_to is not None:
+            target = reach_target(w, i, self.reach_to)
+        elif adapts(w, i):
+            target = reach_target(w, i, self.adult_reach_to)
+        self.offer_target = target
+        arm = offer_posture(w, i, self.posture_deg, target, self.palm, self.palm_tilt)
         open_deg = np.array([OPEN_FINGERS_DEG.get(n, 0.0) for n in names])
         q_target = np.array([arm.get(n, np.deg2rad(open_deg[k])) for k, n in enumerate(names)])
         self.target_angles = self._hold_angles = np.clip(q_target, lo, hi)
@@ -271,7 +371,6 @@ class HandOffer(Partner):
         if self.pour > 0 or back > 0 or down > 0:
             # the palm `back` and `down` from the offer: shoulder and elbow solved, the wrist
             # kept as it holds (with `pour`, the palm tipped over the fingertips)
-            target = self.target
             if target is not None:
                 target = (target[0] - back, target[1], target[2] - down)
             if self.pour > 0:
@@ -308,8 +407,8 @@ class HandOffer(Partner):
                            for j in range(len(w.agents)) if j != i]
             self._palm_of = {h: (site, hand) for site, hand, h in self._palms}
             self._my_palm = int(a.palm_sites[0])
-            tipped = offer_posture(w, i, self.posture_deg, self.target, self.palm,
-                                   (self.palm_tilt[0] - self.present, self.palm_tilt[1]))
+            tipped = offer_posture(w, i, self.posture_deg, self.offer_target, self.palm,
+                                   (self.palm_tilt[0] - present, self.palm_tilt[1]))
             self._tip_angles = np.clip([tipped.get(n, q_target[k])
                                         for k, n in enumerate(names)], lo, hi)
         self._delay_steps = int(round(self.release_delay / env.dt))

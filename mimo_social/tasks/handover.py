@@ -38,15 +38,26 @@ from ..body.tables import load_body
 from ..core.kinematics import Gaze, hand_geoms
 from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
-from ..partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
+from ..partners.hand_offer import (OPEN_FINGERS_DEG, HandOffer, adapts, offer_posture,
+                                   reach_target)
 
 __all__ = ["Handover", "HandoverOptions", "scripted_giver", "OFFER_TARGET"]
 from ..util.checks import ConfigError
 from .common import geoms_touching, parts_outside
+from .dyad import held_angles, tables_of, task_plan
 
 RECEIVER, GIVER = 0, 1
 PARKED = (0.2, 1.5, 0.5)             # where the ball is built (the reset moves it to the palm)
 OFFER_TARGET = (0.18, 0.10, -0.08)   # the giver's palm: m from its right shoulder (fwd, left, up)
+#: where an adult giver holds its palm centre: m from the receiver's right shoulder (forward,
+#: left, up, for an 18-month-old's arm): where the infant giver's palm is held for it at the
+#: default `offer_target` (measured on `handover_v0.scripted_env()`: the giver's
+#: HandOffer.target_position minus infant_0's right shoulder)
+ADULT_OFFER = (0.170, 0.110, -0.080)
+#: how far an adult giver tips its palm to present the ball (HandOffer's ``present``): the
+#: adult's larger hand cups the ball; tipped as an infant's (0.75) it keeps it in 2 of 4
+#: episodes (seeds 0-3), tipped 1.5 it hands it over in 4 of 4 (tests/tasks/test_partner_bodies.py)
+ADULT_PRESENT = 1.5
 BALL_TOWARD_FINGERS = 0.01           # m from the palm centre toward the fingers: the ball's rest
 
 
@@ -116,7 +127,8 @@ def scripted_giver(options: HandoverOptions | None = None) -> HandOffer:
     offering at the options' ``offer_target``, handing the ball over into the receiver's open
     hand (``release="on_hold"``: it lets go only once that hand carries the ball)."""
     o = options if options is not None else HandoverOptions()
-    return HandOffer(target=o.offer_target, grip=True, release="on_hold")
+    return HandOffer(target=o.offer_target, grip=True, release="on_hold",
+                     adult_reach_to=ADULT_OFFER, adult_present=ADULT_PRESENT)
 
 
 class Handover(Task):
@@ -135,19 +147,34 @@ class Handover(Task):
         if config.hands != "five_fingers":
             raise ValueError(f"handover: infant_{i}: hands={config.hands!r} not allowed; the task "
                              "needs hands='five_fingers' (the ball is held between the fingers)")
-        if config.posture != "standing":
+        allowed = ("standing", "kneeling", "sitting") if config.body == "adult" else ("standing",)
+        if config.posture not in allowed:
             raise ValueError(f"handover: infant_{i}: posture={config.posture!r} not allowed; "
-                             "the task places both infants standing (hip fixed)")
-        dist = self.options.distance
+                             f"allowed for body={config.body!r}: {list(allowed)} (the task "
+                             "places infants standing, hip fixed)")
+        # two 18-month-olds stand `distance` apart; other bodies at the distance scaled with
+        # their reach, looking at each other's face (tasks/dyad.py)
+        plan = task_plan(self, "standing", self.options.distance, self._held,
+                         () if self.options.assisted_gaze else (0, 1), ADULT_OFFER)
+        dist = plan.distance
         pos = (0.0, 0.0) if i == RECEIVER else (dist, 0.0)
         facing = (dist, 0.0) if i == RECEIVER else (0.0, 0.0)
-        tables = load_body(config.hands)
+        tables = tables_of(config)
         arm = right_arm_joints(tables)
         gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
-        frozen = held_posture(tables, keep=arm + gaze, angles={"right_knee": -5, "left_knee": -5})
+        frozen = {**self._held(i, config), **plan.gaze[i]}
         return AgentSetup(config, position=config.position or pos,
                           facing=config.facing or facing, frozen=frozen, base="fixed",
                           actuated=arm, gaze_joints=gaze)
+
+    def _held(self, i, config):
+        """Agent i's held joints (rad): all but the right arm (and head and eyes with
+        ``assisted_gaze``); standing knees a little bent, or its own posture's angles (an adult
+        leaning toward the infant)."""
+        tables = tables_of(config)
+        gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
+        angles = held_angles(config, "standing", {"right_knee": -5, "left_knee": -5}, lean=True)
+        return held_posture(tables, keep=right_arm_joints(tables) + gaze, angles=angles)
 
     def props(self):
         o = self.options
@@ -171,7 +198,8 @@ class Handover(Task):
             else []
         r = w.agents[RECEIVER]
         self._receiver_palm = int(r.palm_sites[0])
-        self._offer = HandOffer(target=self.options.offer_target, release=None)
+        self._offer = HandOffer(target=self.options.offer_target, release=None,
+                                adult_reach_to=ADULT_OFFER)
         self._giver_palm = int(w.agents[GIVER].palm_sites[0])
         self._fingers = [self._finger_tables(w, i) for i in (RECEIVER, GIVER)]
         self._hand_body = [int(m.site_bodyid[w.agents[i].palm_sites[0]]) for i in (0, 1)]
@@ -216,6 +244,8 @@ class Handover(Task):
         curl its fingers onto it (used at reset for the giver; tests use it for the receiver)."""
         w = env.world
         a = w.agents[i]
+        if adapts(w, i):   # an adult (or a larger infant) offers where the other reaches
+            target = reach_target(w, i, ADULT_OFFER)
         posture = offer_posture(w, i, None, target)
         d = w.data
         for k in a.actuated_joint_idx:

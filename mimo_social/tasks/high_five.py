@@ -47,6 +47,7 @@ from .common import (
     right_hand_parts,
     touch_only_on,
 )
+from .dyad import held_angles, tables_of, task_plan
 
 # 0.35 m: the right hands meet with the arms forward, half stretched; at 0.45 m (the first
 # version's distance) only the outstretched fingers meet, and PPO takes many times longer
@@ -126,15 +127,27 @@ class HighFive(Task):
     def agent_defaults(self, i, settings):
         return {"posture": "standing", "touch": hand_touch(hands_setting(settings))}
 
+    def _held(self, i, config):
+        """Agent i's held joints (rad): all but the right arm (and head and eyes with
+        ``assisted_gaze``), standing knees a little bent, or its own posture's angles (an adult
+        leaning toward the infant)."""
+        tables = tables_of(config)
+        gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
+        angles = held_angles(config, "standing", {"right_knee": -5, "left_knee": -5}, lean=True)
+        return held_posture(tables, keep=right_arm_joints(tables) + gaze, angles=angles)
+
     def setup(self, i, config):
-        dist = self.options.distance
-        pos, facing = face_to_face(i, dist)
-        tables = load_body(config.hands)
+        # two 18-month-olds stand `distance` apart; other bodies at the distance scaled with
+        # their reach, looking at each other's face (tasks/dyad.py)
+        plan = task_plan(self, "standing", self.options.distance, self._held,
+                         () if self.options.assisted_gaze else (0, 1))
+        pos, facing = face_to_face(i, plan.distance)
+        tables = tables_of(config)
         require_skin(self.name, f"infant_{i}", config, right_hand_parts(tables),
                      "the high five (the right hands meeting)")
         arm = right_arm_joints(tables)
         gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
-        frozen = held_posture(tables, keep=arm + gaze, angles={"right_knee": -5, "left_knee": -5})
+        frozen = {**self._held(i, config), **plan.gaze[i]}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=arm, gaze_joints=gaze)
 

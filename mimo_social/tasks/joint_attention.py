@@ -34,11 +34,11 @@ import numpy as np
 from gymnasium import spaces
 
 from ..body.joint_groups import GAZE_JOINTS, held_posture
-from ..body.postures import POSTURES
-from ..body.tables import load_body
+from ..body.postures import posture_joints
 from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from .common import face_to_face
+from .dyad import held_angles, tables_of, task_plan
 
 DISTANCE = 0.7
 EYE_SIZE = 96
@@ -149,11 +149,20 @@ class JointAttention(Task):
         return {"posture": "sitting", "expressions": False, "vestibular": False,
                 "vision": False if scripted else {"width": EYE_SIZE, "height": EYE_SIZE}}
 
+    def _held(self, i, config):
+        """Agent i's held joints (rad): all but head and eyes, sitting, or in its own posture
+        (an adult kneeling)."""
+        angles = held_angles(config, "sitting", posture_joints("sitting", config.body))
+        return held_posture(tables_of(config), keep=GAZE_JOINTS, angles=angles)
+
     def setup(self, i, config):
-        dist = self.options.distance
-        pos, facing = face_to_face(i, dist)
-        tables = load_body(config.hands)
-        frozen = held_posture(tables, keep=GAZE_JOINTS, angles=POSTURES["sitting"]["joints"])
+        # two sitting 18-month-olds are `distance` apart; other bodies (a kneeling adult) at
+        # the distance scaled with their reach (tasks/dyad.py: 1.31 m for the kneeling adult,
+        # where four toys still lie 25 degrees apart seen from both heads)
+        plan = task_plan(self, "sitting", self.options.distance, self._held, ())
+        self.pair_distance = plan.distance
+        pos, facing = face_to_face(i, plan.distance)
+        frozen = self._held(i, config)
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=GAZE_JOINTS)
 
@@ -215,7 +224,7 @@ class JointAttention(Task):
     def _place_toys(self, rng) -> list[np.ndarray]:
         """Toy positions (x, y): beside the pair (left and right alternate, so both sides hold
         toys), each at least ``min_separation_deg`` from the others seen from either head."""
-        dist = self.options.distance
+        dist = getattr(self, "pair_distance", self.options.distance)
         sep = np.deg2rad(self.options.min_separation_deg)
         n = self.options.n_toys
         for _ in range(MAX_TRIES):   # whole layouts: an early toy may leave no room for a later

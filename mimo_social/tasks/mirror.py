@@ -33,12 +33,12 @@ from typing import ClassVar
 import numpy as np
 
 from ..body.joint_groups import GAZE_JOINTS, held_posture
-from ..body.tables import load_body
 from ..core.kinematics import Gaze
 from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup
 from ..expressions.faces import EXPRESSIONS
 from .common import face_to_face
+from .dyad import held_angles, tables_of, task_plan
 
 DISTANCE = 0.3
 EYE_SIZE = 64
@@ -86,12 +86,21 @@ class Mirror(Task):
         return {"posture": "standing", "expressions": True, "vestibular": False,
                 "vision": False if scripted else {"width": EYE_SIZE, "height": EYE_SIZE}}
 
-    def setup(self, i, config):
-        dist = self.options.distance
-        pos, facing = face_to_face(i, dist)
-        tables = load_body(config.hands)
+    def _held(self, i, config):
+        """Agent i's held joints (rad): all (but head and eyes with ``assisted_gaze``), standing
+        knees a little bent, or its own posture's angles."""
         gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
-        frozen = held_posture(tables, keep=gaze, angles={"right_knee": -5, "left_knee": -5})
+        angles = held_angles(config, "standing", {"right_knee": -5, "left_knee": -5})
+        return held_posture(tables_of(config), keep=gaze, angles=angles)
+
+    def setup(self, i, config):
+        # two 18-month-olds stand `distance` apart; other bodies (a kneeling adult) at the
+        # distance scaled with their reach, looking at each other's face (tasks/dyad.py)
+        plan = task_plan(self, "standing", self.options.distance, self._held,
+                         () if self.options.assisted_gaze else (0, 1))
+        pos, facing = face_to_face(i, plan.distance)
+        gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
+        frozen = {**self._held(i, config), **plan.gaze[i]}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=(), gaze_joints=gaze)
 

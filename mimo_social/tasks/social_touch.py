@@ -40,6 +40,7 @@ from gymnasium import spaces
 
 from ..body.joint_groups import (
     EYE_GAZE_JOINTS,
+    HEAD_GAZE_JOINTS,
     both_arms_joints,
     held_posture,
     right_arm_joints,
@@ -48,6 +49,7 @@ from ..body.tables import load_body, subtree
 from ..core.kinematics import Gaze, hand_geoms
 from ..core.task import Task, TaskOptions
 from ..core.world import AgentSetup
+from .dyad import held_angles, tables_of, task_plan
 from ..util.checks import ConfigError
 from .common import (
     CROSS_LEGGED_DEG,
@@ -91,6 +93,14 @@ REACHABLE = ("upper_body", "lower_body", "left_upper_arm", "left_lower_arm", "le
 #: (uniformly random actions touch it first, palm side, in a third of the episodes; it is
 #: offered with ``targets=[...]``)
 DEFAULT_TARGETS = tuple(p for p in REACHABLE if p != "left_upper_leg")
+#: an adult partner's parts that the toucher's right hand reaches (by posture), measured with
+#: the scripted toucher (SocialTouchController) at the default distance: 2 / 2 seeds each (the
+#: partner's other parts: 0 / 2, the arm touching the adult's thigh or shin first); they are the
+#: adult's default targets. Kneeling upright, the adult's thighs are in front of its belly and
+#: its upper arm is above the infant's reach; sitting cross-legged, its shins are in front of
+#: everything else.
+ADULT_REACHABLE = {"kneeling": ("left_lower_arm", "left_hand", "left_upper_leg"),
+                   "sitting": ("left_lower_leg",)}
 #: a hand contact is made with the back of the hand (which does not count) when the contact
 #: normal (from the hand into the partner) has a component at or below this along the palm's
 #: normal (-0.5: more than 120 deg from it); palm, finger pads, fingertips and edges count
@@ -149,21 +159,27 @@ class SocialTouch(Task):
         return dict(common, touch={"density": 0.25, "normal_only": True})
 
     # -- building ------------------------------------------------------------------------------
-    def _resolve_targets(self, tables) -> tuple[str, ...]:
+    def _resolve_targets(self, tables, config=None) -> tuple[str, ...]:
         parts = skin_parts(tables)
         given = self.options.targets
+        reachable, defaults = REACHABLE, DEFAULT_TARGETS
+        if config is not None and config.body == "adult":
+            if config.posture not in ADULT_REACHABLE:
+                raise ConfigError(f"social_touch: infant_1: posture={config.posture!r} not "
+                                  f"allowed for body='adult'; allowed: {list(ADULT_REACHABLE)}")
+            reachable = defaults = ADULT_REACHABLE[config.posture]
         if given is None:
-            targets = tuple(p for p in DEFAULT_TARGETS if p in parts)
+            targets = tuple(p for p in defaults if p in parts)
         else:
             bad = [p for p in given if p not in parts]
             if bad:
                 raise ConfigError(f"social_touch: targets {bad} are not body parts of the "
                                   f"partner ({tables.hands} body); body parts: {list(parts)}")
-            far = [p for p in given if p not in REACHABLE]
+            far = [p for p in given if p not in reachable]
             if far:
                 raise ConfigError(f"social_touch: targets {far} are out of the toucher's reach "
                                   f"at {DISTANCE_RANGE[0]}-{DISTANCE_RANGE[1]} m; allowed: "
-                                  f"{[p for p in REACHABLE if p in parts]}")
+                                  f"{[p for p in reachable if p in parts]}")
             targets = tuple(given)
         fixed = self.options.target
         if fixed is not None and fixed not in targets:
@@ -171,24 +187,43 @@ class SocialTouch(Task):
                               f"{list(targets)}")
         return targets
 
-    def setup(self, i, config):
-        dist = self.options.distance
-        pos = (0.0, 0.0) if i == TOUCHER else (dist, 0.0)
-        facing = (dist, 0.0) if i == TOUCHER else (0.0, 0.0)
-        tables = load_body(config.hands)
+    def _actuated(self, i, tables):
+        return right_arm_joints(tables) if i == TOUCHER else both_arms_joints(tables)
+
+    def _held(self, i, config):
+        """Agent i's held joints (rad): sitting cross-legged (or its own posture), the toucher
+        leaning in with its head tilted back, the touched infant leaning back a little; all
+        but the actuated arms and the eyes."""
+        tables = tables_of(config)
         if i == TOUCHER:
-            actuated = right_arm_joints(tables)
             angles = {**SITTING_DEG, **SIDE_ARM_DEG, "lower_trunk_bend": LEAN_DEG,
                       "head_tilt": HEAD_TILT_DEG}
+        else:
+            angles = {**SITTING_DEG, "lower_trunk_bend": RECLINE_DEG}
+        angles = held_angles(config, "sitting", angles)
+        return held_posture(tables, keep=self._actuated(i, tables) + EYE_GAZE_JOINTS,
+                            angles=angles)
+
+    def setup(self, i, config):
+        # two 18-month-olds sit `distance` apart; other bodies keep the floor between their
+        # forward depths as two 18-month-olds have it; a partner of another body turns its head
+        # to the toucher's face (tasks/dyad.py)
+        plan = task_plan(self, "sitting", self.options.distance, self._held, (TOUCHED,),
+                         law="gap")
+        dist = plan.distance
+        pos = (0.0, 0.0) if i == TOUCHER else (dist, 0.0)
+        facing = (dist, 0.0) if i == TOUCHER else (0.0, 0.0)
+        tables = tables_of(config)
+        actuated = self._actuated(i, tables)
+        if i == TOUCHER:
             require_skin(self.name, "infant_0", config, right_hand_parts(tables),
                          "the touch it gives")
         else:
-            self.targets = self._resolve_targets(tables)
-            actuated = both_arms_joints(tables)
-            angles = {**SITTING_DEG, "lower_trunk_bend": RECLINE_DEG}
+            self.targets = self._resolve_targets(tables, config)
             require_skin(self.name, "infant_1", config, self.targets,
                          "the touch it receives on every target part")
-        frozen = held_posture(tables, keep=actuated + EYE_GAZE_JOINTS, angles=angles)
+        head = {k: v for k, v in plan.gaze[i].items() if k in HEAD_GAZE_JOINTS}
+        frozen = {**self._held(i, config), **head}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=actuated,
                           gaze_joints=EYE_GAZE_JOINTS)
