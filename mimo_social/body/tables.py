@@ -267,6 +267,8 @@ def _cache_clear() -> None:
     """Forget every loaded table (after the CSV files changed, e.g. a muscle calibration)."""
     _load.cache_clear()
     _published.cache_clear()
+    for maker in MAKERS.values():     # the adult's tables are cached by their maker
+        getattr(maker, "cache_clear", lambda: None)()
 
 
 load_body.cache_clear = _cache_clear

@@ -16,7 +16,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ..body.tables import HAND_VERSIONS, SCALE_RANGE, STRENGTH_RANGE
+from ..body.tables import AGE_RANGE, BODY_KINDS, HAND_VERSIONS, SCALE_RANGE, STRENGTH_RANGE
 from ..senses import SENSES
 from ..senses.proprioception import ProprioceptionConfig
 from ..senses.touch import TouchConfig
@@ -36,10 +36,7 @@ FLOOR_HALF = 10.0      # m: the floor plane's half size (an agent placed beyond 
 FACING_LIMIT = 100.0   # m: how far the point an agent faces may be
 POSTURES = ("standing", "sitting", "kneeling", "lying")
 #: body kinds: the infant (its age from ``age_months``) and an adult caregiver
-BODIES = ("infant", "adult")
-#: infant ages the growth curves carry, in months (body/data/growth_curves.csv: the survey's mean
-#: ages reach 33 months)
-AGE_RANGE = (0.0, 33.0)
+BODIES = BODY_KINDS
 #: what can be delayed (``delays``): each sense and the motor command
 DELAY_CHANNELS = ("proprioception", "vestibular", "touch", "vision", "motor")
 #: the longest delay allowed per channel, milliseconds
