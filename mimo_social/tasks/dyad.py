@@ -52,8 +52,8 @@ CLEARANCE = 0.03
 #: deg: how far an adult leans its trunk (lower bend; the upper follows, coupled) toward the
 #: infant in the tasks where hands meet: kneeling upright, an adult's right arm reaching down to an
 #: 18-month-old's hands crosses its own belly; leaning 15 deg it reaches them over it (measured:
-#: the high five with the kneeling adult, 3 / 3 seeds in 42-56 steps with the lean, 3 / 3 in
-#: 429-493 steps without)
+#: the high five with the kneeling adult, seeds 0-3: 4 / 4 in 43-55 steps with the lean, 1 / 4
+#: without)
 ADULT_LEAN_DEG = 15.0
 #: rounds of :func:`facing_gaze` (mirror, kneeling adult: the second round moves the head
 #: angles by up to 5 degrees, the third by 0.2, a fourth by 0.01)

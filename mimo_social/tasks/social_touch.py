@@ -95,10 +95,10 @@ REACHABLE = ("upper_body", "lower_body", "left_upper_arm", "left_lower_arm", "le
 DEFAULT_TARGETS = tuple(p for p in REACHABLE if p != "left_upper_leg")
 #: an adult partner's parts that the toucher's right hand reaches (by posture), measured with
 #: the scripted toucher (SocialTouchController) at the default distance: 2 / 2 seeds each (the
-#: partner's other parts: 0 / 2, the arm touching the adult's thigh or shin first); they are the
-#: adult's default targets. Kneeling upright, the adult's thighs are in front of its belly and
-#: its upper arm is above the infant's reach; sitting cross-legged, its shins are in front of
-#: everything else.
+#: partner's other parts: 0 / 2, the hand meeting the kneeling adult's hanging left hand or its
+#: thigh first, the sitting adult's shin); they are the adult's default targets. Kneeling
+#: upright, the adult's thighs are in front of its belly and its upper arm is above the
+#: infant's reach; sitting cross-legged, its shins are in front of everything else.
 ADULT_REACHABLE = {"kneeling": ("left_lower_arm", "left_hand", "left_upper_leg"),
                    "sitting": ("left_lower_leg",)}
 #: a hand contact is made with the back of the hand (which does not count) when the contact
