@@ -5,14 +5,16 @@ The social tasks were tuned for two published 18-month-olds (``body="infant"``,
 gives exactly what the tasks used before (same distance, same held angles). Any other pair (an
 adult caregiver, another age or scale, another posture) is measured in the compiled world:
 
-- **distance**: the pair meets at a point in front of the body with the lower shoulder: the
-  point where the high five's scripted 18-month-old holds its palm for the other
-  (:data:`~mimo_social.partners.hand_offer.REACH_TO` from the right shoulder), scaled by that
-  body's arm over the 18-month-old's; the other body stands so that its right shoulder is as
-  many of its own (straight) arm lengths from that point as in the tuned pair at the task's
-  distance. Two bodies twice the size stand twice as far; a kneeling or sitting adult stands
-  where its arm meets the infant's. The distance is never less than the two bodies' forward
-  depths (plus :data:`CLEARANCE`), so no two bodies start inside each other. Social touch, where
+- **distance**: the pair meets where the tuned pair meets (the task's meeting point, by
+  default where the high five's scripted 18-month-old holds its palm for the other:
+  :data:`~mimo_social.partners.hand_offer.REACH_TO` from the learner's right shoulder), seen
+  from the body with the lower shoulder and scaled by its arm over the 18-month-old's; the
+  other body stands so that its right shoulder is as many of its own (straight) arm lengths
+  from that point as in the tuned pair at the task's distance. Two bodies twice the size stand
+  twice as far; a kneeling adult stands where its arm meets the infant's. The distance is never
+  less than the task's distance times the smaller arm over the 18-month-old's, nor than the two
+  bodies' forward depths (plus :data:`CLEARANCE`), so no two bodies start inside each other
+  (:func:`pair_distance`). Social touch, where
   one touches the other's body, keeps instead the floor between the two bodies' forward depths
   as it is for two 18-month-olds (:func:`gap_distance`).
 - **gaze**: where a task holds head and eyes looking "straight ahead at the partner", a pair of
@@ -50,8 +52,8 @@ __all__ = ["CLEARANCE", "ADULT_LEAN_DEG", "LAWS", "Extent", "is_standard", "tabl
 #: m: the least gap between the two bodies' forward depths when the distance is scaled
 CLEARANCE = 0.03
 #: deg: how far an adult leans its trunk (lower bend; the upper follows, coupled) toward the
-#: infant in the tasks where hands meet: kneeling upright, an adult's right arm reaching down to an
-#: 18-month-old's hands crosses its own belly; leaning 15 deg it reaches them over it (measured:
+#: infant in the tasks where hands meet: kneeling upright, an adult's right arm reaching down to
+#: an 18-month-old's hands crosses its own belly; leaning 15 deg it reaches them over it (measured:
 #: the high five with the kneeling adult, seeds 0-3: 4 / 4 in 43-55 steps with the lean, 1 / 4
 #: without)
 ADULT_LEAN_DEG = 15.0
@@ -86,9 +88,10 @@ def tables_of(config: AgentConfig):
 def held_angles(config: AgentConfig, posture: str, angles: Mapping[str, float],
                 lean: bool = False) -> dict:
     """The held angles (deg) of a task whose agents are in ``posture``: ``angles`` as they are
-    for an agent in that posture; in another posture, that posture's joint angles replace them
-    where both name a joint, and the task's leg angles are dropped. With ``lean``, an adult leans its trunk :data:`ADULT_LEAN_DEG`
-    toward the partner (unless its posture's data set the trunk's bend)."""
+    for an agent in that posture; in another posture, the task's leg angles are dropped and
+    that posture's joint angles (the body's own variant) replace the others where both name a
+    joint. With ``lean``, an adult leans its trunk :data:`ADULT_LEAN_DEG` toward the partner
+    (unless its posture's data set the trunk's bend)."""
     if config.posture == posture:
         out = dict(angles)
     else:   # the legs as the other posture has them; the task's other angles kept

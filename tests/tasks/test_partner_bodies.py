@@ -156,6 +156,7 @@ def test_adult_partner_social_touch_targets():
 
 
 @pytest.mark.parametrize("per_agent", [
+    [{}, {"age_months": 0}],
     [{}, {"age_months": 6}], [{"age_months": 6}, {}],
     [{}, {"age_months": 24}], [{"age_months": 24}, {}],
     [{}, {"scale": 1.3}],
@@ -167,37 +168,40 @@ def test_other_ages_meet_in_the_high_five(per_agent):
     assert run_episodes("high_five", range(2), per_agent=per_agent) == 2
 
 
-def test_newborn_partner_starts_apart():
-    """A newborn (0 months) is placed without interpenetrating; the high five with an
-    18-month-old is not reached (see docs/bodies.md)."""
-    env = entry("high_five").parallel_env(per_agent=[{}, {"age_months": 0}])
+def test_newborn_learner_meets_the_offered_hand_in_some_episodes():
+    """A newborn (0 months) learner reaches the 18-month-old's offered hand at the edge of its
+    reach: 4 of seeds 0-5 (docs/bodies.md); here at least one of seeds 0-2."""
+    per_agent = [{"age_months": 0}, {}]
+    env = entry("high_five").parallel_env(per_agent=per_agent)
     assert cross_contacts(env.world) == 0
-    assert env.world.agent_setups[1].position[0] > 0.2
     env.close()
+    assert run_episodes("high_five", range(3), per_agent=per_agent) >= 1
 
 
 def test_reach_to_offers_any_body_at_the_others_reach():
     """``HandOffer(reach_to=...)`` puts an infant partner's palm at a point of the other's
     shoulder frame too."""
     env = entry("high_five").module.scripted_env(HandOffer(grip=False, release=None,
-                                                           reach_to=(0.19, 0.14, -0.09)))
+                                                           reach_to=(0.21, 0.15, -0.09)))
     env.reset(seed=0)
     w = env.unwrapped.world
     sh = w.data.xpos[w.model.body("infant_0/right_upper_arm").id]
     got = env.partners["infant_1"].target_position - sh
-    assert np.allclose(got, (0.19, 0.14, -0.09), atol=0.01)
+    assert np.allclose(got, (0.21, 0.15, -0.09), atol=0.01)
     env.close()
 
 
-if __name__ == "__main__":   # the figures of docs/bodies.md: python tests/tasks/test_partner_bodies.py 10
+# the figures of docs/bodies.md: python tests/tasks/test_partner_bodies.py 10
+if __name__ == "__main__":
     import sys
     import time
 
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 10
     pairs = [("adult kneeling", ADULT)] + [
         (f"infant_1 {k}={v}", [{}, {k: v}]) for k, v in
-        (("age_months", 6), ("age_months", 24), ("scale", 1.3))] + [
-        (f"infant_0 {k}={v}", [{k: v}, {}]) for k, v in (("age_months", 6), ("age_months", 24))]
+        (("age_months", 0), ("age_months", 6), ("age_months", 24), ("scale", 1.3))] + [
+        (f"infant_0 {k}={v}", [{k: v}, {}]) for k, v in
+        (("age_months", 0), ("age_months", 6), ("age_months", 24))]
     for label, per in pairs:
         tasks = SOCIAL if label.startswith("adult") else ("high_five",)
         for task in tasks:
