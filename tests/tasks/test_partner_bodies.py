@@ -143,6 +143,30 @@ def test_adult_giver_handover_success():
     assert run_episodes("handover", range(10)) >= 8
 
 
+@pytest.mark.parametrize("task", SOCIAL)
+def test_adult_pair_pickles_and_continues_exactly(task):
+    import pickle
+    from mimo_social.partners.base import zero_action
+    env = entry(task).parallel_env(per_agent=ADULT)
+    env.reset(seed=1)
+    acts = {a: zero_action(env.action_space(a)) for a in env.agents}
+    env.step(acts)
+    copy = pickle.loads(pickle.dumps(env))
+    a, b = env.step(acts)[0], copy.step(acts)[0]
+    assert all(np.array_equal(np.asarray(a[n][k]), np.asarray(b[n][k])) for n in a for k in a[n])
+    env.close()
+    copy.close()
+
+
+def test_postures_the_tasks_cannot_use_are_refused_by_name():
+    from mimo_social.util.checks import ConfigError
+    with pytest.raises(ConfigError, match="posture='standing' not allowed for body='adult'"):
+        entry("social_touch").parallel_env(per_agent=[{}, {"body": "adult",
+                                                           "posture": "standing"}])
+    with pytest.raises(ValueError, match="infant_1: posture='lying' not allowed"):
+        entry("handover").parallel_env(per_agent=[{}, {"body": "adult", "posture": "lying"}])
+
+
 def test_adult_partner_social_touch_targets():
     """The adult's default targets are the parts the toucher reaches (kneeling: its left arm,
     hand and thigh); parts it cannot reach are refused by name."""
