@@ -2,10 +2,14 @@
 :class:`ScriptedPartners`, the ParallelEnv wrapper that leaves only the learners."""
 
 from .base import Partner, Still, zero_action
+from .contingent import ContingentCaregiver
+from .cues import Cues, learner_cues
 from .expression import ExpressionShow
 from .gaze import GazeAtTarget
 from .hand_offer import HandOffer
+from .replay import ReplayCaregiver, load_stream, save_stream
 from .wrapper import ScriptedPartners
 
 __all__ = ["Partner", "Still", "zero_action", "ScriptedPartners", "ExpressionShow",
-           "GazeAtTarget", "HandOffer"]
+           "GazeAtTarget", "HandOffer", "ContingentCaregiver", "Cues", "learner_cues",
+           "ReplayCaregiver", "load_stream", "save_stream"]
