@@ -191,7 +191,11 @@ def resolve_agents(n_agents: int, common: Mapping[str, Any],
 class PhysicsConfig:
     timestep: float = 0.005        # s per physics step
     frame_skip: int = 2            # physics steps per control step (control at 100 Hz)
-    jacobian: str = "sparse"       # measured faster than dense for these models (BENCHMARKS.md)
+    # dense: MuJoCo 4.0.0's Newton solver with the sparse Jacobian factors the Hessian wrongly
+    # when contacts couple branches of a body's tree (mujoco#3767, fixed in 4.0.1, not on PyPI
+    # here): fingers touching fingers, two infants touching, diverged or were silently wrong
+    # (docs/reliability.md); sparse was ~20 % faster (BENCHMARKS.md)
+    jacobian: str = "dense"
     solver: str = "newton"
     cone: str = "pyramidal"
     iterations: int = 50

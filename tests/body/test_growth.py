@@ -220,11 +220,9 @@ def test_every_age_holds_a_posture_and_plays_stably(age):
 
 @pytest.mark.parametrize("hands, actuation", [
     ("mitten", "spring_damper"), ("five_fingers", "spring_damper"), ("mitten", "muscle"),
-    pytest.param("five_fingers", "muscle", marks=pytest.mark.xfail(
-        reason="not the body: MuJoCo 4.0.0's Newton solver with the default sparse Jacobian "
-               "returns a wrong acceleration (a big toe at step 430; mujoco#3767, fixed in "
-               "4.0.1); with physics={'jacobian': 'dense'} the run is clean "
-               "(tests/body/test_hand_stability.py, docs/reliability.md)"))])
+    # five fingers with muscles diverged under MuJoCo 4.0.0's sparse-Jacobian bug (a big toe at
+    # step 430; mujoco#3767): the default physics is dense since (docs/reliability.md)
+    ("five_fingers", "muscle")])
 def test_newborn_at_full_strength_survives_bang_bang_actions(hands, actuation):
     """Every motor at its lowest or highest control, redrawn each step, for the smallest body
     at the largest allowed strength (3): no divergence in 3000 control steps (30 s)."""
