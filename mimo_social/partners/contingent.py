@@ -10,8 +10,8 @@ acts only through its own action space (motors and face), as every scripted part
 | cue | event (onset) | response |
 |---|---|---|
 | ``"expression"`` | ``face="smile"``: the learner starts smiling (its face becomes ``happy``); ``face="copy"``: its face changes to a non-neutral one | the caregiver shows ``happy`` (``"smile"``) or the learner's face of the event (``"copy"``) |
-| ``"gaze"`` | the learner's line of sight leaves the caregiver's face for a point on the floor (``gaze_point`` appears while ``gaze_on_face`` is false) | the caregiver turns head and eyes to that point (looks where the infant looks) |
-| ``"touch"`` | a hand of the learner starts touching the caregiver's body | a pat: the caregiver's right palm goes to 4 cm above the learner's nearer palm, down onto it, up, and back (each a quarter of the response) |
+| ``"gaze"`` | the learner's line of sight leaves the caregiver's face for a point on the floor (``gaze_point`` appears while ``gaze_on_face`` is false) | the caregiver turns head and eyes to where the learner looks on the floor (the point of the event; while the response lasts, the learner's current floor point, as long as it looks at the floor) |
+| ``"touch"`` | a hand of the learner starts touching the caregiver's body | a pat: the caregiver's right palm goes to 4 cm above the palm of the learner's touching hand (both touching, or none any more: the nearer one), down onto it, up, and back (each a quarter of the response; the arm's angles planned when the response starts) |
 
 Each event is answered with probability ``probability`` (one draw from the partner's
 generator per event, seeded by :class:`~mimo_social.partners.wrapper.ScriptedPartners`), after
@@ -66,7 +66,7 @@ from ..core.kinematics import LookAt, reach_sites
 from ..expressions.faces import EXPRESSIONS
 from ..util.checks import ConfigError, check_choice, check_number, show
 from .base import Partner, agent_index
-from .cues import HAPPY, NEUTRAL, Cues, learner_cues
+from .cues import HAPPY, NEUTRAL, Cues, learner_cues, touching_hands
 
 __all__ = ["ContingentCaregiver", "CUES", "MODES", "FACES", "look_at_point"]
 
@@ -75,6 +75,8 @@ MODES = ("interactive", "still", "non_contingent")
 FACES = ("smile", "copy")
 #: m: the pat's palm height above the learner's palm before it comes down onto it
 PAT_LIFT = 0.04
+#: m: a pat point counts as reached when the planned palm comes this near it
+PAT_REACHED = 0.03
 #: the pat's phases as fractions of the response: above, onto, above, back
 PAT_PHASES = (0.25, 0.5, 0.75)
 
@@ -223,16 +225,20 @@ class ContingentCaregiver(Partner):
             raise ValueError(f"{who}: cue 'gaze' answers by turning head and eyes, but {agent} "
                              f"has no motor on {list(GAZE_JOINTS)}; actuate them or leave "
                              "'gaze' out of cues")
-        # the pat: shoulder and elbow of the right arm
-        arm = [n for n in RIGHT_SHOULDER_ELBOW if n in motor_joint]
-        if "touch" in self.cues and len(arm) < len(RIGHT_SHOULDER_ELBOW):
-            raise ValueError(f"{who}: cue 'touch' answers with a pat of the right arm, but "
-                             f"{agent} has no motor on "
-                             f"{[n for n in RIGHT_SHOULDER_ELBOW if n not in motor_joint]}; "
-                             "actuate them or leave 'touch' out of cues")
-        self._amotor = np.array([motor_joint[n] for n in arm], np.intp)
-        self._palm = int(a.palm_sites[0])
+        # the pat: shoulder and elbow of either arm with all four motors
+        self._arms = []
+        for side, palm in zip(("right", "left"), a.palm_sites):
+            arm = [n.replace("right_", f"{side}_", 1) for n in RIGHT_SHOULDER_ELBOW]
+            if all(n in motor_joint for n in arm):
+                self._arms.append((np.array([motor_joint[n] for n in arm], np.intp), int(palm)))
+        if "touch" in self.cues and not self._arms:
+            raise ValueError(f"{who}: cue 'touch' answers with a pat, but {agent} has no arm "
+                             f"with motors on all of {list(RIGHT_SHOULDER_ELBOW)} (or their "
+                             "left_ counterparts); actuate an arm or leave 'touch' out of cues")
         self._learner_palms = w.agents[k].palm_sites
+        self._learner_arm = [(m.geom(f"{learner}/{side}_lower_arm").id,
+                              m.geom(f"{learner}/{side}_upper_arm").id)
+                             for side in ("right", "left")]
         self._learner_face = int(w.agents[k].head_site)
         self._scratch = mujoco.MjData(m)
         self._dt = float(env.dt)
@@ -385,21 +391,36 @@ class ContingentCaregiver(Partner):
                 self._period_content[cue].append(content)
 
     def _plan_pat(self):
-        """The arm's angles above the learner's nearer palm and on it (damped least squares on a
-        scratch copy of the state)."""
+        """The pat: for each arm with motors and each point of the learner's touching arm
+        (its palm, then the middle of its forearm, then of its upper arm: the first that the
+        palm reaches within :data:`PAT_REACHED` m), the arm's angles above the point and on it
+        (damped least squares on a scratch copy of the state); the plan that comes nearest is
+        kept. ``pat_misses``: how far (m) it leaves the palm from those two points."""
         w = self._env.world
         m, d, s = w.model, w.data, self._scratch
-        palms = d.site_xpos[self._learner_palms]
-        mine = d.site_xpos[self._palm]
-        target = palms[int(np.argmin(np.linalg.norm(palms - mine, axis=1)))].copy()
-        j = self._amotor
-        qadr, dadr, lo, hi = self._qadr[j], self._dadr[j], self._lo[j], self._hi[j]
-        poses = []
-        s.qpos[:] = d.qpos
-        for lift in (PAT_LIFT, 0.0):
-            reach_sites(m, s, qadr, dadr, lo, hi, self._palm, target + [0.0, 0.0, lift])
-            poses.append(s.qpos[qadr].copy())
-        return poses
+        sides = np.flatnonzero(touching_hands(w, self._k, self._i))
+        if not len(sides):      # not touching now (a non-contingent pat): either arm
+            sides = np.arange(2)
+        points = [(d.site_xpos[self._learner_palms[k]], d.geom_xpos[self._learner_arm[k][0]],
+                   d.geom_xpos[self._learner_arm[k][1]]) for k in sides]
+        best = None
+        for motors, palm in self._arms:
+            qadr, dadr = self._qadr[motors], self._dadr[motors]
+            lo, hi = self._lo[motors], self._hi[motors]
+            for level in range(3):
+                for per_side in points:
+                    s.qpos[:] = d.qpos
+                    poses, misses = [], []
+                    for lift in (PAT_LIFT, 0.0):
+                        misses.append(reach_sites(m, s, qadr, dadr, lo, hi, palm,
+                                                  per_side[level] + [0.0, 0.0, lift]))
+                        poses.append(s.qpos[qadr].copy())
+                    if best is None or misses[1] < best[2][1]:
+                        best = (motors, poses, misses)
+                if best[2][1] <= PAT_REACHED:
+                    break
+        self.pat_misses = best[2]
+        return best[0], best[1]
 
     def _action(self, env, n: int) -> tuple[np.ndarray, int]:
         w = env.world
@@ -425,13 +446,13 @@ class ContingentCaregiver(Partner):
             q[self._gmotor] = angles[self._gslot]
         pat = self._active.get("touch")
         if pat is not None:
-            start, end, (above, on) = pat
+            start, end, (motors, (above, on)) = pat
             f = (n - start) / max(1, end - start)
             a, b, c = PAT_PHASES
             if f < b:
-                q[self._amotor] = above if f < a else on
+                q[motors] = above if f < a else on
             elif f < c:
-                q[self._amotor] = above
+                q[motors] = above
         return self._controls(d, q), face
 
     def _controls(self, d, q: np.ndarray) -> np.ndarray:

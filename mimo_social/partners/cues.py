@@ -32,7 +32,7 @@ import numpy as np
 from ..core.kinematics import hand_geoms
 from ..expressions.faces import EXPRESSIONS
 
-__all__ = ["Cues", "learner_cues", "gaze_line", "GAZE_ON_FACE_DEG", "GAZE_RANGE", "HAPPY",
+__all__ = ["Cues", "learner_cues", "gaze_line", "touching_hands", "GAZE_ON_FACE_DEG", "GAZE_RANGE", "HAPPY",
            "NEUTRAL"]
 
 #: degrees: the learner looks at the caregiver's face when its line of sight passes within this
@@ -77,14 +77,29 @@ def gaze_line(world, i: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _hand_mask(world, i: int) -> np.ndarray:
+    """Per geom of the world: 1 for agent i's right hand, 2 for its left, else 0 (cached)."""
     masks = _HANDS.get(world)
     if masks is None:
         masks = _HANDS.setdefault(world, {})
     if i not in masks:
-        mask = np.zeros(world.model.ngeom, bool)
-        mask[np.concatenate([hand_geoms(world, i, 0), hand_geoms(world, i, 1)])] = True
+        mask = np.zeros(world.model.ngeom, np.int8)
+        mask[hand_geoms(world, i, 0)] = 1
+        mask[hand_geoms(world, i, 1)] = 2
         masks[i] = mask
     return masks[i]
+
+
+def touching_hands(world, i: int, j: int) -> tuple[bool, bool]:
+    """Whether agent ``i``'s (right, left) hand touches agent ``j``'s body (a contact)."""
+    hands = _hand_mask(world, i)
+    owner = world.geom_agent
+    d = world.data
+    n = d.ncon
+    if not n:
+        return False, False
+    g1, g2 = d.contact.geom1[:n], d.contact.geom2[:n]
+    side = np.concatenate([hands[g1][owner[g2] == j], hands[g2][owner[g1] == j]])
+    return bool(np.any(side == 1)), bool(np.any(side == 2))
 
 
 def learner_cues(env, learner: str, caregiver: str, plane_z: float = 0.0) -> Cues:
@@ -103,14 +118,7 @@ def learner_cues(env, learner: str, caregiver: str, plane_z: float = 0.0) -> Cue
         t = (plane_z - origin[2]) / direction[2]
         if 0.0 <= t <= GAZE_RANGE:
             point = origin + t * direction
-    hands = _hand_mask(w, i)
-    owner = w.geom_agent
-    d = w.data
-    touching = False
-    n = d.ncon
-    if n:
-        g1, g2 = d.contact.geom1[:n], d.contact.geom2[:n]
-        touching = bool(np.any((hands[g1] & (owner[g2] == j)) | (hands[g2] & (owner[g1] == j))))
+    touching = any(touching_hands(w, i, j))
     return Cues(expression=expression, smiling=expression == HAPPY,
                 gaze_on_face=angle <= GAZE_ON_FACE_DEG, gaze_point=point, touching=touching,
                 gaze_angle_deg=angle)
