@@ -288,32 +288,35 @@ def test_replay_reproduces_the_stream_whatever_the_learner_does(caregiver, tmp_p
 @pytest.mark.parametrize("caregiver", [ADULT, ADULT_POS, {}], ids=["adult_pd", "adult_pos",
                                                                       "infant"])
 def test_still_face_neutral_and_motionless(caregiver):
-    """Interactive for 1 s (the learner smiles and looks away: the caregiver smiles and follows),
-    then still for 2 s while the learner keeps doing so: the caregiver's face is neutral from
-    the switch on, nothing is answered, and from 0.5 s after the switch (the head turn under way
-    at the switch stops: the 18-month-old's overshoots by up to 9 degrees) its joints move less
-    than 0.5 degree (measured: adults 0.00, the 18-month-old 0.13)."""
+    """Interactive (the learner smiles and looks at the floor for 0.6 s, then at the caregiver
+    for 0.6 s), switched to still 5 steps into the caregiver's first gaze response (its head
+    turning) while the learner goes on: the caregiver's face is neutral from the switch on,
+    nothing is answered, and from 0.5 s after the switch (the turn under way stops: up to 5
+    degrees on) its joints move less than 0.5 degree (measured 0.03-0.12)."""
     p = ContingentCaregiver(delay_s=0.1, duration_s=0.5)
     env = face_env(p, caregiver)
-    switch = 100
+    switched = []
 
     def after(k):
-        if k == switch:
+        if not switched and any(r["cue"] == "gaze" and k == r["step"] + 5 for r in p.responses):
+            switched.append(k)
             p.set_mode("still")
 
     def policy(k, lr):
         face = HAPPY if k % 30 < 10 else NEUTRAL
-        if k % 60 < 30:
-            return lr.looking_at(np.array([0.3, 0.2, 0.0]), face)
+        if k % 120 < 60:
+            return lr.looking_at(np.array([0.3, 0.25, 0.0]), face)
         return lr.at_face(face)
 
     faces, qs = run(env, policy, 300, after=after)
+    switch = switched[0]
     assert (faces[:switch, 1] == HAPPY).any()
     assert np.all(faces[switch:, 1] == NEUTRAL)
-    assert all(r["step"] < switch for r in p.responses) and p.responses
+    assert all(r["step"] < switch for r in p.responses)
+    moved = np.degrees(np.abs(qs[switch:] - qs[switch]).max())
     held = qs[switch + 50:]
     drift = np.degrees(np.abs(held - held[0]).max())
-    assert drift < 0.5, drift
+    assert moved > 0.5 and drift < 0.5, (moved, drift)
 
 
 def test_non_contingent_keeps_the_measured_rate():
