@@ -33,7 +33,8 @@ starts in):
   ``rate_hz``), started at random steps (a Bernoulli draw per step and kind: a Poisson process
   independent of the learner); their content is drawn from the responses of that period (the
   faces shown, the points looked at; none yet: ``happy``, a floor point near the learner's
-  feet).
+  feet). Their timing and content do not depend on the learner; a pat still aims at where the
+  learner's arm is, and between responses the caregiver still looks at the learner's face.
 
 **Motors**: the desired angle of each of the caregiver's motors (its held pose, the look-at
 angles of :class:`~mimo_social.core.kinematics.LookAt`'s geometry for head and eyes, the pat's
@@ -50,7 +51,8 @@ float32, ``expression``: (T,) int64, -1 without expressions, ``dt``); a
 
 Logs for measures and tests: ``events`` (one dict per cue event: ``step``, ``cue``,
 ``answered``, ``due``) and ``responses`` (one dict per response started: ``step``, ``cue``,
-``event_step`` (None when non-contingent), ``mode``).
+``event_step`` (None when non-contingent), ``mode``) and ``modes`` ((step, mode) at reset and
+at every :meth:`~ContingentCaregiver.set_mode`: the mode from that step's action on).
 """
 
 from __future__ import annotations
@@ -168,6 +170,7 @@ class ContingentCaregiver(Partner):
         self._env = None
         self.events: list[dict] = []
         self.responses: list[dict] = []
+        self.modes: list[tuple[int, str]] = []
         self._motors: list[np.ndarray] = []
         self._faces: list[int] = []
 
@@ -258,6 +261,7 @@ class ContingentCaregiver(Partner):
         self._content = {c: [] for c in self.cues}
         self._prev = self.cues_now()
         self._enter(self.mode)
+        self.modes = [(0, self.mode)]
 
     def cues_now(self) -> Cues:
         """The learner's cues in the env's current state."""
@@ -275,6 +279,7 @@ class ContingentCaregiver(Partner):
             self._close_period()
         self.mode = mode
         self._enter(mode)
+        self.modes.append((self._step, mode))
 
     def _close_period(self) -> None:
         if self._period_steps:

@@ -87,6 +87,10 @@ class ReplayCaregiver(Partner):
         """The stream played back (copies)."""
         return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self._stream.items()}
 
+    #: :func:`load_stream` and :func:`save_stream`, also reachable from the class
+    load_stream = staticmethod(load_stream)
+    save_stream = staticmethod(save_stream)
+
     def __len__(self) -> int:
         return len(self._stream["motors"])
 

@@ -310,6 +310,7 @@ def test_still_face_neutral_and_motionless(caregiver):
 
     faces, qs = run(env, policy, 300, after=after)
     switch = switched[0]
+    assert p.modes == [(0, "interactive"), (switch, "still")]
     assert (faces[:switch, 1] == HAPPY).any()
     assert np.all(faces[switch:, 1] == NEUTRAL)
     assert all(r["step"] < switch for r in p.responses)
@@ -414,3 +415,27 @@ def test_pickled_mid_episode_continues_exactly():
             e.step({"infant_0": _smile_and_look(k, lr)})
         streams.append(e.partners["infant_1"].stream["motors"])
     np.testing.assert_array_equal(streams[0], streams[1])
+
+
+def test_replay_offset_and_end():
+    stream = {"motors": np.arange(12, dtype=np.float32).reshape(3, 4) / 10,
+              "expression": np.array([0, 1, 2]), "dt": 0.01}
+    env = mirror_v0.scripted_env(partner=ReplayCaregiver(dict(stream, motors=np.zeros((3, 0))),
+                                                         offset=1),
+                                 per_agent=[{"vision": False}, ADULT])
+    env.reset(seed=0)
+    shown = []
+    for _ in range(4):
+        env.step({"infant_0": {"motors": np.zeros(0, np.float32), "expression": np.int64(0)}})
+        shown.append(env.unwrapped.world.expression_of(1))
+    assert shown == [1, 2, 2, 2]              # from row 1; past the end the last row holds
+    strict = ReplayCaregiver(dict(stream, motors=np.zeros((3, 0))), past_end="error")
+    env = mirror_v0.scripted_env(partner=strict, per_agent=[{"vision": False}, ADULT])
+    env.reset(seed=0)
+    with pytest.raises(RuntimeError, match="past_end"):
+        for _ in range(4):
+            env.step({"infant_0": {"motors": np.zeros(0, np.float32),
+                                   "expression": np.int64(0)}})
+    with pytest.raises(ConfigError, match="offset"):
+        ReplayCaregiver(stream, offset=3)
+    assert ReplayCaregiver.load_stream is load_stream
