@@ -28,7 +28,9 @@ starts in):
 
 - ``"interactive"``: as above; the responses started per second of each kind are counted;
 - ``"still"``: neutral face, no response to anything; every motor holds the pose the caregiver
-  had when the mode was set (the still face of Tronick et al. 1978);
+  had when the mode was set (the still face of Tronick et al. 1978): positional, constant
+  controls (the angles at the switch plus the gravity torque at rest over the servo's
+  stiffness); spring-damper, the PD law toward those angles;
 - ``"non_contingent"``: responses at the rates measured in the last interactive period (or
   ``rate_hz``), started at random steps (a Bernoulli draw per step and kind: a Poisson process
   independent of the learner); their content is drawn from the responses of that period (the
@@ -144,6 +146,9 @@ class ContingentCaregiver(Partner):
     or ``"copy"``), ``rest_face`` (an expression name), ``mode`` (the mode each episode starts
     in), ``rate_hz`` (None: non-contingent rates measured; a number or a mapping cue -> rate),
     ``learner`` (None: the other agent of a pair), ``omega`` / ``zeta`` (the spring-damper PD).
+    ``measured_rates`` (responses per second of each cue in the last interactive period that
+    ended, of this or an earlier episode) is kept across resets, so a non-contingent episode can
+    follow a live one.
     """
 
     def __init__(self, cues=CUES, delay_s: float = 0.5, probability: float = 1.0,
@@ -295,7 +300,17 @@ class ContingentCaregiver(Partner):
             self._period_counts = dict.fromkeys(self.cues, 0)
             self._period_content = {c: [] for c in self.cues}
         elif mode == "still":
-            self._hold = self._env.world.data.qpos[self._qadr].copy()
+            w = self._env.world
+            self._hold = w.data.qpos[self._qadr].copy()
+            self._hold_u = None
+            if self._positional:    # constant targets: the angles plus gravity at rest
+                if self.__dict__.get("_scratch") is None:
+                    self._scratch = mujoco.MjData(w.model)
+                s = self._scratch
+                s.qpos[:] = w.data.qpos
+                s.qvel[:] = 0.0
+                mujoco.mj_forward(w.model, s)
+                self._hold_u = self._controls(s, self._hold)
         elif self.rate_hz is None and self.measured_rates is None:
             raise ValueError("ContingentCaregiver: mode 'non_contingent' needs response rates: "
                              "none measured yet (no interactive period has ended); give "
@@ -431,6 +446,8 @@ class ContingentCaregiver(Partner):
         w = env.world
         d = w.data
         if self.mode == "still":
+            if self._hold_u is not None:
+                return self._hold_u.copy(), NEUTRAL
             return self._controls(d, self._hold), NEUTRAL
         q = self._home.copy()
         face = self.rest_face

@@ -318,6 +318,9 @@ def test_still_face_neutral_and_motionless(caregiver):
     held = qs[switch + 50:]
     drift = np.degrees(np.abs(held - held[0]).max())
     assert moved > 0.5 and drift < 0.5, (moved, drift)
+    if caregiver.get("actuation") == "positional":      # constant targets
+        still = p.stream["motors"][switch:]
+        np.testing.assert_array_equal(still, np.broadcast_to(still[0], still.shape))
 
 
 def test_non_contingent_keeps_the_measured_rate():
