@@ -46,9 +46,10 @@ NEUTRAL = EXPRESSIONS.index("neutral")
 _HANDS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Cues:
-    """The learner's cues at one moment (see the module docstring)."""
+    """The learner's cues at one moment (see the module docstring); compared by identity (it
+    holds an array)."""
 
     expression: int
     smiling: bool
