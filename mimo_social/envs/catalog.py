@@ -18,6 +18,8 @@ from ..partners.controllers import (CatchController, GazeFollowController, HighF
                                     SelfBodyController, SocialTouchController, StandupController)
 from . import (catch_v0, free_play_v0, handover_v0, high_five_v0, joint_attention_v0, mirror_v0,
                reach_v0, selfbody_v0, social_touch_v0, standup_v0)
+from . import contingency_v0
+from ..partners.controllers.contingency import ContingencyDetectorController
 
 __all__ = ["EnvEntry", "CATALOG", "KINDS", "entry", "names", "make_gym", "register_envs"]
 
@@ -96,6 +98,9 @@ CATALOG: tuple[EnvEntry, ...] = (
     EnvEntry("handover", handover_v0, "mimo_social/Handover-v0", "social",
              "take a ball from the partner's hand",
              controller=ReceiveController),
+    EnvEntry("contingency", contingency_v0, "mimo_social/Contingency-v0", "social",
+             "smile with a caregiver who answers live, replays a session or smiles on a timer",
+             controller=ContingencyDetectorController),
 )
 
 _BY_NAME = {e.name: e for e in CATALOG}

@@ -10,6 +10,7 @@ zero-action and trained policies.
 """
 
 from .catch import CatchController
+from .contingency import ContingencyDetectorController
 from .gaze_follow import GazeFollowController
 from .high_five import HighFiveController
 from .mirror import MirrorController
@@ -21,4 +22,4 @@ from .touch import SocialTouchController
 
 __all__ = ["CatchController", "GazeFollowController", "HighFiveController", "MirrorController",
            "ReachController", "ReceiveController", "SelfBodyController", "SocialTouchController",
-           "StandupController"]
+           "StandupController", "ContingencyDetectorController"]

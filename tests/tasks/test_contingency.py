@@ -1,0 +1,182 @@
+"""The contingency paradigm (live, replay, non-contingent caregiver) through its public API."""
+
+import numpy as np
+import pytest
+
+from mimo_social.envs import contingency_v0
+from mimo_social.expressions.faces import EXPRESSIONS
+from mimo_social.partners import Partner
+from mimo_social.partners.controllers.contingency import ContingencyDetectorController
+from mimo_social.tasks.contingency import CONDITIONS, condition_summary
+from mimo_social.util.checks import ConfigError
+
+HAPPY = EXPRESSIONS.index("happy")
+NO_MOTORS = np.zeros(0, np.float32)
+FAST = {"per_agent": [{"vision": False}, {}]}     # the measures need no rendering
+
+
+def act(face):
+    return {"motors": NO_MOTORS, "expression": np.int64(face)}
+
+
+class Pulses(Partner):
+    """Smiles for ``on`` steps every ``period`` steps (the test's own learner)."""
+
+    def __init__(self, period=100, on=30, offset=0):
+        self.period, self.on, self.offset = period, on, offset
+
+    def reset(self, env, agent, rng):
+        self.t = 0
+
+    def act(self, env, agent, observation):
+        self.t += 1
+        return act(HAPPY if (self.t + self.offset) % self.period < self.on else 0)
+
+
+class Random(Partner):
+    def reset(self, env, agent, rng):
+        self.rng = np.random.default_rng(7)
+
+    def act(self, env, agent, observation):
+        return act(int(self.rng.integers(len(EXPRESSIONS))))
+
+
+def run(env, learner, condition, seed=0, rng_seed=0):
+    """One episode: the caregiver's face per step and the last info."""
+    inner = env.unwrapped
+    inner.task.set_condition(condition)
+    env.reset(seed=seed)
+    learner.reset(inner, "infant_0", np.random.default_rng(rng_seed))
+    faces, info = [], {}
+    while env.agents:
+        _, _, _, _, infos = env.step({"infant_0": learner.act(inner, "infant_0", None)})
+        faces.append(inner.world.expression_of(1))
+        info = infos["infant_0"]
+    return np.array(faces), info
+
+
+def test_options_conditions_and_bodies():
+    with pytest.raises(ConfigError, match=r"condition='video'.*'live', 'replay', 'non_contingent'"):
+        contingency_v0.scripted_env(task_options={"condition": "video"})
+    with pytest.raises(ConfigError, match=r"condition='replay' needs the scripted caregiver"):
+        contingency_v0.parallel_env(task_options={"condition": "replay"})
+    with pytest.raises(ConfigError, match="response_probability"):
+        contingency_v0.scripted_env(task_options={"response_probability": 1.5})
+    env = contingency_v0.parallel_env()
+    with pytest.raises(ConfigError, match="non_contingent"):
+        env.task.set_condition("non_contingent")
+    cfg = env.agent_configs
+    assert (cfg[0].body, cfg[0].posture, cfg[1].body, cfg[1].posture) == \
+        ("infant", "standing", "adult", "kneeling")
+    space = env.observation_space("infant_0")
+    assert space["eye_left"].shape == (64, 64, 3) and space["proprioception"].shape == (0,)
+    assert env.action_space("infant_0")["motors"].shape == (0,)
+    assert env.action_space("infant_0")["expression"].n == len(EXPRESSIONS)
+    # an infant caregiver stands; the scripted caregiver has no eyes
+    s = contingency_v0.scripted_env(per_agent=[{}, {"body": "infant"}]).unwrapped
+    assert (s.agent_configs[1].body, s.agent_configs[1].posture) == ("infant", "standing")
+    assert s.agent_configs[1].vision is None
+    # replay needs an earlier live episode (or a given stream)
+    env = contingency_v0.scripted_env(task_options={"condition": "replay"}, **FAST)
+    with pytest.raises(RuntimeError, match="run a live episode first"):
+        env.reset(seed=0)
+
+
+def test_live_caregiver_answers_smiles_with_the_delay_and_probability():
+    """Coarse (the caregiver's own tests measure it finely): every caregiver smile onset comes
+    the delay (+ one control step) after a learner smile onset; about the probability of them
+    are answered."""
+    env = contingency_v0.scripted_env(task_options={"response_delay_s": 0.3,
+                                                    "response_probability": 0.7}, **FAST)
+    faces, info = run(env, Pulses(period=150, on=40), "live")
+    learner = np.array([(t + 1) % 150 < 40 for t in range(len(faces))])
+    l_on = np.flatnonzero(learner[1:] & ~learner[:-1]) + 1
+    l_on = np.r_[0, l_on] if learner[0] else l_on
+    c_on = np.flatnonzero((faces[1:] == HAPPY) & (faces[:-1] != HAPPY)) + 1
+    lag = 30 + 1
+    assert set(c_on) <= set(l_on + lag), (l_on, c_on)
+    assert 0.4 <= len(c_on) / len(l_on) <= 1.0, (len(c_on), len(l_on))
+    assert info["condition"] == 0 and info["learner_smiles"] == len(l_on)
+    assert info["contingency_index"] > 0.4
+
+
+def test_replay_and_non_contingent_ignore_the_learner():
+    env = contingency_v0.scripted_env(max_steps=800, **FAST)
+    live, _ = run(env, ContingencyDetectorController(), "live")
+    recorded = env.partners["infant_1"].recorded
+    assert np.array_equal(recorded["expression"], live)
+    replays = [run(env, learner, "replay", seed=s)[0]
+               for learner, s in ((Pulses(), 0), (Random(), 1), (Pulses(80, 5, 13), 2))]
+    for faces in replays:
+        assert np.array_equal(faces, live)        # the live stream, bit for bit, whoever looks
+    timers = [run(env, learner, "non_contingent", seed=3)
+              for learner in (Pulses(), Random(), Pulses(60, 50, 7))]
+    for faces, info in timers:
+        assert np.array_equal(faces, timers[0][0]) and info["condition"] == 2
+    assert (timers[0][0] == HAPPY).any()
+
+
+def test_scripted_detector_smiles_more_and_detects_contingency_in_live():
+    table = condition_summary(episodes=3, seed=0, env_kwargs=FAST)
+    live, replay, timer = (table[c] for c in CONDITIONS)
+    for other in (replay, timer):
+        assert live["smiling_fraction"][0] > other["smiling_fraction"][0]
+        assert live["contingency_index"][0] > other["contingency_index"][0]
+        assert live["shared_fraction"][0] > other["shared_fraction"][0]
+    assert live["is_success"][0] >= 2 / 3
+
+
+def test_success_and_reward_free():
+    """Live: the detector succeeds, the zero action (neutral) and a random face do not; with
+    reward_free every reward is 0 and the measures are the same."""
+    finals = {}
+    for free in (False, True):
+        env = contingency_v0.scripted_env(task_options={"reward_free": free}, **FAST)
+        for name, learner in (("detector", ContingencyDetectorController()),
+                              ("zero", Pulses(10, 0)), ("random", Random())):
+            inner = env.unwrapped
+            env.reset(seed=5)
+            learner.reset(inner, "infant_0", np.random.default_rng(5))
+            total = 0.0
+            while env.agents:
+                _, r, _, _, infos = env.step({"infant_0": learner.act(inner, "infant_0", None)})
+                total += r["infant_0"]
+            info = infos["infant_0"]
+            assert total == (0.0 if free else info["shared_steps"])
+            finals[free, name] = info
+    assert finals[False, "detector"]["is_success"]
+    assert not finals[False, "zero"]["is_success"] and not finals[False, "random"]["is_success"]
+    assert finals[False, "random"]["shared_fraction"] < 0.16
+    for name in ("detector", "zero", "random"):
+        assert finals[False, name] == finals[True, name]
+
+
+def hack_figures(episodes=20, seed=1000):
+    """Live, seeds ``seed ..``: per policy (successes, return mean, return sd); the learner's
+    eyes off (no policy here reads them)."""
+    from mimo_social.partners.controllers.mirror import MirrorController
+    policies = {"always happy": Pulses(10, 10), "copies the caregiver": MirrorController(),
+                "1-step dip every 0.5 s": Pulses(50, 49),
+                "detector": ContingencyDetectorController()}
+    env = contingency_v0.scripted_env(**FAST)
+    out = {}
+    for name, policy in policies.items():
+        finals = [run(env, policy, "live", seed=s, rng_seed=s)[1]
+                  for s in range(seed, seed + episodes)]
+        returns = [f["shared_steps"] for f in finals]
+        out[name] = (sum(bool(f["is_success"]) for f in finals), float(np.mean(returns)),
+                     float(np.std(returns)))
+    return out
+
+
+@pytest.mark.slow
+def test_hacks_score_less_than_the_detector():
+    figures = hack_figures()
+    assert figures["always happy"][0] == figures["copies the caregiver"][0] == 0
+    assert figures["detector"][0] >= 16
+    assert figures["always happy"][1] < figures["detector"][1] < figures["1-step dip every 0.5 s"][1]
+
+
+if __name__ == "__main__":   # the hack figures of the task's table
+    for name, (ok, mean, sd) in hack_figures().items():
+        print(f"{name}: {ok} / 20 successes, return {mean:.1f} +- {sd:.1f}")
