@@ -20,6 +20,8 @@ from . import (catch_v0, free_play_v0, handover_v0, high_five_v0, joint_attentio
                reach_v0, selfbody_v0, social_touch_v0, standup_v0)
 from . import contingency_v0
 from ..partners.controllers.contingency import ContingencyDetectorController
+from . import still_face_v0
+from ..partners.controllers.still_face import StillFaceInfantController
 
 __all__ = ["EnvEntry", "CATALOG", "KINDS", "entry", "names", "make_gym", "register_envs"]
 
@@ -101,6 +103,9 @@ CATALOG: tuple[EnvEntry, ...] = (
     EnvEntry("contingency", contingency_v0, "mimo_social/Contingency-v0", "social",
              "smile with a caregiver who answers live, replays a session or smiles on a timer",
              controller=ContingencyDetectorController),
+    EnvEntry("still_face", still_face_v0, "mimo_social/StillFace-v0", "social",
+             "face-to-face play, the caregiver's still face, reunion: per-phase measures",
+             controller=StillFaceInfantController),
 )
 
 _BY_NAME = {e.name: e for e in CATALOG}

@@ -18,8 +18,9 @@ from .reach import ReachController
 from .receive import ReceiveController
 from .selfbody import SelfBodyController
 from .standup import StandupController
+from .still_face import StillFaceInfantController
 from .touch import SocialTouchController
 
 __all__ = ["CatchController", "GazeFollowController", "HighFiveController", "MirrorController",
            "ReachController", "ReceiveController", "SelfBodyController", "SocialTouchController",
-           "StandupController", "ContingencyDetectorController"]
+           "StandupController", "StillFaceInfantController", "ContingencyDetectorController"]
