@@ -116,6 +116,33 @@ def test_replay_and_non_contingent_ignore_the_learner():
     assert (timers[0][0] == HAPPY).any()
 
 
+def test_a_saved_stream_replays_in_a_new_env_and_a_copy_continues_exactly(tmp_path):
+    import copy
+    import pickle
+    from mimo_social.partners.replay import load_stream, save_stream
+    env = contingency_v0.scripted_env(max_steps=300, **FAST)
+    live, _ = run(env, ContingencyDetectorController(), "live")
+    path = save_stream(tmp_path / "caregiver", env.partners["infant_1"].recorded)
+    other = contingency_v0.scripted_env(max_steps=300, stream=load_stream(path),
+                                        task_options={"condition": "replay"}, **FAST)
+    faces, info = run(other, Random(), "replay", seed=9)
+    assert np.array_equal(faces, live) and info["condition"] == 1
+    # a copy taken mid-episode (replay, then non-contingent) continues as the original
+    for condition in ("replay", "non_contingent"):
+        env.unwrapped.task.set_condition(condition)
+        env.reset(seed=4)
+        learner = Pulses(70, 20)
+        learner.reset(env.unwrapped, "infant_0", None)
+        for _ in range(120):
+            env.step({"infant_0": learner.act(env.unwrapped, "infant_0", None)})
+        twin, twin_learner = pickle.loads(pickle.dumps(env)), copy.deepcopy(learner)
+        for e, p in ((env, learner), (twin, twin_learner)):
+            out = [e.step({"infant_0": p.act(e.unwrapped, "infant_0", None)})[4]["infant_0"]
+                   for _ in range(100)]
+            p.out = out
+        assert learner.out == twin_learner.out
+
+
 def test_scripted_detector_smiles_more_and_detects_contingency_in_live():
     table = condition_summary(episodes=3, seed=0, env_kwargs=FAST)
     live, replay, timer = (table[c] for c in CONDITIONS)
