@@ -75,7 +75,12 @@ class ReplayCaregiver(Partner):
 
     def __init__(self, stream, offset: int = 0, past_end: str = "hold"):
         if isinstance(stream, (str, os.PathLike)):
-            stream = load_stream(stream)
+            try:
+                stream = load_stream(stream)
+            except (OSError, ValueError, EOFError) as e:   # missing, unreadable, not a stream
+                raise ConfigError(f"ReplayCaregiver: stream={show(stream)} cannot be read "
+                                  f"({type(e).__name__}: {e}); allowed: the path of a .npz "
+                                  "file written by save_stream, or a stream mapping") from None
         self._stream = check_stream(stream)
         n = len(self._stream["motors"])
         self.offset = check_int("ReplayCaregiver", "offset", offset, 0, n - 1)
