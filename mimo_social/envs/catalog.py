@@ -16,10 +16,12 @@ from ..core.gym_adapter import SingleAgentEnv
 from ..partners.controllers import (CatchController, GazeFollowController, HighFiveController,
                                     MirrorController, ReachController, ReceiveController,
                                     SelfBodyController, SocialTouchController, StandupController)
+from ..partners.controllers.imitation import ImitationController
 from . import (catch_v0, free_play_v0, handover_v0, high_five_v0, joint_attention_v0, mirror_v0,
                reach_v0, selfbody_v0, social_touch_v0, standup_v0)
 from . import contingency_v0
 from ..partners.controllers.contingency import ContingencyDetectorController
+from . import imitation_v0
 from . import still_face_v0
 from ..partners.controllers.still_face import StillFaceInfantController
 
@@ -106,6 +108,9 @@ CATALOG: tuple[EnvEntry, ...] = (
     EnvEntry("still_face", still_face_v0, "mimo_social/StillFace-v0", "social",
              "face-to-face play, the caregiver's still face, reunion: per-phase measures",
              controller=StillFaceInfantController),
+    EnvEntry("imitation", imitation_v0, "mimo_social/Imitation-v0", "social",
+             "reproduce the action a caregiver demonstrated, seen through the eyes",
+             controller=ImitationController),
 )
 
 _BY_NAME = {e.name: e for e in CATALOG}

@@ -3,8 +3,8 @@
 | | |
 |---|---|
 | reads | at reset and each step, from the task (duck-typed: ``env.task.demonstrated_action``, the name of the episode's action, and ``env.task.demo_steps``, the length of the demonstration phase in steps; ``env.task.step_count``) |
-| acts | through its own arm motors only (``actuation="positional"``: the controls are target angles, :func:`~mimo_social.body.actuation.positional_controls`): holds its start pose for ``lead_s``, moves its arms to the action's pose (:data:`ACTION_POSES`) in ``move_s`` (the targets interpolated linearly), holds it ``hold_s``, moves back in ``move_s`` and holds its start pose for the rest of the episode (still during the learner's turn). A demonstration phase shorter than the script compresses it in proportion |
-| poses | per action, target angles (deg) of the arm joints, the same for the kneeling adult and an 18-month-old (found by a grid search over shoulder, elbow angles, `tests/tasks/test_imitation.py` checks that each produces its outcome for both bodies): `head_touch` right hand on top of the head; `hand_raise` right arm straight up; `clap` both arms forward, hands together in front of the chest |
+| acts | through its own arm motors only (``actuation="positional"``: the controls are target angles, :func:`~mimo_social.body.actuation.positional_controls`): holds its start pose for ``lead_s``, moves its arms through the action's poses (:data:`ACTION_POSES`), ``move_s`` each (the targets interpolated linearly), holds the last ``hold_s``, moves back the same way and holds its start pose for the rest of the episode (still during the learner's turn). A demonstration phase shorter than the script compresses it in proportion |
+| poses | per action, target angles (deg) of the arm joints (:data:`ACTION_POSES`), the same for the kneeling adult and an 18-month-old, found by searches over shoulder and elbow angles (kinematics, then simulation with both bodies): `head_touch` right hand on the head; `hand_raise` right arm straight up; `clap` both arms forward, hands together in front of the chest; `push_box` two poses: the right hand lifted behind its box, then reaching forward through it (`tests/tasks/test_imitation.py` checks that each produces its outcome alone, for both bodies) |
 
 The same poses are what the scripted learner
 (:class:`~mimo_social.partners.controllers.imitation.ImitationController`) reproduces.
@@ -27,6 +27,10 @@ ACTION_POSES: dict[str, dict[str, float]] = {
     "clap": {"right_shoulder_abduction": 90.0, "right_shoulder_horizontal": 110.0,
              "right_elbow": -30.0, "left_shoulder_abduction": 90.0,
              "left_shoulder_horizontal": 110.0, "left_elbow": -30.0},
+    "push_box": [{"right_shoulder_abduction": 100.0, "right_shoulder_horizontal": 0.0,
+                  "right_shoulder_rotation": 60.0, "right_elbow": -90.0},
+                 {"right_shoulder_abduction": 70.0, "right_shoulder_horizontal": 40.0,
+                  "right_shoulder_rotation": 30.0, "right_elbow": -20.0}],
 }
 
 
@@ -49,16 +53,26 @@ class PoseScript:
         self.start = act.controls_for(dict(zip(names, q))).astype(np.float32)
         self.names = names
 
-    def pose_controls(self, action: str) -> np.ndarray:
-        """Controls that target ``action``'s pose (its other arm joints at the start pose)."""
-        pose = {k: np.deg2rad(v) for k, v in ACTION_POSES[action].items() if k in self.names}
+    def path(self, action: str) -> list[np.ndarray]:
+        """The controls of the start pose, then of each of ``action``'s poses (its other arm
+        joints at the start pose)."""
+        poses = ACTION_POSES[action]
+        poses = [poses] if isinstance(poses, dict) else list(poses)
         start = dict(zip(self.names, self.act.targets(self.start)))
-        return self.act.controls_for({**start, **pose}).astype(np.float32)
+        out = [self.start]
+        for pose in poses:
+            angles = {k: np.deg2rad(v) for k, v in pose.items() if k in self.names}
+            out.append(self.act.controls_for({**start, **angles}).astype(np.float32))
+        return out
 
     @staticmethod
-    def blend(a: np.ndarray, b: np.ndarray, x: float) -> np.ndarray:
-        x = float(np.clip(x, 0.0, 1.0))
-        return ((1.0 - x) * a + x * b).astype(np.float32)
+    def along(path: list[np.ndarray], x: float) -> np.ndarray:
+        """The controls ``x`` segments along ``path`` (0: its first pose, ``len(path) - 1``:
+        its last; linear between)."""
+        x = float(np.clip(x, 0.0, len(path) - 1))
+        k = min(int(x), len(path) - 2)
+        f = x - k
+        return ((1.0 - f) * path[k] + f * path[k + 1]).astype(np.float32)
 
 
 class Demonstrator(Partner):
@@ -80,9 +94,10 @@ class Demonstrator(Partner):
             raise ValueError(f"Demonstrator: the task {task.name!r} demonstrates no action; "
                              "allowed: the imitation task")
         self._script = PoseScript(env, agent, "Demonstrator")
-        self._target = self._script.pose_controls(task.demonstrated_action)
+        self._path = self._script.path(task.demonstrated_action)
+        n = len(self._path) - 1        # moves out (and as many back)
         dt = float(env.dt)
-        total = (self.lead_s + 2 * self.move_s + self.hold_s) / dt
+        total = (self.lead_s + 2 * n * self.move_s + self.hold_s) / dt
         squeeze = min(1.0, 0.95 * task.demo_steps / total)
         self._lead = self.lead_s / dt * squeeze
         self._move = max(1.0, self.move_s / dt * squeeze)
@@ -90,14 +105,12 @@ class Demonstrator(Partner):
 
     def act(self, env, agent, observation):
         k = env.task.step_count     # the step about to be taken is k + 1
-        s = self._script
-        t = k - self._lead
-        if t <= 0:
-            u = s.start
-        elif t <= self._move:
-            u = s.blend(s.start, self._target, t / self._move)
-        elif t <= self._move + self._hold:
-            u = self._target
+        path = self._path
+        n = len(path) - 1
+        t = (k - self._lead) / self._move          # in moves since the start of the first
+        if t <= n:
+            u = PoseScript.along(path, t)
         else:
-            u = s.blend(self._target, s.start, (t - self._move - self._hold) / self._move)
+            t -= n + self._hold / self._move
+            u = PoseScript.along(path, n - max(t, 0.0))
         return motor_action(env.action_space(agent), u)

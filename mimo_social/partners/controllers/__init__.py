@@ -13,6 +13,7 @@ from .catch import CatchController
 from .contingency import ContingencyDetectorController
 from .gaze_follow import GazeFollowController
 from .high_five import HighFiveController
+from .imitation import ImitationController
 from .mirror import MirrorController
 from .reach import ReachController
 from .receive import ReceiveController
@@ -21,6 +22,7 @@ from .standup import StandupController
 from .still_face import StillFaceInfantController
 from .touch import SocialTouchController
 
-__all__ = ["CatchController", "GazeFollowController", "HighFiveController", "MirrorController",
-           "ReachController", "ReceiveController", "SelfBodyController", "SocialTouchController",
-           "StandupController", "StillFaceInfantController", "ContingencyDetectorController"]
+__all__ = ["CatchController", "GazeFollowController", "HighFiveController", "ImitationController",
+           "MirrorController", "ReachController", "ReceiveController", "SelfBodyController",
+           "SocialTouchController", "StandupController", "StillFaceInfantController",
+           "ContingencyDetectorController"]

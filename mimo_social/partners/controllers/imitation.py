@@ -3,7 +3,7 @@
 | | |
 |---|---|
 | reads | from the task (duck-typed): the episode's demonstrated action (``env.task.demonstrated_action``) and whether the learner's turn has begun (``env.task.turn``): what a learner has to find out from its eyes |
-| acts | through its own arm motors only (``actuation="positional"``): holds its start pose through the demonstration, then moves its arms to the action's pose (:data:`~mimo_social.partners.demonstrator.ACTION_POSES`, the demonstrator's own) in ``move_s`` and holds it; it writes no state |
+| acts | through its own arm motors only (``actuation="positional"``): holds its start pose through the demonstration, then moves its arms through the action's poses (:data:`~mimo_social.partners.demonstrator.ACTION_POSES`, the demonstrator's own), ``move_s`` (0.3 s) each, and holds the last; it needs ``actuation="positional"``; it writes no state |
 
 ``ImitationController(action="clap")`` performs one fixed action whatever was demonstrated (the
 "always the same act" hack, and the way the tests make each action's outcome on purpose).
@@ -42,15 +42,12 @@ class ImitationController(Partner):
                              "action; allowed: the imitation task")
         self._script = PoseScript(env, agent, "ImitationController")
         action = self.action or task.demonstrated_action
-        self._target = self._script.pose_controls(action)
+        self._path = self._script.path(action)
         self._move = max(1.0, self.move_s / float(env.dt))
         self._since = 0
 
     def act(self, env, agent, observation):
-        s = self._script
-        if not env.task.turn:
-            u = s.start
-        else:
+        if env.task.turn:
             self._since += 1
-            u = s.blend(s.start, self._target, self._since / self._move)
+        u = PoseScript.along(self._path, self._since / self._move)
         return motor_action(env.action_space(agent), u)

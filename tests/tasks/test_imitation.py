@@ -1,0 +1,139 @@
+"""The imitation task (imitation of actions, seen through the eyes) through its public API."""
+
+import numpy as np
+import pytest
+
+from mimo_social.envs import imitation_v0
+from mimo_social.partners.controllers.imitation import ImitationController
+from mimo_social.partners.demonstrator import ACTION_POSES, Demonstrator
+from mimo_social.tasks.imitation import ACTIONS, partner_policy, run_episodes, summary
+
+BLIND = {"vision": False}      # the learner's eyes off where the test needs no pictures
+
+
+def scripted(learner=BLIND, partner=None, **options):
+    return imitation_v0.scripted_env(per_agent=[dict(learner), dict(partner or {})],
+                                     task_options=options)
+
+
+def seeds_by_action(env, first=0, n=40) -> dict:
+    """One reset seed per demonstrated action (the task draws it from the seeded generator)."""
+    out = {}
+    for seed in range(first, first + n):
+        env.reset(seed=seed)
+        out.setdefault(env.unwrapped.task.demonstrated_action, seed)
+        if len(out) == len(ACTIONS):
+            return out
+    raise AssertionError(f"not every action drawn in {n} seeds: {out}")
+
+
+def episode(env, partner, seed):
+    """The learner's last info and its return over one episode with a scripted policy."""
+    [rec] = run_episodes(env, partner_policy(partner), 1, seed=seed)
+    return rec
+
+
+def test_bad_options_raise_clear_errors():
+    with pytest.raises(ValueError, match="n_agents=3"):
+        imitation_v0.parallel_env(n_agents=3)
+    with pytest.raises(ValueError, match=r"actions \['wave'\] unknown.*head_touch"):
+        imitation_v0.parallel_env(task_options={"actions": ["wave"]})
+    with pytest.raises(ValueError, match="actions"):
+        imitation_v0.parallel_env(task_options={"actions": ["clap", "clap"]})
+    with pytest.raises(ValueError, match="wrong_reward"):
+        imitation_v0.parallel_env(task_options={"wrong_reward": 1.0})
+    with pytest.raises(ValueError, match="demo_s"):
+        imitation_v0.parallel_env(task_options={"demo_s": 0.1})
+    with pytest.raises(ValueError, match="action='wave'"):
+        ImitationController(action="wave")
+    with pytest.raises(ValueError, match="actuation='spring_damper'.*positional"):
+        episode(scripted(learner={**BLIND, "actuation": "spring_damper"}),
+                ImitationController(), 0)
+
+
+def test_spaces_and_nothing_privileged():
+    env = imitation_v0.scripted_env()
+    space = env.observation_space("infant_0")
+    assert set(space.spaces) == {"proprioception", "eye_left", "eye_right", "turn"}
+    assert space["eye_left"].shape == (64, 64, 3)
+    assert env.action_space("infant_0").shape == (16,)       # both arms, positional
+    # before the demonstration every episode looks the same, whatever action is drawn
+    seeds = seeds_by_action(env)
+    first = [env.reset(seed=s)[0]["infant_0"] for s in seeds.values()]
+    for obs in first[1:]:
+        for k in obs:
+            np.testing.assert_array_equal(obs[k], first[0][k])
+    # two learners: the demonstrator alone is told the action (its own task)
+    two = imitation_v0.parallel_env(per_agent=[BLIND, BLIND])
+    obs, _ = two.reset(seed=seeds["clap"])
+    assert obs["infant_1"]["instruction"].tolist() == [0, 0, 1, 0]
+    assert obs["infant_0"]["instruction"].tolist() == [0, 0, 0, 0]
+
+
+@pytest.mark.parametrize("body", ["adult", "infant"])
+def test_each_outcome_fires_for_the_demonstration_and_the_reproduction(body):
+    """The demonstrator (the kneeling adult, or an 18-month-old) shows each action with that
+    action's outcome alone; the scripted learner reproduces it and succeeds."""
+    partner = {} if body == "adult" else {"body": "infant"}
+    for k, action in enumerate(ACTIONS):
+        env = scripted(partner=partner, actions=[action])
+        rec = episode(env, ImitationController(), 0)
+        assert rec["demonstrated"] == k
+        assert rec["demonstration"] == k, (body, action, rec)
+        assert rec["demonstration_outcomes"] == 1 << k, (body, action, rec)
+        assert rec["response"] == k and rec["is_success"], (body, action, rec)
+        assert rec["return"] == 1.0
+        assert 0 < rec["response_step"] < 100          # within a second of its turn
+
+
+def test_reward_is_highest_for_the_demonstrated_action():
+    """The scripted learner performing each action in turn, for each demonstrated action: +1
+    for the demonstrated one, ``wrong_reward`` for every other."""
+    env = scripted(wrong_reward=-0.5)
+    seeds = seeds_by_action(env)
+    for shown, seed in seeds.items():
+        for done in ACTIONS:
+            rec = episode(env, ImitationController(action=done), seed)
+            assert rec["response"] == ACTIONS.index(done), (shown, done, rec)
+            assert rec["return"] == (1.0 if done == shown else -0.5), (shown, done, rec)
+            assert rec["is_success"] == (done == shown)
+
+
+def test_random_and_zero_actions_fail():
+    env = scripted()
+    zero = run_episodes(env, lambda o, e: np.zeros(16, np.float32), 4, seed=100)
+    assert all(r["response"] == -1 and r["return"] == 0.0 for r in zero)
+    env.action_space("infant_0").seed(0)
+    rand = run_episodes(env, lambda o, e: e.action_space("infant_0").sample(), 8, seed=100)
+    assert sum(r["is_success"] for r in rand) <= 2
+
+
+def test_reward_free_keeps_the_measures_and_summary_counts():
+    env = scripted(reward_free=True)
+    recs = run_episodes(env, partner_policy(ImitationController()), 4, seed=0)
+    assert all(r["is_success"] and r["return"] == 0.0 for r in recs)
+    s = summary(recs)
+    assert s["all"]["episodes"] == 4 and s["all"]["success"] == 1.0
+    for action, row in s.items():
+        if action != "all":
+            assert row["responses"][action] == row["episodes"]
+
+
+def test_two_learners_the_demonstrator_is_rewarded_for_its_instruction():
+    env = imitation_v0.parallel_env(per_agent=[BLIND, BLIND])
+    obs, _ = env.reset(seed=3)
+    demo = Demonstrator()
+    demo.reset(env, "infant_1", np.random.default_rng(0))
+    total = {"infant_0": 0.0, "infant_1": 0.0}
+    while env.agents:
+        act = {"infant_0": np.zeros(16, np.float32),
+               "infant_1": demo.act(env, "infant_1", obs["infant_1"])}
+        obs, rew, term, trunc, info = env.step(act)
+        for a in rew:
+            total[a] += rew[a]
+    assert total == {"infant_0": 0.0, "infant_1": 1.0}
+    assert info["infant_1"]["is_success"] and not info["infant_0"]["is_success"]
+
+
+def test_every_action_has_a_pose():
+    assert set(ACTION_POSES) == set(ACTIONS)
