@@ -383,13 +383,16 @@ def run_episodes(env, policy, episodes: int, seed: int = 0) -> list[dict]:
     return out
 
 
-def partner_policy(partner, agent: str = "infant_0"):
-    """A ``policy`` for :func:`run_episodes` from a scripted Partner (reset at each episode's
-    first step)."""
+def partner_policy(partner, agent: str = "infant_0", seed: int = 0):
+    """A ``policy`` for :func:`run_episodes` from a scripted Partner, reset at each episode's
+    first step with a generator seeded ``seed``, ``seed + 1``, ... (one per episode)."""
+    episodes = [0]
+
     def policy(obs, env):
         inner = env.unwrapped
         if inner.task.step_count == 0:
-            partner.reset(inner, agent, np.random.default_rng(inner.task.demonstrated))
+            partner.reset(inner, agent, np.random.default_rng(seed + episodes[0]))
+            episodes[0] += 1
         return partner.act(inner, agent, obs)
 
     return policy

@@ -137,3 +137,20 @@ def test_two_learners_the_demonstrator_is_rewarded_for_its_instruction():
 
 def test_every_action_has_a_pose():
     assert set(ACTION_POSES) == set(ACTIONS)
+
+
+def test_a_push_during_the_demonstration_is_no_act():
+    """The learner's box is put back when its turn begins: a learner that pushes it while the
+    demonstration runs (here: the demonstrator's own script on the learner's arms) and then
+    holds still has made no act."""
+    env = scripted(actions=["push_box"])
+    obs, _ = env.reset(seed=0)
+    inner = env.unwrapped
+    early = Demonstrator()
+    early.reset(inner, "infant_0", np.random.default_rng(0))
+    slid = []
+    while env.agents:
+        obs, rew, term, trunc, info = env.step({"infant_0": early.act(inner, "infant_0", None)})
+        slid.append(info["infant_0"]["outcomes"] if info else 0)
+    assert max(slid[:inner.task.demo_steps]) == 1 << ACTIONS.index("push_box")   # pushed
+    assert info["infant_0"]["response"] == -1 and rew["infant_0"] == 0.0
