@@ -154,3 +154,23 @@ def test_a_push_during_the_demonstration_is_no_act():
         slid.append(info["infant_0"]["outcomes"] if info else 0)
     assert max(slid[:inner.task.demo_steps]) == 1 << ACTIONS.index("push_box")   # pushed
     assert info["infant_0"]["response"] == -1 and rew["infant_0"] == 0.0
+
+
+def test_the_demonstration_reaches_the_learners_eyes():
+    """While the demonstrator holds each act (1.5 s in), the learner's eye image differs from
+    its first one and from every other act's in many pixels (a channel changed by over 30)."""
+    def changed(a, b):
+        return int((np.abs(a.astype(int) - b.astype(int)).max(-1) > 30).sum())
+
+    seen = {}
+    for action in ACTIONS:
+        env = imitation_v0.scripted_env(task_options={"actions": [action]})
+        obs, _ = env.reset(seed=0)
+        start = obs["infant_0"]["eye_left"]
+        for _ in range(150):
+            obs, *_ = env.step({"infant_0": np.zeros(16, np.float32)})
+        seen[action] = obs["infant_0"]["eye_left"]
+        assert changed(seen[action], start) > 100, action
+    for i, a in enumerate(ACTIONS):
+        for b in ACTIONS[i + 1:]:
+            assert changed(seen[a], seen[b]) > 100, (a, b)
