@@ -13,17 +13,14 @@ from dataclasses import dataclass
 from types import ModuleType
 
 from ..core.gym_adapter import SingleAgentEnv
-from ..partners.controllers import (CatchController, GazeFollowController, HighFiveController,
-                                    MirrorController, ReachController, ReceiveController,
-                                    SelfBodyController, SocialTouchController, StandupController)
-from ..partners.controllers.imitation import ImitationController
-from . import (catch_v0, free_play_v0, handover_v0, high_five_v0, joint_attention_v0, mirror_v0,
-               reach_v0, selfbody_v0, social_touch_v0, standup_v0)
-from . import contingency_v0
-from ..partners.controllers.contingency import ContingencyDetectorController
-from . import imitation_v0
-from . import still_face_v0
-from ..partners.controllers.still_face import StillFaceInfantController
+from ..partners.controllers import (CatchController, ContingencyDetectorController,
+                                    GazeFollowController, HighFiveController,
+                                    ImitationController, MirrorController, ReachController,
+                                    ReceiveController, SelfBodyController, SocialTouchController,
+                                    StandupController, StillFaceInfantController)
+from . import (catch_v0, contingency_v0, free_play_v0, handover_v0, high_five_v0, imitation_v0,
+               joint_attention_v0, mirror_v0, reach_v0, selfbody_v0, social_touch_v0,
+               standup_v0, still_face_v0)
 
 __all__ = ["EnvEntry", "CATALOG", "KINDS", "entry", "names", "make_gym", "register_envs"]
 
