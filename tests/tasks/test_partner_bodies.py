@@ -22,7 +22,7 @@ ADULT = [{}, {"body": "adult", "posture": "kneeling"}]
 SOCIAL = names("social")
 # the distance each task uses for two 18-month-olds (its option's default)
 STANDARD_DISTANCE = {"high_five": 0.35, "mirror": 0.3, "joint_attention": 0.7,
-                     "social_touch": 0.37, "handover": 0.34}
+                     "social_touch": 0.37, "handover": 0.34, "still_face": 0.6}
 
 
 def run_episodes(task, seeds, per_agent=ADULT, **kwargs):
@@ -73,6 +73,10 @@ def cross_contacts(world) -> int:
 @pytest.mark.parametrize("task", SOCIAL)
 def test_two_infants_placed_as_before(task):
     env = entry(task).parallel_env()
+    if env.agent_configs[1].body != "infant":   # an adult caregiver by default: two infants
+        posture = env.agent_configs[0].posture
+        env.close()
+        env = entry(task).parallel_env(per_agent=[{}, {"body": "infant", "posture": posture}])
     setups = env.world.agent_setups
     assert setups[0].position == (0.0, 0.0)
     assert setups[1].position == (STANDARD_DISTANCE[task], 0.0)
