@@ -22,7 +22,10 @@ ADULT = [{}, {"body": "adult", "posture": "kneeling"}]
 SOCIAL = names("social")
 # the distance each task uses for two 18-month-olds (its option's default)
 STANDARD_DISTANCE = {"high_five": 0.35, "mirror": 0.3, "joint_attention": 0.7,
-                     "social_touch": 0.37, "handover": 0.34, "still_face": 0.6}
+                     "social_touch": 0.37, "handover": 0.34, "still_face": 0.6,
+                     # the paradigms of issue 19 with an infant partner: face to face like
+                     # mirror (contingency), the demonstrator seen whole (imitation)
+                     "contingency": 0.3, "imitation": 1.4}
 
 
 def run_episodes(task, seeds, per_agent=ADULT, **kwargs):
