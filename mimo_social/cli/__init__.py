@@ -19,9 +19,10 @@ from . import baselines
 from . import soak
 from . import bench_engines
 from . import bench_development
+from . import paradigm
 
 SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, bench_vision, figure, docs,
-               bench_recording, baselines, soak, bench_engines, bench_development)
+               bench_recording, baselines, soak, bench_engines, bench_development, paradigm)
 
 
 class UsageError(SystemExit):

@@ -94,6 +94,14 @@ BAD = [
     (["figure", "skin-hand-ball", "{file}/x.png"], "OUT.png"),
     (["docs", "--out", "{file}/tasks.md"], "--out"),
     (["docs", "--out", "{dir}"], "--out"),
+    (["paradigm", "mirror"], "task"),
+    (["paradigm", "still_face", "--episodes", "0"], "--episodes"),
+    (["paradigm", "still_face", "--seed", "-1"], "--seed"),
+    (["paradigm", "still_face", "--learner", "{dir}/nothing"], "--learner"),
+    (["paradigm", "still_face", "--learner", "{file}"], "--learner"),
+    (["paradigm", "still_face", "--env-kwargs", '{"bogus": 1}'], "--env-kwargs"),
+    (["paradigm", "still_face", "--model", "worst"], "--model"),
+    (["paradigm", "still_face", "--json", "{file}/x.json"], "--json"),
 ]
 
 

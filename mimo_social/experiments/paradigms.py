@@ -1,0 +1,296 @@
+"""The classic paradigms of infant social development run with a learner of one's choice.
+
+``run_paradigm(task, learners, episodes, seed)`` runs ``episodes`` episodes of one paradigm
+(``still_face``, ``contingency``, ``imitation``: the scripted forms of their catalogue envs,
+``infant_0`` the learner, the caregiver scripted) with each learner and returns the paradigm's
+own summary per learner, computed by the task module's summary function (nothing is
+re-measured here):
+
+* ``still_face``: :func:`mimo_social.tasks.still_face.still_face_summary` of each episode's last
+  info: per phase (interaction, still face, reunion) the share of the phase's steps with a smile,
+  with the gaze on the caregiver's face and with self-touch;
+* ``contingency``: :func:`mimo_social.tasks.contingency.condition_summary`: blocks of a live, a
+  replay (of that block's live episode) and a non-contingent episode; per condition the smile
+  rates, response and baseline rates, contingency index, gaze and shared smiling;
+* ``imitation``: :func:`mimo_social.tasks.imitation.summary` of
+  :func:`~mimo_social.tasks.imitation.run_episodes`: per demonstrated action the success rate,
+  the mean return and which act the learner answered with.
+
+A learner (:func:`make_learner`) is ``"scripted"`` (the catalogue's controller of the task: the
+scripted infant baseline), ``"random"`` (uniform samples of the learner's action space, seeded
+per episode), ``"zero"`` (the resting action: no motor command, the neutral face) or the folder
+of a run trained with ``mimo-social train`` / ``compare`` on the same task with ``--mode
+scripted`` (its ``model.zip`` or ``best_model.zip``, deterministic, on the flat observation it
+was trained on, normalisation inside the saved policy). Every learner has the
+:class:`~mimo_social.partners.base.Partner` interface (``reset(env, agent, rng)``,
+``act(env, agent, obs)``) and drives ``infant_0`` through its own action only.
+
+:func:`side_by_side` formats the summaries as one markdown table, a column per learner.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from ..envs.catalog import entry
+from ..partners.base import zero_action
+from ..train.tasks import TrainInputError
+
+__all__ = ["PARADIGMS", "LEARNER_NAMES", "make_learner", "run_paradigm", "side_by_side",
+           "check_learner"]
+
+#: the paradigms this runs (catalogue task names)
+PARADIGMS = ("still_face", "contingency", "imitation")
+#: the built-in learners (besides a run folder)
+LEARNER_NAMES = ("scripted", "random", "zero")
+AGENT = "infant_0"
+
+
+class _Random:
+    """Uniform samples of the learner's action space, the space seeded per episode."""
+
+    def __init__(self, space):
+        import copy
+        self.space = copy.deepcopy(space)
+        self.name = "random"
+
+    def reset(self, env, agent, rng) -> None:
+        self.space.seed(int(rng.integers(2**31)))
+
+    def act(self, env, agent, obs):
+        return self.space.sample()
+
+
+class _Zero:
+    def __init__(self, space):
+        self.action = zero_action(space)
+        self.name = "zero"
+
+    def reset(self, env, agent, rng) -> None:
+        pass
+
+    def act(self, env, agent, obs):
+        return self.action
+
+
+class _Trained:
+    """A trained run's policy (SB3), deterministic, on the flat observation it was trained on
+    (:class:`~mimo_social.core.wrappers.FlattenParallel`'s: the parts in order, images in
+    [0, 1]); its flat action decoded onto the learner's action space."""
+
+    def __init__(self, run: Path, config: Mapping[str, Any], model: str, obs_space, act_space):
+        from ..core.wrappers import _ActionDecoder, _ObsFlattener
+        from ..train.tasks import algo_class
+        path = {"final": run / "model.zip", "best": run / "best_model.zip"}[model]
+        if not path.exists():
+            raise FileNotFoundError(f"run {run}: model {path.name} not found (model: final or "
+                                    "best, the files 'mimo-social train' writes)")
+        import torch
+        torch.set_num_threads(1)
+        self.model = algo_class(config["algo"]).load(str(path), device="cpu")
+        self.flatten, self.decode = _ObsFlattener(obs_space), _ActionDecoder(act_space)
+        if self.model.observation_space.shape != self.flatten.space.shape:
+            raise TrainInputError(f"run {run}: its policy observes "
+                                  f"{self.model.observation_space.shape} floats, the env gives "
+                                  f"{self.flatten.space.shape}: evaluate with the env settings "
+                                  "it was trained with (--env-kwargs)")
+        self.name = f"{run.name} ({config['algo'].upper()})"
+        self.run = str(run)
+
+    def reset(self, env, agent, rng) -> None:
+        pass
+
+    def act(self, env, agent, obs):
+        action = self.model.predict(self.flatten(obs), deterministic=True)[0]
+        return self.decode(action, agent)
+
+
+def _run_config(task: str, run: str | Path) -> dict:
+    run = Path(run)
+    if not (run / "config.json").is_file():
+        raise FileNotFoundError(f"learner {str(run)!r}: no config.json in it; allowed: "
+                                f"{', '.join(LEARNER_NAMES)} or a folder written by "
+                                "'mimo-social train' / 'compare'")
+    config = json.loads((run / "config.json").read_text())
+    if config.get("task") != task:
+        raise TrainInputError(f"learner {str(run)!r} was trained on {config.get('task')!r}, "
+                              f"not {task!r}")
+    if config.get("mode") not in (None, "scripted") or config.get("engine", "sb3") != "sb3":
+        raise TrainInputError(f"learner {str(run)!r}: mode {config.get('mode')!r}, engine "
+                              f"{config.get('engine', 'sb3')!r}; allowed: an SB3 run with "
+                              "--mode scripted (one learner, the caregiver scripted)")
+    return config
+
+
+def check_learner(task: str, spec: str) -> str:
+    """``spec`` if it is a built-in learner or a run folder of ``task``; else the error."""
+    if spec not in LEARNER_NAMES:
+        _run_config(task, spec)
+    return spec
+
+
+def make_learner(task: str, spec: str, env, model: str = "final"):
+    """The learner ``spec`` (one of :data:`LEARNER_NAMES` or a run folder) for ``infant_0`` of
+    ``env`` (the paradigm's one-learner PettingZoo env, for the spaces)."""
+    if task not in PARADIGMS:
+        raise TrainInputError(f"task {task!r} not allowed; allowed: {', '.join(PARADIGMS)}")
+    if model not in ("final", "best"):
+        raise TrainInputError(f"model {model!r} not allowed; allowed: final, best")
+    space = env.action_space(AGENT)
+    if spec == "scripted":
+        controller = entry(task).controller()
+        controller.name = f"scripted ({type(controller).__name__})"
+        return controller
+    if spec == "random":
+        return _Random(space)
+    if spec == "zero":
+        return _Zero(space)
+    config = _run_config(task, spec)
+    return _Trained(Path(spec), config, model, env.observation_space(AGENT), space)
+
+
+def _env_kwargs(task: str, specs: Sequence[str], env_kwargs) -> dict:
+    """The env settings every learner runs with: ``env_kwargs``, else those the runs were
+    trained with (which must agree), else the defaults."""
+    if env_kwargs is not None:
+        return dict(env_kwargs)
+    kws = [dict(_run_config(task, s).get("env_kwargs", {})) for s in specs
+           if s not in LEARNER_NAMES]
+    if any(k != kws[0] for k in kws[1:]):
+        raise TrainInputError("the runs were trained with different env settings ("
+                              + "; ".join(map(str, kws)) + "); give --env-kwargs")
+    return kws[0] if kws else {}
+
+
+def _still_face(learner, env, episodes: int, seed: int) -> dict:
+    from ..tasks.still_face import still_face_summary
+    finals, returns = [], []
+    for k in range(episodes):
+        obs, infos = env.reset(seed=seed + k)
+        learner.reset(env.unwrapped, AGENT, np.random.default_rng(seed + k))
+        last, total = infos.get(AGENT, {}), 0.0
+        while env.agents:
+            obs, rew, _, _, infos = env.step({AGENT: learner.act(env.unwrapped, AGENT,
+                                                                  obs[AGENT])})
+            last, total = infos.get(AGENT, last), total + float(rew.get(AGENT, 0.0))
+        finals.append(last)
+        returns.append(total)
+    out = still_face_summary(finals)
+    out["return"] = (float(np.mean(returns)), float(np.std(returns)))
+    return out
+
+
+def _imitation(learner, env, episodes: int, seed: int) -> dict:
+    from ..tasks.imitation import partner_policy, run_episodes, summary
+    return summary(run_episodes(env, partner_policy(learner, AGENT, seed=seed), episodes, seed))
+
+
+def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: int = 5,
+                 seed: int = 0, env_kwargs: Mapping[str, Any] | None = None,
+                 model: str = "final") -> dict:
+    """Each learner on the same seeded episodes of ``task`` (one of :data:`PARADIGMS`).
+
+    ``episodes``: episodes per learner (contingency: blocks of a live, a replay and a
+    non-contingent episode); seeds ``seed``, ``seed + 1``, ... Returns ``task``, ``episodes``,
+    ``seed``, ``env_kwargs`` and ``learners``: a list of ``{"learner", "spec", "summary"}``,
+    the summary being the task module's (see the module docstring)."""
+    if task not in PARADIGMS:
+        raise TrainInputError(f"task {task!r} not allowed; allowed: {', '.join(PARADIGMS)}")
+    episodes, seed = int(episodes), int(seed)
+    if episodes < 1:
+        raise TrainInputError(f"episodes={episodes}; allowed: a positive integer")
+    specs = [str(s) for s in learners]
+    if not specs:
+        raise TrainInputError("no learner; allowed: one or more of "
+                              f"{', '.join(LEARNER_NAMES)} or run folders")
+    for s in specs:
+        check_learner(task, s)
+    kw = _env_kwargs(task, specs, env_kwargs)
+    results = []
+    for spec in specs:
+        if task == "contingency":
+            from ..tasks.contingency import condition_summary
+            probe = entry(task).scripted_env(**kw)
+            try:
+                learner = make_learner(task, spec, probe, model)
+            finally:
+                probe.close()
+            summ = condition_summary(episodes, seed, controller=learner, env_kwargs=kw)
+        else:
+            env = entry(task).scripted_env(**kw)
+            try:
+                learner = make_learner(task, spec, env, model)
+                run = _still_face if task == "still_face" else _imitation
+                summ = run(learner, env, episodes, seed)
+            finally:
+                env.close()
+        results.append({"learner": getattr(learner, "name", type(learner).__name__),
+                        "spec": spec, "summary": summ})
+    return {"task": task, "episodes": episodes, "seed": seed, "env_kwargs": kw,
+            "learners": results}
+
+
+# -- tables -----------------------------------------------------------------------------------
+def _ms(pair) -> str:
+    mean, sd = pair
+    return f"{mean:.2f} +- {sd:.2f}"
+
+
+def _rows_still_face(summaries) -> list[tuple[str, list[str]]]:
+    from ..tasks.still_face import MEASURES, PHASES
+    rows = [("success", [f"{100 * s['success']:.0f} %" for s in summaries]),
+            ("return", [f"{s['return'][0]:.1f} +- {s['return'][1]:.1f}" for s in summaries])]
+    for phase in PHASES:
+        for m in MEASURES:
+            rows.append((f"{phase}: {m}", [_ms(s["phases"][phase][m]) for s in summaries]))
+    return rows
+
+
+def _rows_contingency(summaries) -> list[tuple[str, list[str]]]:
+    from ..tasks.contingency import CONDITIONS, MEASURES
+    rows = []
+    for cond in CONDITIONS:
+        if not all(cond in s for s in summaries):
+            continue
+        for m in MEASURES:
+            rows.append((f"{cond}: {m}", [_ms(s[cond][m]) for s in summaries]))
+    return rows
+
+
+def _rows_imitation(summaries) -> list[tuple[str, list[str]]]:
+    keys = [k for k in summaries[0] if all(k in s for s in summaries)]
+    rows = []
+    for key in keys:
+        rows.append((f"{key}: success", [f"{100 * s[key]['success']:.0f} % of "
+                                         f"{s[key]['episodes']}" for s in summaries]))
+        rows.append((f"{key}: return", [f"{s[key]['return']:.2f}" for s in summaries]))
+        rows.append((f"{key}: responses",
+                     [", ".join(f"{n} {c}" for n, c in s[key]["responses"].items() if c)
+                      for s in summaries]))
+    return rows
+
+
+def side_by_side(result: Mapping[str, Any]) -> str:
+    """:func:`run_paradigm`'s result as a markdown table: a row per measure (per phase,
+    condition or demonstrated action), a column per learner (mean +- sd over episodes)."""
+    task = result["task"]
+    names = [r["learner"] for r in result["learners"]]
+    summaries = [r["summary"] for r in result["learners"]]
+    rows = {"still_face": _rows_still_face, "contingency": _rows_contingency,
+            "imitation": _rows_imitation}[task](summaries)
+    unit = "blocks (live, replay, non-contingent)" if task == "contingency" else "episodes"
+    lines = [f"{task}: {result['episodes']} {unit} per learner, seeds from {result['seed']}",
+             "", "| measure | " + " | ".join(names) + " |",
+             "|---" * (len(names) + 1) + "|"]
+    lines += [f"| {label} | " + " | ".join(cells) + " |" for label, cells in rows]
+    return "\n".join(lines) + "\n"
+
+
+def to_json(result: Mapping[str, Any]) -> str:
+    """The result as JSON (tuples as lists)."""
+    return json.dumps(result, indent=1, default=lambda o: o.tolist() if hasattr(o, "tolist")
+                      else str(o))

@@ -1,0 +1,84 @@
+"""``mimo-social paradigm`` / ``experiments.paradigms``: the paradigms' own summaries for the
+scripted, random, zero and trained learners, side by side (tiny episodes: short phases, few
+steps)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from mimo_social import cli
+from mimo_social.experiments.paradigms import run_paradigm, side_by_side
+from mimo_social.train.tasks import TrainInputError
+
+SHORT_SF = {"task_options": {"phases_s": [0.5, 0.5, 0.5]}}
+TINY_SF = {"task_options": {"phases_s": [0.1, 0.1, 0.1]},
+           "per_agent": [{"vision": {"width": 16, "height": 16}}, {}]}
+
+
+def _col(result, k):
+    return result["learners"][k]["summary"]
+
+
+def test_still_face_scripted_shows_the_pattern_zero_shows_nothing():
+    res = run_paradigm("still_face", ["scripted", "zero"], episodes=1, seed=0,
+                       env_kwargs=SHORT_SF)
+    scripted, zero = _col(res, 0)["phases"], _col(res, 1)["phases"]
+    assert scripted["interaction"]["smile"][0] > 0.9 > 0.1 > scripted["still"]["smile"][0]
+    assert scripted["reunion"]["smile"][0] > 0.9
+    assert scripted["still"]["self_touch"][0] > scripted["interaction"]["self_touch"][0]
+    assert all(v[0] == 0.0 for phase in zero.values() for v in phase.values())
+    table = side_by_side(res)
+    assert "| still: smile | 0.00 +- 0.00 | 0.00 +- 0.00 |" in table
+    assert "scripted (StillFaceInfantController)" in table
+
+
+def test_contingency_per_condition_and_imitation_per_action():
+    res = run_paradigm("contingency", ["scripted", "zero"], episodes=1, seed=0,
+                       env_kwargs={"max_steps": 120})
+    for k in (0, 1):
+        assert list(_col(res, k)) == ["live", "replay", "non_contingent"]
+    assert _col(res, 0)["live"]["smiling_fraction"][0] > 0.3
+    assert _col(res, 1)["live"]["smiling_fraction"][0] == 0.0
+    assert "| replay: contingency_index |" in side_by_side(res)
+
+    res = run_paradigm("imitation", ["scripted", "zero"], episodes=2, seed=0)
+    scripted, zero = _col(res, 0), _col(res, 1)
+    assert scripted["all"]["success"] == 1.0 and zero["all"]["success"] == 0.0
+    assert zero["all"]["responses"]["none"] == 2
+    assert "| all: success | 100 % of 2 | 0 % of 2 |" in side_by_side(res)
+
+
+def test_a_trained_run_is_a_learner_with_its_env_settings(tmp_path, capsys):
+    run = tmp_path / "sf"
+    assert cli.main(["train", "--task", "still_face", "--mode", "scripted", "--algo", "ppo",
+                     "--steps", "64", "--out", str(run), "--algo-kwargs",
+                     '{"n_steps": 32, "batch_size": 32, "n_epochs": 1}', "--env-kwargs",
+                     json.dumps(TINY_SF), "--eval-episodes", "1", "--eval-every", "64",
+                     "--checkpoint-every", "0", "--no-progress"]) == 0
+    capsys.readouterr()
+    out = tmp_path / "sf.json"
+    assert cli.main(["paradigm", "still_face", "--learner", "random", str(run), "--episodes",
+                     "1", "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "| measure | random | sf (PPO) |" in text and "| reunion: gaze |" in text
+    data = json.loads(out.read_text())
+    assert data["env_kwargs"] == TINY_SF            # the run's settings, for every learner
+    assert [r["spec"] for r in data["learners"]] == ["random", str(run)]
+    # eye size differs from the run's: refused, naming both shapes
+    with pytest.raises(TrainInputError, match="observes"):
+        run_paradigm("still_face", [str(run)], episodes=1, env_kwargs=SHORT_SF)
+    # a run of another task: exit code 2, one line naming the learner and both tasks
+    assert cli.main(["paradigm", "imitation", "--learner", str(run)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "'still_face', not 'imitation'" in err
+
+
+def test_bad_library_arguments_are_refused():
+    with pytest.raises(TrainInputError, match="allowed: still_face, contingency, imitation"):
+        run_paradigm("mirror", ["zero"])
+    with pytest.raises(TrainInputError, match="positive integer"):
+        run_paradigm("still_face", ["zero"], episodes=0)
+    with pytest.raises(FileNotFoundError, match="allowed: scripted, random, zero"):
+        run_paradigm("still_face", ["nowhere"])
