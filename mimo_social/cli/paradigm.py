@@ -38,7 +38,8 @@ def _main(args) -> int:
     from ..train.tasks import TrainInputError
     try:
         res = run_paradigm(args.task, args.learner or list(LEARNER_NAMES), args.episodes,
-                           args.seed, env_kwargs=args.env_kwargs, model=args.model)
+                           args.seed, env_kwargs=args.env_kwargs, model=args.model,
+                           deterministic=not args.stochastic)
     except (TrainInputError, FileNotFoundError) as e:
         print(f"mimo-social paradigm: error: {e}", file=sys.stderr)
         return 2
@@ -71,6 +72,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("--seed", type=seed, default=0, help="seed of the first episode")
     p.add_argument("--model", default="final", choices=("final", "best"),
                    help="a run's final (model.zip) or best (best_model.zip) policy")
+    p.add_argument("--stochastic", action="store_true",
+                   help="a run's policy samples its actions as in training (seeded per "
+                   "episode) instead of taking the most likely one")
     p.add_argument("--env-kwargs", type=env_kwargs, default=None,
                    help="JSON keyword arguments for the env of every learner (default: those "
                    "the runs were trained with)")

@@ -82,7 +82,8 @@ class _Trained:
     (:class:`~mimo_social.core.wrappers.FlattenParallel`'s: the parts in order, images in
     [0, 1]); its flat action decoded onto the learner's action space."""
 
-    def __init__(self, run: Path, config: Mapping[str, Any], model: str, obs_space, act_space):
+    def __init__(self, run: Path, config: Mapping[str, Any], model: str, obs_space, act_space,
+                 deterministic: bool = True):
         from ..core.wrappers import _ActionDecoder, _ObsFlattener
         from ..train.tasks import algo_class
         path = {"final": run / "model.zip", "best": run / "best_model.zip"}[model]
@@ -98,14 +99,18 @@ class _Trained:
                                   f"{self.model.observation_space.shape} floats, the env gives "
                                   f"{self.flatten.space.shape}: evaluate with the env settings "
                                   "it was trained with (--env-kwargs)")
-        self.name = f"{run.name} ({config['algo'].upper()})"
+        self.deterministic = bool(deterministic)
+        self.name = (f"{run.name} ({config['algo'].upper()}"
+                     + ("" if self.deterministic else ", sampled") + ")")
         self.run = str(run)
 
     def reset(self, env, agent, rng) -> None:
-        pass
+        if not self.deterministic:   # the sampled actions: seeded per episode
+            import torch
+            torch.manual_seed(int(rng.integers(2**31)))
 
     def act(self, env, agent, obs):
-        action = self.model.predict(self.flatten(obs), deterministic=True)[0]
+        action = self.model.predict(self.flatten(obs), deterministic=self.deterministic)[0]
         return self.decode(action, agent)
 
 
@@ -133,9 +138,11 @@ def check_learner(task: str, spec: str) -> str:
     return spec
 
 
-def make_learner(task: str, spec: str, env, model: str = "final"):
+def make_learner(task: str, spec: str, env, model: str = "final", deterministic: bool = True):
     """The learner ``spec`` (one of :data:`LEARNER_NAMES` or a run folder) for ``infant_0`` of
-    ``env`` (the paradigm's one-learner PettingZoo env, for the spaces)."""
+    ``env`` (the paradigm's one-learner PettingZoo env, for the spaces). A run's policy acts
+    deterministically (the mode of its action distribution), or with ``deterministic=False``
+    samples its actions as in training (seeded per episode)."""
     if task not in PARADIGMS:
         raise TrainInputError(f"task {task!r} not allowed; allowed: {', '.join(PARADIGMS)}")
     if model not in ("final", "best"):
@@ -150,7 +157,8 @@ def make_learner(task: str, spec: str, env, model: str = "final"):
     if spec == "zero":
         return _Zero(space)
     config = _run_config(task, spec)
-    return _Trained(Path(spec), config, model, env.observation_space(AGENT), space)
+    return _Trained(Path(spec), config, model, env.observation_space(AGENT), space,
+                    deterministic)
 
 
 def _env_kwargs(task: str, specs: Sequence[str], env_kwargs) -> dict:
@@ -191,13 +199,14 @@ def _imitation(learner, env, episodes: int, seed: int) -> dict:
 
 def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: int = 5,
                  seed: int = 0, env_kwargs: Mapping[str, Any] | None = None,
-                 model: str = "final") -> dict:
+                 model: str = "final", deterministic: bool = True) -> dict:
     """Each learner on the same seeded episodes of ``task`` (one of :data:`PARADIGMS`).
 
     ``episodes``: episodes per learner (contingency: blocks of a live, a replay and a
     non-contingent episode); seeds ``seed``, ``seed + 1``, ... Returns ``task``, ``episodes``,
     ``seed``, ``env_kwargs`` and ``learners``: a list of ``{"learner", "spec", "summary"}``,
-    the summary being the task module's (see the module docstring)."""
+    the summary being the task module's (see the module docstring). ``deterministic``: see
+    :func:`make_learner` (runs only)."""
     if task not in PARADIGMS:
         raise TrainInputError(f"task {task!r} not allowed; allowed: {', '.join(PARADIGMS)}")
     episodes, seed = int(episodes), int(seed)
@@ -216,14 +225,14 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
             from ..tasks.contingency import condition_summary
             probe = entry(task).scripted_env(**kw)
             try:
-                learner = make_learner(task, spec, probe, model)
+                learner = make_learner(task, spec, probe, model, deterministic)
             finally:
                 probe.close()
             summ = condition_summary(episodes, seed, controller=learner, env_kwargs=kw)
         else:
             env = entry(task).scripted_env(**kw)
             try:
-                learner = make_learner(task, spec, env, model)
+                learner = make_learner(task, spec, env, model, deterministic)
                 run = _still_face if task == "still_face" else _imitation
                 summ = run(learner, env, episodes, seed)
             finally:
@@ -231,7 +240,7 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
         results.append({"learner": getattr(learner, "name", type(learner).__name__),
                         "spec": spec, "summary": summ})
     return {"task": task, "episodes": episodes, "seed": seed, "env_kwargs": kw,
-            "learners": results}
+            "deterministic": bool(deterministic), "learners": results}
 
 
 # -- tables -----------------------------------------------------------------------------------

@@ -66,6 +66,11 @@ def test_a_trained_run_is_a_learner_with_its_env_settings(tmp_path, capsys):
     data = json.loads(out.read_text())
     assert data["env_kwargs"] == TINY_SF            # the run's settings, for every learner
     assert [r["spec"] for r in data["learners"]] == ["random", str(run)]
+    # sampled actions (as in training), seeded per episode: the same twice
+    a, b = (run_paradigm("still_face", [str(run)], episodes=2, seed=3, deterministic=False)
+            for _ in range(2))
+    assert a["learners"][0]["learner"] == "sf (PPO, sampled)"
+    assert a["learners"] == b["learners"]
     # eye size differs from the run's: refused, naming both shapes
     with pytest.raises(TrainInputError, match="observes"):
         run_paradigm("still_face", [str(run)], episodes=1, env_kwargs=SHORT_SF)
