@@ -4,7 +4,7 @@
 --seed 1000 --markdown sf.md --json sf.json`` runs each learner on the same seeded episodes of
 the paradigm (``still_face``: per phase; ``contingency``: per condition, in blocks of a live, a
 replay and a non-contingent episode; ``imitation``: per demonstrated action) and prints one
-markdown table, a column per learner; :mod:`mimo_social.experiments.paradigms` says what each
+markdown table, a column per learner; :mod:`mimo_social.train.paradigms` says what each
 learner and measure is (the measures are the task modules' own summaries).
 """
 
@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ..experiments.paradigms import LEARNER_NAMES, PARADIGMS
+from ..train.paradigms import LEARNER_NAMES, PARADIGMS
 from ._args import env_kwargs, output_file, positive_int, seed, write_file
 
 __all__ = ["add_parser"]
@@ -34,7 +34,7 @@ def learner(text: str) -> str:
 
 
 def _main(args) -> int:
-    from ..experiments.paradigms import run_paradigm, side_by_side, to_json
+    from ..train.paradigms import run_paradigm, side_by_side, to_json
     from ..train.tasks import TrainInputError
     try:
         res = run_paradigm(args.task, args.learner or list(LEARNER_NAMES), args.episodes,

@@ -38,7 +38,7 @@ import numpy as np
 
 from ..envs.catalog import entry
 from ..partners.base import zero_action
-from ..train.tasks import TrainInputError
+from .tasks import TrainInputError
 
 __all__ = ["PARADIGMS", "LEARNER_NAMES", "make_learner", "run_paradigm", "side_by_side",
            "check_learner"]
@@ -85,7 +85,7 @@ class _Trained:
     def __init__(self, run: Path, config: Mapping[str, Any], model: str, obs_space, act_space,
                  deterministic: bool = True):
         from ..core.wrappers import _ActionDecoder, _ObsFlattener
-        from ..train.tasks import algo_class
+        from .tasks import algo_class
         path = {"final": run / "model.zip", "best": run / "best_model.zip"}[model]
         if not path.exists():
             raise FileNotFoundError(f"run {run}: model {path.name} not found (model: final or "

@@ -1,4 +1,4 @@
-"""``mimo-social paradigm`` / ``experiments.paradigms``: the paradigms' own summaries for the
+"""``mimo-social paradigm`` / ``train.paradigms``: the paradigms' own summaries for the
 scripted, random, zero and trained learners, side by side (tiny episodes: short phases, few
 steps)."""
 
@@ -9,7 +9,7 @@ import json
 import pytest
 
 from mimo_social import cli
-from mimo_social.experiments.paradigms import run_paradigm, side_by_side
+from mimo_social.train.paradigms import run_paradigm, side_by_side
 from mimo_social.train.tasks import TrainInputError
 
 SHORT_SF = {"task_options": {"phases_s": [0.5, 0.5, 0.5]}}
