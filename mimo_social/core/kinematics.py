@@ -52,10 +52,20 @@ class LookAt:
 
         Computed on ``data``: its angles of these joints are overwritten (pass a scratch copy
         to keep a state)."""
+        data.qpos[self.qpos] = 0.0
+        mujoco.mj_kinematics(model, data)
+        target = (data.xpos if kind == "body" else data.site_xpos)[obj].copy()
+        return self.point(model, data, target, zeroed=True)
+
+    def point(self, model, data, target, zeroed: bool = False) -> np.ndarray:
+        """Angles that fixate the world point ``target``, computed on ``data`` like
+        :meth:`__call__` (its angles of these joints are overwritten; ``zeroed``: they are
+        already 0 and the kinematics up to date)."""
         d = data
-        d.qpos[self.qpos] = 0.0
-        mujoco.mj_kinematics(model, d)
-        target = (d.xpos if kind == "body" else d.site_xpos)[obj].copy()
+        if not zeroed:
+            d.qpos[self.qpos] = 0.0
+            mujoco.mj_kinematics(model, d)
+        target = np.asarray(target, float)
         q = np.zeros(len(self.joints))
         hb = self.head_body
         if self.swivel is not None:

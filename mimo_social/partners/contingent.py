@@ -89,29 +89,8 @@ def look_at_point(look: LookAt, model, scratch, qpos, point) -> np.ndarray:
     """:class:`LookAt`'s angles (head swivel then tilt facing ``point`` from the neck, each eye
     then aimed from its own centre) for a world point instead of a body or site, computed on
     ``scratch`` (a private MjData) from the state ``qpos``."""
-    d = scratch
-    d.qpos[:] = qpos
-    d.qpos[look.qpos] = 0.0
-    mujoco.mj_kinematics(model, d)
-    target = np.asarray(point, float)
-    q = np.zeros(len(look.joints))
-    hb = look.head_body
-    if look.swivel is not None:
-        v = d.xmat[hb].reshape(3, 3).T @ (target - d.xpos[hb])
-        q[look.swivel] = np.arctan2(v[1], v[0])
-        if look.tilt is not None:
-            q[look.tilt] = -np.arctan2(v[2], np.hypot(v[0], v[1]))
-        np.clip(q, look.lo, look.hi, out=q)
-        d.qpos[look.qpos] = q
-        mujoco.mj_kinematics(model, d)
-    R = d.xmat[hb].reshape(3, 3)
-    for body, sign, horizontal, vertical in look.eyes:
-        v = R.T @ (target - d.xpos[body])
-        if horizontal is not None:
-            q[horizontal] = sign * np.arctan2(v[1], v[0])
-        if vertical is not None:
-            q[vertical] = np.arctan2(v[2], np.hypot(v[0], v[1]))
-    return np.clip(q, look.lo, look.hi)
+    scratch.qpos[:] = qpos
+    return look.point(model, scratch, point)
 
 
 def _check_cues(value) -> tuple[str, ...]:
