@@ -98,7 +98,7 @@ def geom_archetype(model: mujoco.MjModel, g: int, rgba=None) -> Any | None:
     if t == _G.mjGEOM_CAPSULE:
         return rr.Capsules3D(lengths=[2 * size[1]], radii=[size[0]],
                              translations=[pos - size[1] * axis], quaternions=[quat],
-                             colors=[color])
+                             colors=[color], fill_mode="solid")
     if t == _G.mjGEOM_CYLINDER:
         return rr.Cylinders3D(lengths=[2 * size[1]], radii=[size[0]], centers=[pos],
                               quaternions=[quat], colors=[color], fill_mode="solid")
