@@ -19,7 +19,7 @@ def blueprint(agents: list[str], face_paths: list[str],
     """The 3D world (seen from ``eye``) beside the faces, each agent's two eyes side by side
     (``eye_paths``: agent index -> its left and right eye paths), time series of rewards, of the
     touch totals of ``touch_agents`` and of the ``/scalars``, and tabs with the action norms, the
-    expressions and (``contacts``) the contact events."""
+    expressions and (``contacts``) the contact events. The selection panel starts collapsed."""
     side: list = [rrb.Horizontal(*[rrb.Spatial2DView(origin=p, name=f"{a} face")
                                    for a, p in zip(agents, face_paths)],
                                  name="faces")]
@@ -49,6 +49,8 @@ def blueprint(agents: list[str], face_paths: list[str],
             rrb.Vertical(*side),
             column_shares=[3, 2]),
         rrb.TimePanel(timeline=SIM_TIME),
+        # the selection panel takes a fifth of the page and is empty until one clicks
+        rrb.SelectionPanel(state="collapsed"),
         collapse_panels=False)
 
 

@@ -564,6 +564,13 @@ def test_blueprint_without_vision_has_no_eyes_but_touch_totals(tmp_path):
     assert any(isinstance(n, rrb.TextLogView) and n.origin == "/events/contacts" for n in nodes)
 
 
+def test_blueprint_starts_with_the_selection_panel_collapsed(tmp_path):
+    env = free_play_v0.parallel_env(n_agents=1)
+    with Recorder(env, tmp_path / "sel.rrd") as rec:
+        panel = rec.blueprint().selection_panel
+    assert panel is not None and str(panel.state) == "collapsed"
+
+
 @pytest.fixture(scope="module")
 def touch_episode(tmp_path_factory):
     env = free_play_v0.parallel_env(n_agents=2, touch=True)
