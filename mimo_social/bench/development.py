@@ -2,9 +2,9 @@
 of sensorimotor delays and of the acuity filter, each measured against the same env without it.
 
 ``mimo-social bench-development`` runs it (:mod:`mimo_social.cli.bench_development`); the numbers
-go to BENCHMARKS.md. Variants that are compared run in turns (``rounds`` turns of ``steps`` steps
-each, under the same smooth random actions), so a change of the machine's speed touches them alike;
-each figure is the median over the turns.
+go to BENCHMARKS.md. Variants that are compared run in turns of 100 steps under the same smooth
+random actions (:func:`mimo_social.bench.vision_cost.bench_env`), so a change of the machine's
+speed touches them alike; each figure is the mean over every step.
 """
 
 from __future__ import annotations
@@ -15,10 +15,11 @@ from typing import Callable, Sequence
 import numpy as np
 
 from ..body.tables import load_body
-from ..core.random_actions import smooth_random_actions
+from ..core.config import PhysicsConfig
 from ..envs import free_play_v0
+from .vision_cost import bench_env
 
-__all__ = ["BUILD_BODIES", "ALL_DELAYS_MS", "build_times", "step_costs", "delay_cost",
+__all__ = ["BUILD_BODIES", "ALL_DELAYS_MS", "build_times", "delay_cost",
            "acuity_cost", "measure", "format_results"]
 
 #: The bodies whose build time is measured: (label, agent settings).
@@ -60,63 +61,41 @@ def build_times(hands: Sequence[str] = ("mitten", "five_fingers"), repeats: int 
     return out
 
 
-def step_costs(variants: dict[str, Callable[[], object]], steps: int = 300, rounds: int = 5,
-               seed: int = 0) -> dict[str, float]:
-    """Milliseconds per env step of each variant (a function making the env), median over
-    ``rounds`` turns of ``steps`` steps each; the variants take turns, under the same actions."""
-    envs = {name: make() for name, make in variants.items()}
-    actions = {}
-    for name, env in envs.items():
-        env.reset(seed=seed)
-        acts = {}
-        for i, a in enumerate(env.possible_agents):
-            n = env.action_space(a)["motors"].shape[0]
-            acts[a] = (0.5 * smooth_random_actions(steps, n, seed + i)[0]).astype(np.float32)
-        actions[name] = acts
-    times: dict[str, list[float]] = {name: [] for name in envs}
-    for _ in range(rounds):
-        for name, env in envs.items():
-            env.reset(seed=seed)
-            acts = actions[name]
-            t0 = time.perf_counter()
-            for k in range(steps):
-                env.step({a: {"motors": acts[a][k], "expression": 0} for a in env.agents})
-            times[name].append((time.perf_counter() - t0) / steps)
-    for env in envs.values():
-        env.close()
-    return {name: 1e3 * float(np.median(t)) for name, t in times.items()}
+def _ms_per_step(configs: dict[str, dict], sim_seconds: float) -> dict[str, float]:
+    """Milliseconds per env step of each free-play configuration, measured by
+    :func:`~mimo_social.bench.vision_cost.bench_env` (the configurations take turns of 100
+    steps under the same smooth random actions)."""
+    dt = PhysicsConfig().timestep * PhysicsConfig().frame_skip
+    return {r["config"]: 1e3 * r["total"] * dt for r in bench_env(configs, sim_seconds)}
 
 
-def delay_cost(steps: int = 300, rounds: int = 5) -> dict[str, float]:
+def delay_cost(sim_seconds: float = 15.0) -> dict[str, float]:
     """ms per step of two infants with touch, no delays vs every sense delayed 100 ms
     (:data:`ALL_DELAYS_MS`), and with vision (64x64 eyes) too."""
-    def make(delays, vision):
-        return lambda: free_play_v0.parallel_env(n_agents=2, touch=True, delays=delays,
-                                                 vision={"width": 64, "height": 64}
-                                                 if vision else False)
-    return step_costs({"touch": make(None, False), "touch + delays": make(ALL_DELAYS_MS, False),
-                       "touch + vision": make(None, True),
-                       "touch + vision + delays": make(ALL_DELAYS_MS, True)}, steps, rounds)
+    eyes = {"width": 64, "height": 64}
+    return _ms_per_step({
+        "touch": dict(n_agents=2, touch=True),
+        "touch + delays": dict(n_agents=2, touch=True, delays=ALL_DELAYS_MS),
+        "touch + vision": dict(n_agents=2, touch=True, vision=eyes),
+        "touch + vision + delays": dict(n_agents=2, touch=True, vision=eyes,
+                                        delays=ALL_DELAYS_MS)}, sim_seconds)
 
 
-def acuity_cost(sizes: Sequence[int] = (128, 256), steps: int = 200,
-                rounds: int = 5) -> dict[str, float]:
+def acuity_cost(sizes: Sequence[int] = (128, 256), sim_seconds: float = 10.0) -> dict[str, float]:
     """ms per step of two newborns with vision, acuity off vs on (the newborn's blur), per eye
     image size."""
-    variants = {}
-    for size in sizes:
-        for acuity in (None, "age"):
-            label = f"{size}x{size} eyes, acuity {'on' if acuity else 'off'}"
-            vision = {"width": size, "height": size, "acuity": acuity}
-            variants[label] = (lambda v=vision: free_play_v0.parallel_env(
-                n_agents=2, age_months=0.0, vision=v))
-    return step_costs(variants, steps, rounds)
+    return _ms_per_step({
+        f"{size}x{size} eyes, acuity {'on' if acuity else 'off'}": dict(
+            n_agents=2, age_months=0.0,
+            vision={"width": size, "height": size, "acuity": acuity})
+        for size in sizes for acuity in (None, "age")}, sim_seconds)
 
 
-def measure(steps: int = 300, rounds: int = 5, repeats: int = 3) -> dict:
-    """Every figure of this module, as a dict for JSON."""
-    return {"build": build_times(repeats=repeats), "delays": delay_cost(steps, rounds),
-            "acuity": acuity_cost(steps=max(steps * 2 // 3, 1), rounds=rounds)}
+def measure(sim_seconds: float = 15.0, repeats: int = 3) -> dict:
+    """Every figure of this module, as a dict for JSON (``sim_seconds`` per delay
+    configuration, two thirds of it per acuity one)."""
+    return {"build": build_times(repeats=repeats), "delays": delay_cost(sim_seconds),
+            "acuity": acuity_cost(sim_seconds=sim_seconds * 2 / 3)}
 
 
 def _relative(costs: dict[str, float], base_of: Callable[[str], str]) -> list[str]:

@@ -2,7 +2,7 @@
 of sensorimotor delays and of the acuity filter (:mod:`mimo_social.bench.development`).
 
     mimo-social bench-development                      # the figures of BENCHMARKS.md
-    mimo-social bench-development --steps 50 --rounds 2 --json out.json
+    mimo-social bench-development --sim-seconds 1 --repeats 1 --json out.json
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import argparse
 import json
 
 from ..bench import development
-from ._args import output_file, positive_int, write_file
+from ._args import output_file, positive_float, positive_int, write_file
 
 __all__ = ["add_parser", "run"]
 
@@ -20,11 +20,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         "bench-development", help="cost of developing bodies: build time per age, delays, acuity",
         description="Build time per age and for the adult; ms per step with and without "
-                    "sensorimotor delays and the acuity filter, measured in turns.")
-    parser.add_argument("--steps", type=positive_int, default=300,
-                        help="steps per turn of each compared env (default 300)")
-    parser.add_argument("--rounds", type=positive_int, default=5,
-                        help="turns per env; each figure is the median (default 5)")
+                    "sensorimotor delays and the acuity filter, measured in turns of 100 steps.")
+    parser.add_argument("--sim-seconds", type=positive_float, default=15.0,
+                        help="simulated seconds per delay configuration, two thirds of it per "
+                             "acuity one, in turns of 100 steps (default 15)")
     parser.add_argument("--repeats", type=positive_int, default=3,
                         help="builds per body; the median is shown (default 3)")
     parser.add_argument("--json", default=None, type=output_file, help="write all results here")
@@ -33,7 +32,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    results = development.measure(args.steps, args.rounds, args.repeats)
+    results = development.measure(args.sim_seconds, args.repeats)
     print(development.format_results(results))
     if args.json:
         write_file(args.json, json.dumps(results, indent=1))
