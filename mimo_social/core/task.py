@@ -7,7 +7,7 @@ One-agent tasks (reach ...) are tasks like any other; the Gymnasium adapter wrap
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, ClassVar, Mapping, Sequence
+from typing import Any, Callable, ClassVar, Mapping, Sequence
 
 import mujoco
 import numpy as np
@@ -19,8 +19,8 @@ from ..body.tables import load_body
 from .config import AgentConfig
 from .world import AgentSetup, Prop
 
-__all__ = ["Task", "TaskOptions", "agent_user_settings", "check_start_poses", "OVERLAP_DEPTH",
-           "TRUNK_PARTS"]
+__all__ = ["Task", "TaskOptions", "Plot", "REWARD", "agent_user_settings", "check_start_poses",
+           "OVERLAP_DEPTH", "TRUNK_PARTS"]
 
 #: m: how deep the trunks (:data:`TRUNK_PARTS`) of two agents may interpenetrate in their start
 #: poses; deeper: a ConfigError (agents placed inside each other; MuJoCo would push them apart
@@ -32,6 +32,59 @@ TRUNK_PARTS = ("hip", "lower_body", "upper_body", "head")
 #: (its public view: ``world``, ``systems``, ``system(name)``, ``actuation``, ``controls``,
 #: ``steps``, ``dt``, ``max_steps``, ``possible_agents``)
 EnvView = Any
+
+
+#: the name of the reward plot (:meth:`Plot.reward`)
+REWARD = "reward"
+
+
+@dataclasses.dataclass(frozen=True)
+class Plot:
+    """A time series that a task wants in a replay (:meth:`Task.plots`): the recorder logs it
+    at every recorded step after an env step (none at reset) and its default layout shows it in a
+    view of its own, one line per agent in the agent's clothes colour.
+
+    ``name``: the series' name (the view's title, with ``unit``; logged at
+    ``/plots/<name>/<agent>``, or ``/plots/<name>`` for one value). ``fn(env)``: the value(s)
+    after the step just made (the task's state then, e.g. what ``rewards`` computed): with
+    ``per_agent`` one number per agent (a sequence of ``n_agents``; NaN: none this step), else
+    one number; keep it cheap (it runs at every recorded step). ``fn=None`` is the reward the env
+    returned (:meth:`reward`, logged at ``/agents/<agent>/reward``). ``agents``: with
+    ``per_agent``, the agent indices that get a line (None: all)."""
+
+    name: str
+    unit: str = ""
+    fn: Callable[[Any], Any] | None = None
+    per_agent: bool = True
+    agents: tuple[int, ...] | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name or "/" in self.name:
+            raise ConfigError(f"Plot: name={self.name!r}; allowed: a non-empty name without '/'")
+        if self.fn is None and self.name != REWARD:
+            raise ConfigError(f"Plot {self.name!r}: fn=None; allowed: a function env -> value(s) "
+                              f"(None only for the reward plot, Plot.reward())")
+        if self.fn is not None and not callable(self.fn):
+            raise ConfigError(f"Plot {self.name!r}: fn={self.fn!r}; allowed: a function "
+                              "env -> value(s)")
+        if self.agents is not None:
+            agents = tuple(self.agents)
+            if not self.per_agent or not agents or not all(
+                    isinstance(i, (int, np.integer)) and i >= 0 for i in agents):
+                raise ConfigError(f"Plot {self.name!r}: agents={self.agents!r}; allowed: None, "
+                                  "or with per_agent a non-empty list of agent indices")
+            object.__setattr__(self, "agents", tuple(int(i) for i in agents))
+
+    @property
+    def title(self) -> str:
+        """The view's title: the name and the unit."""
+        return f"{self.name} ({self.unit})" if self.unit else self.name
+
+    @classmethod
+    def reward(cls, shared: bool = False) -> "Plot":
+        """The reward the env returned, one line per agent; ``shared``: the agents always get
+        the same reward, shown as one line (two equal lines would hide each other)."""
+        return cls(REWARD, "", None, per_agent=not shared)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -283,3 +336,9 @@ class Task:
     def terminations(self, env: EnvView) -> tuple[np.ndarray, list[dict]]:
         """Per agent: terminated?, and task infos."""
         return np.zeros(self.n_agents, bool), [{} for _ in range(self.n_agents)]
+
+    # -- replay --------------------------------------------------------------------------------
+    def plots(self) -> list[Plot]:
+        """The time series a replay shows for this task (:class:`Plot`); the base: the reward.
+        A task names what tells its story (a distance, a success, a phase ...)."""
+        return [Plot.reward()]
