@@ -1,56 +1,118 @@
-"""The default Rerun viewer layout of a recording."""
+"""The default Rerun viewer layout of a recording, made for a 1920x1080 browser page.
+
+Left (about 55 % of the width): the 3D world, large, with the skin-force legend beside it (touch
+on); under it the contact events between agents in a wide text log (only the time and the text:
+no column cuts the sentence) beside tabs with the expression log and the action norms. Right:
+one panel per agent with its face and its two eyes side by side (each ~280 px wide, so a 64x64
+eye shows at >= 200 px: rows for one or two agents, a tab per agent for more), and under them
+the task's plots (:meth:`~mimo_social.core.task.Task.plots`, one time-series view per plot), the
+touch totals and the recorder's ``scalars``, in a grid of two columns. The selection and
+blueprint panels start collapsed and the time panel compact (each is one click away).
+"""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import rerun.blueprint as rrb
+from rerun.blueprint.encodings import TextLogColumn, TextLogColumnKind, TimelineColumn
 
-from .columns import SIM_TIME, entity
+from .columns import SIM_TIME, STEP, entity
 from .contacts import CONTACTS_PATH
 from .eyes import EYES
 
 __all__ = ["blueprint", "scene_eye"]
 
 
+def _text_log(origin: str, name: str, entity_column: bool) -> rrb.TextLogView:
+    """A text log showing the simulated time and the text (the log level, always "INFO", and
+    the step are hidden; the entity path only where it tells who)."""
+    return rrb.TextLogView(
+        origin=origin, name=name,
+        columns=rrb.TextLogColumns(
+            timeline_columns=[TimelineColumn(SIM_TIME, visible=True),
+                              TimelineColumn(STEP, visible=False)],
+            text_log_columns=[TextLogColumn(TextLogColumnKind.EntityPath, visible=entity_column),
+                              TextLogColumn(TextLogColumnKind.LogLevel, visible=False),
+                              TextLogColumn(TextLogColumnKind.Body, visible=True)]))
+
+
+def _agent_panel(agent: str, face: str | None, eyes: Sequence[str] | None):
+    """One agent's face beside its two eyes (each a third of the panel's width)."""
+    views = [rrb.Spatial2DView(origin=face, name=f"{agent} face")] if face else []
+    if eyes:
+        pair = rrb.Horizontal(*[rrb.Spatial2DView(origin=p, name=f"{agent} {e} eye")
+                                for e, p in zip(EYES, eyes)], name=f"{agent} eyes")
+        if not views:
+            return pair
+        return rrb.Horizontal(*views, pair, column_shares=[1, 2], name=agent)
+    return views[0]
+
+
 def blueprint(agents: list[str], face_paths: list[str],
               eye_paths: dict[int, list[str]] | None = None,
-              touch_agents: list[int] = (), scalars: bool = False, contacts: bool = False,
-              eye: rrb.EyeControls3D | None = None) -> rrb.Blueprint:
-    """The 3D world (seen from ``eye``) beside the faces, each agent's two eyes side by side
-    (``eye_paths``: agent index -> its left and right eye paths), time series of rewards, of the
-    touch totals of ``touch_agents`` and of the ``/scalars``, and tabs with the action norms, the
-    expressions and (``contacts``) the contact events. The selection panel starts collapsed."""
-    side: list = [rrb.Horizontal(*[rrb.Spatial2DView(origin=p, name=f"{a} face")
-                                   for a, p in zip(agents, face_paths)],
-                                 name="faces")]
-    if eye_paths:
-        eyes = [rrb.Horizontal(*[rrb.Spatial2DView(origin=p, name=f"{agents[i]} {e} eye")
-                                 for e, p in zip(EYES, paths)],
-                               name=f"{agents[i]} eyes")
-                for i, paths in eye_paths.items()]
-        side.append(eyes[0] if len(eyes) == 1 else rrb.Vertical(*eyes, name="eyes"))
-    side.append(rrb.TimeSeriesView(origin="/agents", name="rewards",
-                                   contents=[entity("agents", a, "reward") for a in agents]))
+              touch_agents: Sequence[int] = (), scalars: bool = False, contacts: bool = False,
+              eye: rrb.EyeControls3D | None = None, plots: Sequence | None = None,
+              legend: Sequence[str] = ()) -> rrb.Blueprint:
+    """The layout of the module docstring. ``face_paths``: each agent's face image; ``eye_paths``:
+    agent index -> its left and right eye paths (vision on); ``touch_agents``: indices of the
+    agents with touch totals; ``scalars``: a view of ``/scalars``; ``contacts``: the contact
+    events' log; ``eye``: the 3D view's camera; ``plots``: the task's plot views (objects with
+    ``title`` and ``paths``; None: a reward view of every agent); ``legend``: entity paths of the
+    skin-force legend (shown beside the 3D view)."""
+    eye_paths = eye_paths or {}
+    # -- left: the world, its legend, the logs
+    world = rrb.Spatial3DView(origin="/world", name="world", eye_controls=eye)
+    if legend:
+        world = rrb.Horizontal(world, rrb.Spatial2DView(origin="/", contents=list(legend),
+                                                        name="skin force (N)"),
+                               column_shares=[6, 1])
+    logs = [_text_log("/agents", "expressions", entity_column=True),
+            rrb.TimeSeriesView(origin="/", name="action norms",
+                               contents=[entity("agents", a, "action_norm") for a in agents])]
+    bottom = rrb.Tabs(*logs)
+    if contacts:
+        bottom = rrb.Horizontal(_text_log(CONTACTS_PATH, "contacts between agents", False),
+                                bottom, column_shares=[3, 2])
+    left = rrb.Vertical(world, bottom, row_shares=[3, 1])
+    # -- right: one panel per agent, then the plots
+    panels = [_agent_panel(a, face_paths[i] if i < len(face_paths) else None,
+                           eye_paths.get(i)) for i, a in enumerate(agents)]
+    if not eye_paths:
+        agent_part = rrb.Horizontal(*panels, name="faces")
+        agent_rows = 0.6
+    elif len(agents) <= 2:
+        agent_part = panels[0] if len(panels) == 1 else rrb.Vertical(*panels, name="agents")
+        agent_rows = len(panels)
+    else:
+        agent_part = rrb.Tabs(*panels, name="agents")
+        agent_rows = 1.1
+    if plots is None:
+        from .plots import PlotView
+        plots = [PlotView("reward", tuple(entity("agents", a, "reward") for a in agents))]
+    series = [rrb.TimeSeriesView(origin="/", name=p.title, contents=list(p.paths))
+              for p in plots]
     if touch_agents:
-        side.append(rrb.TimeSeriesView(
-            origin="/agents", name="touch totals (N)",
+        series.append(rrb.TimeSeriesView(
+            origin="/", name="touch totals (N)",
             contents=[entity("agents", agents[i], "touch_total") for i in touch_agents]))
     if scalars:
-        side.append(rrb.TimeSeriesView(origin="/scalars", name="scalars"))
-    tabs = [rrb.TimeSeriesView(origin="/agents", name="action norms",
-                               contents=[entity("agents", a, "action_norm") for a in agents]),
-            rrb.TextLogView(origin="/agents", name="expressions")]
-    if contacts:
-        tabs.append(rrb.TextLogView(origin=CONTACTS_PATH, name="contacts"))
-    side.append(rrb.Tabs(*tabs))
+        series.append(rrb.TimeSeriesView(origin="/scalars", name="scalars"))
+    right_parts, shares = [agent_part], [agent_rows]
+    if series:
+        right_parts.append(series[0] if len(series) == 1 else
+                           rrb.Grid(*series, grid_columns=2 if len(series) <= 4 else 3,
+                                    name="plots"))
+        shares.append(max(1.0, 2.0 - 0.4 * agent_rows) if agent_rows else 1.5)
+    right = rrb.Vertical(*right_parts, row_shares=shares)
     return rrb.Blueprint(
-        rrb.Horizontal(
-            rrb.Spatial3DView(origin="/world", name="world", eye_controls=eye),
-            rrb.Vertical(*side),
-            column_shares=[3, 2]),
-        rrb.TimePanel(timeline=SIM_TIME),
-        # the selection panel takes a fifth of the page and is empty until one clicks
+        rrb.Horizontal(left, right, column_shares=[11, 9]),
+        rrb.TimePanel(timeline=SIM_TIME, state="collapsed"),
+        # the selection panel took a fifth of the page, empty until one clicks; the blueprint
+        # tree is for rearranging: both one click away
         rrb.SelectionPanel(state="collapsed"),
+        rrb.BlueprintPanel(state="collapsed"),
         collapse_panels=False)
 
 

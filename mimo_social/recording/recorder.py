@@ -39,6 +39,7 @@ Layout of a recording::
                                     touching a body part of another ("infant_0 right_hand touches
                                     infant_1 right_fingers")
     /scalars/<name>                 Scalars: the ``scalars={name: fn(env)}`` given to the Recorder
+    /plots/<name>[/<agent>]         Scalars: the task's plots (``Task.plots()``, :mod:`.plots`)
 
 Heads are textured spheres (Mesh3D) that show the current face; the eyeballs (sclera, iris,
 pupil) are drawn and turn with the eye joints; geoms in group 3 (none of the body's) are left
@@ -113,6 +114,7 @@ from .contacts import ContactLog
 from .eyes import EYE_FORMATS, EyeLog
 from .faces import FaceLog
 from .geometry import WXYZ_TO_XYZW, log_shapes, visible_bodies
+from .plots import PlotLog
 from .skin import SkinLog
 from .streams import WRITE_TIMEOUT_S, FileStream
 
@@ -239,8 +241,9 @@ class Recorder:
         self.scalar_names = list(scalars)
         if len(set(self._scalar_paths)) < len(self._scalar_paths):
             raise ValueError(f"scalars: names {self.scalar_names} give the same entity path twice")
-        self._schema = self._build_schema()
         self._capacity = max(1, math.ceil(flush_every_s / (self._dt * self.every_k_steps)))
+        self._plots = PlotLog(penv, self.agents, self._capacity)
+        self._schema = self._build_schema()
         self._faces = FaceLog(world, self.agents,
                               max(0, math.ceil(face_hold_s / self._dt - 1e-9)))
         n_touch = len(self._skin.agents) if self._skin is not None else 0
@@ -303,6 +306,7 @@ class Recorder:
                 fields.append(component_field(f"{p}:scalars", p, s_desc, SCALARS))
         if self._skin is not None:
             fields += self._skin.fields()
+        fields += self._plots.fields()
         for p in self._scalar_paths:
             fields.append(component_field(f"{p}:scalars", p, s_desc, SCALARS))
         return pa.schema(fields)
@@ -311,6 +315,7 @@ class Recorder:
         self._rec.log("/world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         if self._skin is not None:
             self._skin.log_static(self._rec)
+        self._plots.log_static(self._rec, self._skin.agents if self._skin is not None else ())
         self._head_paths = log_shapes(self._rec, self.world, self._bodies, self._textured_heads)
 
     def blueprint(self) -> rrb.Blueprint:
@@ -321,7 +326,7 @@ class Recorder:
                           self._eyes.paths if self._eyes is not None else None,
                           self._skin.agents if self._skin is not None else (),
                           bool(self._scalar_paths), self._contacts is not None,
-                          scene_eye(self.env))
+                          scene_eye(self.env), self._plots.views)
 
     # -- logging ----------------------------------------------------------------------------------
     def log_reset(self, observations: Mapping[str, Any] | None = None) -> None:
@@ -446,6 +451,7 @@ class Recorder:
                 rows.motors[i][n] = np.nan
         if self._skin is not None:
             self._skin.note(rows, n, self._xmat)
+        self._plots.note(n, self._episode_steps > 0)
         for k, fn in enumerate(self._scalar_fns):
             try:
                 rows.scalars[n, k] = fn(self._user_env)
@@ -513,6 +519,7 @@ class Recorder:
                         optional_scalars(norm, ~np.isnan(norm))]
         if self._skin is not None:
             columns += self._skin.columns(rows)
+        columns += self._plots.columns(n)
         for k in range(len(self._scalar_fns)):
             value = rows.scalars[:n, k].copy()
             columns.append(optional_scalars(value, ~np.isnan(value)))

@@ -551,7 +551,7 @@ def test_blueprint_puts_each_agents_eyes_side_by_side(vision_env, tmp_path):
         assert len(eyes) == 1, f"no Horizontal with {agent}'s left and right eye side by side"
     views = {n.name: n for n in nodes if isinstance(n, (rrb.Spatial3DView, rrb.TimeSeriesView))}
     assert views["world"].origin == "/world"
-    assert isinstance(views["rewards"], rrb.TimeSeriesView)
+    assert isinstance(views["reward"], rrb.TimeSeriesView)
 
 
 def test_blueprint_without_vision_has_no_eyes_but_touch_totals(tmp_path):
@@ -560,7 +560,7 @@ def test_blueprint_without_vision_has_no_eyes_but_touch_totals(tmp_path):
         nodes = list(blueprint_nodes(rec.blueprint().root_container))
     assert not [n for n in nodes if "eyes" in str(getattr(n, "origin", ""))]
     names = {n.name for n in nodes if isinstance(n, rrb.TimeSeriesView)}
-    assert {"rewards", "touch totals (N)", "action norms"} <= names
+    assert {"touch totals (N)", "action norms"} <= names
     assert any(isinstance(n, rrb.TextLogView) and n.origin == "/events/contacts" for n in nodes)
 
 

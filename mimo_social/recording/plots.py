@@ -1,0 +1,155 @@
+"""The task's plots in a recording: the time series each task chooses (:meth:`Task.plots`).
+
+Each :class:`~mimo_social.core.task.Plot` becomes one series per agent (``/plots/<name>/<agent>``)
+or one series (``/plots/<name>``); the reward plot is the recorder's own per-agent reward
+(``/agents/<agent>/reward``). At every recorded row after an env step the plots' functions
+write their values into one preallocated buffer row (at reset: no value); at flush the columns
+go out in the recorder's Arrow batch, like every other scalar. Every per-agent series (the
+plots', rewards, action norms, touch totals) is styled once, statically, with the agent's name
+and its clothes colour, so that the lines match the bodies in the 3D view.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pyarrow as pa
+import rerun as rr
+
+from ..core.task import REWARD, Plot
+from ..core.world import CLOTHES_PALETTE
+from .columns import SCALARS, component_field, entity, optional_scalars
+
+__all__ = ["ONE_SERIES_RGB", "PlotLog", "PlotView", "agent_colors"]
+
+#: the colour of a series that is no agent's (one value for the pair, a shared reward)
+ONE_SERIES_RGB = (225, 225, 225)
+_WIDTH = 2.0
+
+
+def agent_colors(world) -> list[tuple[int, int, int]]:
+    """Each agent's clothes colour as 8-bit RGB (its ``clothes_rgba``, else the palette's)."""
+    out = []
+    for i, setup in enumerate(world.agent_setups):
+        rgba = setup.config.clothes_rgba or CLOTHES_PALETTE[i % len(CLOTHES_PALETTE)]
+        out.append(tuple(int(round(255 * float(c))) for c in rgba[:3]))
+    return out
+
+
+@dataclass(frozen=True)
+class PlotView:
+    """One time-series view of the default layout: its title and the series' entity paths."""
+
+    title: str
+    paths: tuple[str, ...]
+
+
+class PlotLog:
+    """The series of an env's task plots, their buffer and their static styles.
+
+    ``env``: the ``MimoParallelEnv`` (its ``task.plots()`` are read once, here; a task without
+    ``plots`` gets the reward); ``agents``: the agent names (by index); ``capacity``: the
+    recorder's rows per flush.
+    """
+
+    def __init__(self, env, agents: list[str], capacity: int):
+        task = getattr(env, "task", None)
+        plots = list(task.plots()) if hasattr(task, "plots") else [Plot.reward()]
+        self.env = env
+        self.agents = list(agents)
+        self.colors = agent_colors(env.world)
+        n = len(self.agents)
+        task_name = getattr(task, "name", type(task).__name__)
+        seen = set()
+        self.plots: list[Plot] = []
+        self.views: list[PlotView] = []
+        self.paths: list[str] = []            # the logged series (all but the reward), in order
+        self._styles: dict[str, tuple[tuple[int, int, int], str]] = {}
+        self._calls = []                      # (fn, per_agent, agent indices or None, first col)
+        for plot in plots:
+            if not isinstance(plot, Plot):
+                raise TypeError(f"{task_name}.plots(): {plot!r}; allowed: Plot instances")
+            if plot.name in seen:
+                raise ValueError(f"{task_name}.plots(): the name {plot.name!r} twice; "
+                                 "allowed: one plot per name")
+            seen.add(plot.name)
+            who = list(plot.agents) if plot.agents is not None else list(range(n))
+            bad = [i for i in who if i >= n]
+            if bad:
+                raise ValueError(f"{task_name}.plots(): plot {plot.name!r} agents={plot.agents}; "
+                                 f"allowed: indices below {n} (the env's agents)")
+            self.plots.append(plot)
+            if plot.fn is None:               # the reward: the recorder logs it per agent
+                paths = [entity("agents", a, REWARD) for a in self.agents]
+                if plot.per_agent:
+                    for i in who:
+                        self._styles[paths[i]] = (self.colors[i], self.agents[i])
+                    paths = [paths[i] for i in who]
+                else:
+                    paths = paths[:1]
+                    self._styles[paths[0]] = (ONE_SERIES_RGB, "reward (shared)")
+                self.views.append(PlotView(plot.title, tuple(paths)))
+                continue
+            first = len(self.paths)
+            if plot.per_agent:
+                paths = [entity("plots", plot.name, self.agents[i]) for i in who]
+                for i, p in zip(who, paths):
+                    self._styles[p] = (self.colors[i], self.agents[i])
+                index = None if who == list(range(n)) else np.array(who, dtype=np.intp)
+            else:
+                paths = [entity("plots", plot.name)]
+                self._styles[paths[0]] = (ONE_SERIES_RGB, plot.name)
+                index = None
+            self.paths += paths
+            self._calls.append((plot, index, first, first + len(paths)))
+            self.views.append(PlotView(plot.title, tuple(paths)))
+        self.values = np.full((max(1, int(capacity)), len(self.paths)), np.nan)
+
+    # -- set-up ---------------------------------------------------------------------------------
+    def fields(self) -> list[pa.Field]:
+        """One Scalars field per logged series."""
+        desc = rr.Scalars.descriptor_scalars()
+        return [component_field(f"{p}:scalars", p, desc, SCALARS) for p in self.paths]
+
+    def log_static(self, rec: rr.RecordingStream, touch_agents=()) -> None:
+        """Every series' name and colour (the agent's clothes colour): the task's plots, and the
+        recorder's per-agent rewards, action norms and (``touch_agents``) touch totals."""
+        styles = dict(self._styles)
+        for i, a in enumerate(self.agents):
+            styles.setdefault(entity("agents", a, REWARD), (self.colors[i], a))
+            styles[entity("agents", a, "action_norm")] = (self.colors[i], a)
+        for i in touch_agents:
+            styles[entity("agents", self.agents[i], "touch_total")] = (self.colors[i],
+                                                                      self.agents[i])
+        for path, (rgb, name) in styles.items():
+            rec.log(path, rr.SeriesLines(colors=[rgb], names=[name], widths=[_WIDTH]),
+                    static=True)
+
+    # -- per row --------------------------------------------------------------------------------
+    def note(self, n: int, stepped: bool = True) -> None:
+        """Row ``n``: every plot's value(s) now (``stepped``: after an env step; at reset the
+        row holds no values)."""
+        row = self.values[n]
+        if not stepped:
+            row.fill(np.nan)
+            return
+        env = self.env
+        for plot, index, a, b in self._calls:
+            try:
+                value = plot.fn(env)
+                if plot.per_agent:
+                    row[a:b] = value if index is None else np.asarray(value, float)[index]
+                else:
+                    row[a] = value
+            except Exception as e:
+                raise RuntimeError(f"{getattr(env.task, 'name', 'task')} plot {plot.name!r}: "
+                                   f"{plot.fn!r} failed: {type(e).__name__}: {e}") from e
+
+    def columns(self, n: int) -> list[pa.Array]:
+        """The Scalars columns of the first ``n`` rows (no data where NaN)."""
+        out = []
+        for k in range(len(self.paths)):
+            value = self.values[:n, k].copy()          # fresh memory: Arrow wraps it
+            out.append(optional_scalars(value, ~np.isnan(value)))
+        return out
