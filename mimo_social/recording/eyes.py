@@ -2,18 +2,36 @@
 
 Images are taken from the observations given to the recorder when they hold them, else from
 the env's vision system, and stored as PNG (lossless), JPEG (lossy, needs Pillow) or raw pixels.
+
+Cost: the stepping thread only copies the pixels (a few microseconds an image) and hands them
+to one worker thread (:class:`EyeEncoder`), which encodes them meanwhile (zlib and numpy let go
+of Python's lock while they work, so the worker runs beside the simulation). Each frame keeps
+the time and step it was taken at: the batch of an interval is built with explicit ``sim_time``
+and ``step`` columns (Rerun's own time context is per thread and never used here). A flush waits
+for the frames of its interval (by then long encoded, save the last one or two), so a file holds
+every logged frame up to :attr:`~mimo_social.recording.Recorder.flushed_step`; ``close`` flushes
+the worker and ends its thread.
+
+Rate: by default eye images are logged at :data:`EYE_LOG_HZ` (25 per simulated second, every
+4th step at the default 100 Hz control): a replay is watched at about video rate, and encoding
+every frame of two agents' four 64x64 eyes at 100 Hz would cost about a fifth of a step's CPU
+time (``mimo-social bench-recording --eyes``). ``Recorder(eye_every_k_steps=1)`` logs every
+rendered frame.
 """
 
 from __future__ import annotations
 
 import io
+import math
 from collections.abc import Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 import pyarrow as pa
 import rerun as rr
 
 from ..render.png import encode_png
+from ..util.checks import check_int
 from .columns import (
     BLOBS,
     TEXTS,
@@ -25,10 +43,22 @@ from .columns import (
     sparse_column,
 )
 
-__all__ = ["EYES", "EYE_FORMATS", "EyeLog"]
+__all__ = ["EYES", "EYE_FORMATS", "EYE_LOG_HZ", "EyeEncoder", "EyeLog", "eye_every_k_steps"]
 
 EYE_FORMATS = ("png", "jpeg", "raw")   # how eye images are stored (see Recorder)
 EYES = ("left", "right")
+#: default rate (frames per simulated second) of eye images in a recording (see the docstring)
+EYE_LOG_HZ = 25.0
+
+
+def eye_every_k_steps(dt: float, every_k_steps: int, value: int | None = None) -> int:
+    """Every how many env steps eye images are logged: ``value`` when given (checked), else
+    the smallest multiple of ``every_k_steps`` that is at least ``1 / EYE_LOG_HZ`` seconds of
+    steps of ``dt`` seconds (4 at 100 Hz)."""
+    if value is not None:
+        return check_int("Recorder", "eye_every_k_steps", value, lo=1)
+    k = max(1, math.ceil(1.0 / (EYE_LOG_HZ * dt) - 1e-9))
+    return every_k_steps * math.ceil(k / every_k_steps)
 
 
 def _encode_jpeg(image: np.ndarray, quality: int) -> bytes:
@@ -37,6 +67,40 @@ def _encode_jpeg(image: np.ndarray, quality: int) -> bytes:
     out = io.BytesIO()
     PILImage.fromarray(np.ascontiguousarray(image)).save(out, format="JPEG", quality=quality)
     return out.getvalue()
+
+
+class EyeEncoder:
+    """One worker thread that encodes eye frames, off the stepping thread.
+
+    :meth:`submit` takes a list of (t, step, agent, left, right) frames with pixel arrays and
+    returns a Future of the same list with ``encode(image)`` in place of the pixels.
+    """
+
+    def __init__(self, encode):
+        self._encode = encode
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="mimo-eye-encoder")
+
+    def _run(self, frames: list) -> list:
+        enc = self._encode
+        return [(t, step, i, enc(left), enc(right)) for t, step, i, left, right in frames]
+
+    def submit(self, frames: list) -> Future:
+        return self._pool.submit(self._run, frames)
+
+    @staticmethod
+    def resolve(items: list) -> list:
+        """``items`` with every Future replaced by the frames it gives (waiting for them; an
+        error in the worker is raised here)."""
+        out = []
+        for x in items:
+            if isinstance(x, Future):
+                out += x.result()
+            else:
+                out.append(x)
+        return out
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True)
 
 
 class EyeLog:
@@ -68,6 +132,7 @@ class EyeLog:
                 raise ImportError("eye_format='jpeg' needs Pillow (pip install pillow); "
                                   "'png' needs nothing") from None
         self._renders: dict[int, int] = {}
+        self._encoder: EyeEncoder | None = None      # started at the first frame to encode
         self._build_schema()
 
     def _build_schema(self) -> None:
@@ -99,10 +164,12 @@ class EyeLog:
         self._renders = {}
 
     def note(self, out: list, t: float, step: int, observations) -> int:
-        """Append to ``out`` the encoded eye images, as (t, step, agent, left, right), of every
-        agent with vision rendered anew since the last time; return how many pairs."""
+        """Append to ``out`` the eye images, as (t, step, agent, left, right), of every agent
+        with vision rendered anew since the last time (PNG / JPEG: one :class:`~concurrent.
+        futures.Future` of those tuples per call, encoded on the worker thread); return how
+        many pairs."""
         renders = getattr(self.vision, "renders", None)
-        count = 0
+        frames = []
         for i in self.agents:
             if renders is not None:
                 if self._renders.get(i) == renders[i]:
@@ -114,9 +181,23 @@ class EyeLog:
             else:
                 images = self.vision.images[i]
                 left, right = images["eye_left"], images["eye_right"]
-            out.append((t, step, i, self.encode(left), self.encode(right)))
-            count += 1
-        return count
+            # copies: the worker reads them later, and the caller may write into its arrays
+            frames.append((t, step, i, np.array(left, np.uint8), np.array(right, np.uint8)))
+        if not frames:
+            return 0
+        if self.format == "raw":
+            out += [(t, s, i, left.tobytes(), right.tobytes()) for t, s, i, left, right in frames]
+        else:
+            if self._encoder is None:
+                self._encoder = EyeEncoder(self.encode)
+            out.append(self._encoder.submit(frames))
+        return len(frames)
+
+    def close(self) -> None:
+        """Wait for the frames being encoded and end the worker thread (idempotent)."""
+        if self._encoder is not None:
+            self._encoder.close()
+            self._encoder = None
 
     def encode(self, image: np.ndarray):
         """One image in this log's format (PNG / JPEG bytes, or the raw pixel bytes)."""
@@ -128,7 +209,8 @@ class EyeLog:
 
     def batch(self, eyes) -> pa.RecordBatch:
         """Eye images as one record batch: a row per step with images, per agent and eye its
-        image where rendered, no data elsewhere."""
+        image where rendered, no data elsewhere (waits for the frames still being encoded)."""
+        eyes = EyeEncoder.resolve(eyes)
         steps = sorted({step: t for t, step, _, _, _ in eyes}.items())
         row_of = {step: r for r, (step, _) in enumerate(steps)}
         cells = {(i, e): [None] * len(steps) for i in self.agents for e in range(2)}

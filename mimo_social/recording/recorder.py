@@ -112,6 +112,7 @@ from .columns import (
 )
 from .contacts import ContactLog
 from .eyes import EYE_FORMATS, EyeLog
+from .eyes import eye_every_k_steps as eye_every
 from .faces import FaceLog
 from .geometry import WXYZ_TO_XYZW, log_shapes, visible_bodies
 from .plots import PlotLog
@@ -183,7 +184,8 @@ class Recorder:
         ``"png"`` (default: lossless, ~2 KB a 64x64 image), ``"jpeg"`` (needs Pillow; smaller,
         lossy, ``eye_jpeg_quality``) or ``"raw"`` (uncompressed ``Image``; 12 KB a 64x64 image).
     eye_every_k_steps:
-        Log eye images every k-th env step of an episode (default: ``every_k_steps``).
+        Log eye images every k-th env step of an episode (default: 25 a simulated second, every
+        4th step at 100 Hz, see :mod:`.eyes`; 1: every rendered frame).
     skin:
         Log the skin points that feel a force (agents with touch) and each agent's touch total.
     contacts:
@@ -210,9 +212,7 @@ class Recorder:
         every_k_steps = check_int("Recorder", "every_k_steps", every_k_steps, lo=1)
         if not flush_every_s > 0:
             raise ValueError(f"flush_every_s={flush_every_s!r}; allowed: a positive number")
-        if eye_every_k_steps is None:
-            eye_every_k_steps = every_k_steps
-        eye_every_k_steps = check_int("Recorder", "eye_every_k_steps", eye_every_k_steps, lo=1)
+        eye_every_k_steps = eye_every(float(penv.dt), every_k_steps, eye_every_k_steps)
         check_choice("Recorder", "eye_format", eye_format, EYE_FORMATS)
         scalars = dict(scalars or {})
         for name, fn in scalars.items():
@@ -554,12 +554,14 @@ class Recorder:
         t0 = time.perf_counter()
         try:
             self._faces.commit(self._rows, self._global_step, everything=True)
-            self._flush()
+            self._flush()                      # (waits for the eye frames still being encoded)
             self._rec = None                   # the stream's last reference is the FileStream's
             self._stream.close()
             self.flushed_rows, self.flushed_step = self._sent_rows, self._sent_step
         finally:
             self._rec = None
+            if self._eyes is not None:         # ends the eye encoder's thread
+                self._eyes.close()
             if self._stream.rec is not None:   # an error before the stream was finished
                 self._stream.close()
             self._detach()

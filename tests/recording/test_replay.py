@@ -445,7 +445,7 @@ def test_eye_images_of_every_agent_at_every_step_lossless(vision_env, tmp_path):
     obs, _ = env.reset(seed=0)
     seen = [obs]
     rng = np.random.default_rng(0)
-    with Recorder(env, path) as rec:
+    with Recorder(env, path, eye_every_k_steps=1) as rec:     # every frame (default: 25 Hz)
         rec.log_reset(obs)
         for _ in range(8):
             actions = {a: {"motors": rng.uniform(-1, 1, 44).astype(np.float32), "expression": 0}
@@ -514,7 +514,7 @@ def test_eye_images_as_jpeg_or_left_out(vision_env, tmp_path):
             pytest.importorskip("PIL", reason="eye_format='jpeg' needs Pillow")
         path = tmp_path / f"{len(options)}{list(options.values())[0]}.rrd"
         obs, _ = env.reset(seed=0)
-        with Recorder(env, path, **options) as rec:
+        with Recorder(env, path, eye_every_k_steps=1, **options) as rec:
             rec.log_reset(obs)
             for _ in range(2):
                 obs, *_ = env.step(zero)
