@@ -34,7 +34,7 @@ from gymnasium import spaces
 from ..body.joint_groups import GAZE_JOINTS, RIGHT_WRIST, held_posture
 from ..body.tables import load_body, subtree
 from ..core.kinematics import Gaze, hand_geoms
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from ..partners.controllers.catch import torque_controls
 from .common import geoms_touching, parts_outside, settle
@@ -249,6 +249,16 @@ class Catch(Task):
         cost = env.actuation[0].weighted_cost(env.controls[0])
         touch = o.contact_reward if self._n_touch else 0.0
         return np.array([touch - o.cost_weight * cost])
+
+    def plots(self):
+        """Reward, the ball's height above the palm, the body parts touching it and success
+        (held long enough)."""
+        def above(env):
+            d = env.world.data
+            return (d.xpos[self._ball_body, 2] - d.site_xpos[self._palm, 2],)
+        return [Plot.reward(), Plot("ball_above_palm", "m", above),
+                Plot("parts_touching", "parts", lambda env: (self._n_touch,)),
+                Plot("success", "0/1", lambda env: (self._success,))]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

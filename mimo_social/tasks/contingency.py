@@ -35,7 +35,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 
 from ..body.joint_groups import held_posture
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup
 from ..expressions.faces import EXPRESSIONS
 from ..partners.base import Partner
@@ -238,6 +238,15 @@ class Contingency(Task):
         self.measures.update(learner, caregiver, gaze0, bool(self._shared[0]))
         self._state = (learner, caregiver, gaze0, bool(self._shared[0]))
         return self._weights * self._shared
+
+    def plots(self):
+        """Reward, each agent smiling (learner, caregiver), the shared smiles (what is
+        rewarded) and the shared steps as a share of those success needs."""
+        return [Plot.reward(),
+                Plot("smiling", "0/1", lambda env: self._state[:2]),
+                Plot("shared_smile", "0/1", lambda env: self._shared),
+                Plot("shared_share", "of success",
+                     lambda env: self.measures.shared_steps / self._need, per_agent=False)]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

@@ -22,7 +22,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..core.task import Task, TaskOptions
+import numpy as np
+
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import Prop
 
 
@@ -49,3 +51,26 @@ class FreePlay(Task):
         return [Prop("ball", "sphere", (0.04,), (0.08, 0.12, 0.04), 0.1, (0.9, 0.25, 0.2, 1)),
                 Prop("cube", "box", (0.03, 0.03, 0.03), (-0.08, -0.12, 0.03), 0.1,
                      (0.2, 0.5, 0.9, 1))]
+
+    def plots(self):
+        """No reward (it is 0): each infant's head height (standing, sitting or fallen) and its
+        distance to the nearest other infant (hips, on the floor plane)."""
+        out = [Plot("head_height", "m", self._head_height)]
+        if self.n_agents > 1:
+            out.append(Plot("nearest_infant", "m", self._nearest))
+        return out
+
+    def _head_height(self, env):
+        w = env.world
+        if getattr(self, "_heads", None) is None or self._plot_world is not w:
+            self._plot_world = w
+            self._heads = np.array([a.head_site for a in w.agents], np.intp)
+            self._roots = np.array([a.root_body for a in w.agents], np.intp)
+        return w.data.site_xpos[self._heads, 2]
+
+    def _nearest(self, env):
+        self._head_height(env)
+        xy = env.world.data.xpos[self._roots, :2]
+        gap = np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)
+        np.fill_diagonal(gap, np.inf)
+        return gap.min(axis=1)

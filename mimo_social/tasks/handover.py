@@ -36,7 +36,7 @@ import numpy as np
 from ..body.joint_groups import GAZE_JOINTS, held_posture, right_arm_joints
 from ..body.tables import load_body
 from ..core.kinematics import Gaze, hand_geoms
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from ..partners.hand_offer import (OPEN_FINGERS_DEG, HandOffer, adapts, offer_posture,
                                    reach_target)
@@ -362,6 +362,16 @@ class Handover(Task):
         if self._dropped:
             r += o.failure_reward
         return np.array([r, r])
+
+    def plots(self):
+        """The shared reward (one line), the ball's distance to the receiver's palm, who holds
+        the ball (-1 giver, 0 nobody, 1 receiver) and success."""
+        holder = {"giver": -1.0, "none": 0.0, "receiver": 1.0}
+        return [Plot.reward(shared=True),
+                Plot("ball_to_hand", "m", lambda env: self._distance, per_agent=False),
+                Plot("holder", "-1 giver, 0 none, 1 receiver",
+                     lambda env: holder[self._holder], per_agent=False),
+                Plot("success", "0/1", lambda env: self._success, per_agent=False)]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

@@ -35,7 +35,7 @@ import numpy as np
 from ..body.joint_groups import GAZE_JOINTS, held_posture, right_arm_joints
 from ..body.tables import HAND_VERSIONS, load_body
 from ..core.kinematics import Gaze, hand_geoms
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup
 from ..util.checks import ConfigError
 from .common import (
@@ -208,6 +208,14 @@ class HighFive(Task):
             + (self.options.touch_bonus if self._touching else 0.0)
         self._distance = dist
         return np.array([r, r])
+
+    def plots(self):
+        """The shared reward (one line), the distance between the right palms, success (both
+        right hands feel the partner's) and whether each right hand feels the partner."""
+        return [Plot.reward(shared=True),
+                Plot("hand_distance", "m", lambda env: self._distance, per_agent=False),
+                Plot("success", "0/1", lambda env: self._touching, per_agent=False),
+                Plot("hand_feels_partner", "0/1", lambda env: self._felt)]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

@@ -36,7 +36,7 @@ from gymnasium import spaces
 
 from ..body.joint_groups import both_arms_joints, held_posture
 from ..core.kinematics import hand_geoms
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from ..util.checks import ConfigError
 from .common import ContactProbe, face_to_face
@@ -347,6 +347,16 @@ class Imitation(Task):
         if self.options.reward_free:
             return np.zeros(2)
         return r * self._weights
+
+    def plots(self):
+        """Reward, the learner's turn (0: the demonstration), its response (the action's index,
+        -1 none yet) and success (learner: the demonstrated action; demonstrator: its
+        demonstration)."""
+        return [Plot.reward(),
+                Plot("turn", "0/1", lambda env: self.turn, per_agent=False),
+                Plot("response", "action, -1 none", lambda env: self.response,
+                     per_agent=False),
+                Plot("success", "0/1", lambda env: (self.success, self.demo_done))]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

@@ -35,7 +35,7 @@ from gymnasium import spaces
 
 from ..body.joint_groups import GAZE_JOINTS, held_posture
 from ..body.postures import posture_joints
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from .common import face_to_face
 from .dyad import held_angles, tables_of, task_plan
@@ -285,6 +285,19 @@ class JointAttention(Task):
         err = angle[np.arange(2), np.maximum(targets, 0)]
         r = on.astype(float) - self.options.shaping * np.where(has, err, 0.0)
         return self._weights * r
+
+    def plots(self):
+        """Reward, each agent's gaze error to its target toy (none while it has no target), on
+        target, and the toy each looks at (-1: none)."""
+        def error(env):
+            t = self._targets
+            if self._angle is None:
+                return (float("nan"),) * 2
+            err = np.rad2deg(self._angle[np.arange(2), np.maximum(t, 0)])
+            return np.where(t >= 0, err, np.nan)
+        return [Plot.reward(), Plot("gaze_error", "deg", error),
+                Plot("on_target", "0/1", lambda env: self._shared),
+                Plot("looked_at", "toy, -1 none", lambda env: self._looked)]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

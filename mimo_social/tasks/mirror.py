@@ -34,7 +34,7 @@ import numpy as np
 
 from ..body.joint_groups import GAZE_JOINTS, held_posture
 from ..core.kinematics import Gaze
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup
 from ..expressions.faces import EXPRESSIONS
 from .common import face_to_face
@@ -158,6 +158,14 @@ class Mirror(Task):
         self._match = w.expression_of(0) == w.expression_of(1)
         self._matched += int(self._match)
         return self._weights * float(self._match)
+
+    def plots(self):
+        """Reward, matched expression (the two faces the same) and the matched steps as a share
+        of those success needs."""
+        return [Plot.reward(),
+                Plot("match", "0/1", lambda env: self._match, per_agent=False),
+                Plot("matched_share", "of success", lambda env: self._matched / self._need,
+                     per_agent=False)]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

@@ -30,7 +30,7 @@ import numpy as np
 from ..body.joint_groups import GAZE_JOINTS, held_posture, right_arm_joints
 from ..body.tables import load_body
 from ..core.kinematics import Gaze, hand_geoms, reach_sites
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from .common import ContactProbe
 
@@ -166,6 +166,12 @@ class Reach(Task):
         self._touched = self._touch_ball(d)
         self._dist = float(np.linalg.norm(d.site_xpos[self._tip] - d.xpos[self._ball_body]))
         return np.array([self.options.success_reward if self._touched else -self._dist])
+
+    def plots(self):
+        """Reward, the fingertip's distance to the ball and success (the ball touched)."""
+        return [Plot.reward(),
+                Plot("distance", "m", lambda env: (self._dist,)),
+                Plot("success", "0/1", lambda env: (self._touched,))]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

@@ -33,7 +33,7 @@ from gymnasium import spaces
 from ..body.joint_groups import held_posture, right_arm_joints
 from ..body.tables import load_body, subtree
 from ..core.kinematics import hand_geoms, reach_sites
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup
 from .common import CROSS_LEGGED_DEG
 
@@ -199,6 +199,15 @@ class SelfBody(Task):
             return np.array([-(self.options.other_touch_cost + self._distance)])
         self._distance = None
         return np.array([self.options.miss_reward])
+
+    def plots(self):
+        """Reward, the touch's distance to the target primitive (none without a touch) and
+        success."""
+        nan = float("nan")
+        return [Plot.reward(),
+                Plot("distance", "m",
+                     lambda env: (nan if self._distance is None else self._distance,)),
+                Plot("success", "0/1", lambda env: (self._success,))]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

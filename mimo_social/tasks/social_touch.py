@@ -47,7 +47,7 @@ from ..body.joint_groups import (
 )
 from ..body.tables import load_body, subtree
 from ..core.kinematics import Gaze, hand_geoms
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup
 from .dyad import held_angles, tables_of, task_plan
 from ..util.checks import ConfigError
@@ -372,6 +372,14 @@ class SocialTouch(Task):
                     # current distance, is charged now
                     r -= self._distance * max(env.max_steps - env.steps, 0)
         return np.array([r, r])
+
+    def plots(self):
+        """The shared reward (one line), the toucher's fingertip distance to the target part,
+        the target felt, and success."""
+        return [Plot.reward(shared=True),
+                Plot("fingertip_distance", "m", lambda env: self._distance, per_agent=False),
+                Plot("target_felt", "0/1", lambda env: self._felt, per_agent=False),
+                Plot("success", "0/1", lambda env: self._success, per_agent=False)]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

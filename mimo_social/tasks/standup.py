@@ -51,7 +51,7 @@ import numpy as np
 from ..body.joint_groups import held_posture
 from ..body.tables import load_body
 from ..core.kinematics import reach_sites
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from .common import settle
 
@@ -240,6 +240,13 @@ class Standup(Task):
         u = env.controls[0]
         self._cost = self.options.cost_weight * float(np.dot(u, u))
         return np.array([self._height - self._ref - self._cost])
+
+    def plots(self):
+        """Reward, the head's height, its gain over the start and success (held above)."""
+        return [Plot.reward(),
+                Plot("head_height", "m", lambda env: (self._height,)),
+                Plot("head_gain", "m", lambda env: (self._height - self._start_height,)),
+                Plot("success", "0/1", lambda env: (self._above >= self._hold_steps,))]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..body.joint_groups import GAZE_JOINTS, held_posture
 from ..body.postures import posture_joints
-from ..core.task import Task, TaskOptions
+from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup
 from ..expressions.faces import EXPRESSIONS
 from ..partners.cues import learner_cues
@@ -271,6 +271,17 @@ class StillFace(Task):
         if self.options.reward_free:
             return np.zeros(2)
         return self._weights * float(engaged)
+
+    def plots(self):
+        """Reward, the phase (0 interaction, 1 still face, 2 reunion), the learner's smile and
+        gaze on the caregiver's face, and engagement (what is rewarded)."""
+        nan = float("nan")
+        return [Plot.reward(),
+                Plot("phase", "0 play, 1 still, 2 reunion", lambda env: self.phase,
+                     per_agent=False),
+                Plot("smiling", "0/1", lambda env: (self._now[0], nan), agents=(0,)),
+                Plot("gaze_on_face", "0/1", lambda env: (self._now[1], nan), agents=(0,)),
+                Plot("engaged", "0/1", lambda env: self._now[3], per_agent=False)]
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
