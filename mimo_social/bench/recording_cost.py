@@ -8,6 +8,7 @@ to BENCHMARKS.md and the recorder's docstring.
 from __future__ import annotations
 
 import os
+import statistics
 import tempfile
 import time
 from collections.abc import Mapping
@@ -17,7 +18,8 @@ from ..core.random_actions import smooth_random_actions
 from ..envs import free_play_v0
 from ..recording import Recorder
 
-__all__ = ["BENCH_CONFIGS", "bench_recording", "format_table"]
+__all__ = ["BENCH_CONFIGS", "EYE_COST_CONFIG", "EYE_COST_VARIANTS", "bench_eye_cost",
+           "bench_recording", "format_eye_table", "format_table"]
 
 #: the configurations of :func:`bench_recording`: env keyword arguments of ``free_play_v0``
 BENCH_CONFIGS = {
@@ -128,4 +130,110 @@ def format_table(results: list[dict]) -> str:
     lines += [f"| {r['config']} | {r['ms_per_step']:.3f} | {r['ms_per_step_recorded']:.3f} | "
               f"{r['cpu_pct']:.1f} % | {r['main_cpu_pct']:.1f} % | {r['wall_pct']:.1f} % | "
               f"{r['mb_per_sim_minute']:.1f} |" for r in results]
+    return "\n".join(lines)
+
+
+#: the env of :func:`bench_eye_cost`: 2 infants with touch and 2 x 64x64 eyes each (free play)
+EYE_COST_CONFIG = {"n_agents": 2, "touch": True, "vision": {"width": 64, "height": 64}}
+#: the runs of :func:`bench_eye_cost`: name -> Recorder keyword arguments (None: not recorded)
+EYE_COST_VARIANTS = {
+    "plain step": None,
+    "recorded, no eyes": {"eyes": False},
+    "recorded, eyes (default: 25 Hz)": {},
+    "recorded, eyes every frame (100 Hz)": {"eye_every_k_steps": 1},
+}
+
+
+def bench_eye_cost(sim_seconds: float = 40.0, rounds: int | None = None, seed: int = 0,
+                   variants: Mapping[str, dict | None] | None = None,
+                   config: Mapping | None = None, folder: str | Path | None = None,
+                   flush_every_s: float = 4.0) -> list[dict]:
+    """Side by side in one run: the plain step and the same env recorded without and with eyes
+    (default :data:`EYE_COST_VARIANTS`, env :data:`EYE_COST_CONFIG`).
+
+    One env per variant, all taking the same smooth random actions; they take turns in blocks
+    of one flush interval (``flush_every_s`` simulated seconds, so that every block holds one
+    flush), the order rotating each round; ``rounds`` blocks each (default: ``sim_seconds``
+    split into blocks). Per variant: the medians over the rounds of the wall-clock and the
+    stepping thread's CPU ms per step, and of the cost against the plain step in the same round
+    (``main_cpu_pct``: stepping thread's CPU time, which a busy machine hardly changes;
+    ``wall_pct``); the eye encoder's CPU ms per step (its worker thread) and its share of the
+    plain step (``encoder_pct``); the eye frames logged. Rerun's own threads are not counted.
+    """
+    variants = EYE_COST_VARIANTS if variants is None else variants
+    names = list(variants)
+    config = dict(EYE_COST_CONFIG if config is None else config)
+    folder = Path(folder) if folder is not None else Path(tempfile.mkdtemp(prefix="mimo_rec_"))
+    envs = [free_play_v0.parallel_env(max_steps=10 ** 9, **config) for _ in names]
+    dt = envs[0].dt
+    block = max(1, round(flush_every_s / dt))
+    rounds = rounds if rounds is not None else max(1, round(sim_seconds / (block * dt)))
+    n_steps = block * rounds
+    agents = envs[0].possible_agents
+    acts = [smooth_random_actions(n_steps, envs[0].action_space(a)["motors"].shape[0], seed + i)
+            for i, a in enumerate(agents)]
+    recs, wall, cpu = [], [[] for _ in names], [[] for _ in names]
+    try:
+        for k, (env, options) in enumerate(zip(envs, variants.values())):
+            obs = env.reset(seed=seed)[0]
+            rec = None
+            if options is not None:
+                rec = Recorder(env, folder / f"eyes_{k}.rrd", flush_every_s=flush_every_s,
+                               **options)
+                rec.log_reset(obs)
+            recs.append(rec)
+        for r in range(rounds):
+            steps = range(r * block, (r + 1) * block)
+            for k in [(r + j) % len(names) for j in range(len(names))]:
+                env, rec = envs[k], recs[k]
+                t0, c0 = time.perf_counter(), time.thread_time()
+                for s in steps:
+                    actions = {a: {"motors": acts[i][0][s], "expression": int(acts[i][1][s])}
+                               for i, a in enumerate(agents)}
+                    o, rewards, _, _, _ = env.step(actions)
+                    if rec is not None:
+                        rec.log_step(actions, rewards, o)
+                wall[k].append(1e3 * (time.perf_counter() - t0) / block)
+                cpu[k].append(1e3 * (time.thread_time() - c0) / block)
+        for rec in recs:
+            if rec is not None:
+                rec.close()
+    finally:
+        for rec in recs:
+            if rec is not None:
+                rec.close()
+        for env in envs:
+            env.close()
+    base = next(k for k, o in enumerate(variants.values()) if o is None)
+    med = statistics.median
+    out = []
+    for k, name in enumerate(names):
+        rec = recs[k]
+        eyes = getattr(rec, "_eyes", None)
+        enc_ms = 1e3 * eyes.encode_cpu_s / n_steps if eyes is not None else 0.0
+        out.append({
+            "variant": name, "steps": n_steps, "rounds": rounds, "sim_s": n_steps * dt,
+            "ms_per_step": med(wall[k]), "cpu_ms_per_step": med(cpu[k]),
+            "main_cpu_pct": 100.0 * med([c / b - 1.0 for c, b in zip(cpu[k], cpu[base])]),
+            "wall_pct": 100.0 * med([w / b - 1.0 for w, b in zip(wall[k], wall[base])]),
+            "encoder_ms_per_step": enc_ms,
+            "encoder_pct": 100.0 * enc_ms / med(cpu[base]),
+            "eye_frames": rec.eye_frames if rec is not None else 0,
+            "path": str(rec.path) if rec is not None else None})
+    return out
+
+
+def format_eye_table(results: list[dict]) -> str:
+    """The results of :func:`bench_eye_cost` as a Markdown table."""
+    lines = ["| run | ms/step (wall) | ms/step (stepping thread CPU) | cost: stepping thread CPU "
+             "| cost: wall clock | eye encoder thread (CPU) | eye frame pairs |",
+             "|---|---|---|---|---|---|---|"]
+    for r in results:
+        plain = r["eye_frames"] == 0 and r["main_cpu_pct"] == 0.0
+        cost = "-" if plain else f"{r['main_cpu_pct']:.1f} %"
+        wall = "-" if plain else f"{r['wall_pct']:.1f} %"
+        enc = (f"{r['encoder_ms_per_step']:.3f} ms ({r['encoder_pct']:.1f} %)"
+               if r["encoder_ms_per_step"] else "-")
+        lines.append(f"| {r['variant']} | {r['ms_per_step']:.3f} | {r['cpu_ms_per_step']:.3f} | "
+                     f"{cost} | {wall} | {enc} | {r['eye_frames']} |")
     return "\n".join(lines)

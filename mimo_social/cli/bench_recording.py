@@ -1,6 +1,8 @@
 """``mimo-social bench-recording``: what recording with the Rerun recorder costs (share of the env
 step time) and how big the file grows (MB per simulated minute), for the configurations of
-:data:`mimo_social.bench.recording_cost.BENCH_CONFIGS`."""
+:data:`mimo_social.bench.recording_cost.BENCH_CONFIGS`; ``--eyes``: the plain step, recording
+without eyes and with eyes side by side in one run
+(:func:`mimo_social.bench.recording_cost.bench_eye_cost`)."""
 
 from __future__ import annotations
 
@@ -17,13 +19,20 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "bench-recording", help="recording benchmark: cost per env step and MB per sim. minute",
         description="Cost (share of the env step time) and size (MB per simulated minute) of "
                     "recording with the Recorder, for 2 infants without images, with touch and "
-                    "with 2 x 64x64 eyes each.")
-    parser.add_argument("--sim-seconds", type=positive_float, default=60.0,
-                        help="simulated seconds per configuration (default: 60)")
+                    "with 2 x 64x64 eyes each. --eyes: the plain step beside recording without and "
+                    "with eyes (2 infants, 64x64 eyes, touch on), in turns in one run: eye images "
+                    "are logged at 25 Hz by default (every 4th step; a replay is watched at about "
+                    "video rate) and encoded on a worker thread; Recorder(eye_every_k_steps=1) "
+                    "logs every frame (the last row).")
+    parser.add_argument("--sim-seconds", type=positive_float, default=None,
+                        help="simulated seconds per configuration (default: 60; --eyes: 40)")
     indices = [str(i) for i in range(len(recording_cost.BENCH_CONFIGS))]
     parser.add_argument("--only", default=None, type=comma_choices(indices, "index"),
                         help="comma-separated indices of the configurations to run "
                              f"({', '.join(indices)})")
+    parser.add_argument("--eyes", action="store_true",
+                        help="run the eye-cost comparison instead (default 40 simulated s per "
+                             "run, in blocks of one 4 s flush interval)")
     parser.add_argument("--folder", default=None, type=output_dir,
                         help="where to keep the .rrd files")
     parser.set_defaults(func=run)
@@ -31,10 +40,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.eyes:
+        results = recording_cost.bench_eye_cost(args.sim_seconds or 40.0, folder=args.folder)
+        print(recording_cost.format_eye_table(results))
+        return 0
     configs = dict(recording_cost.BENCH_CONFIGS)
     if args.only:
         keep = {int(x) for x in args.only}
         configs = {k: v for i, (k, v) in enumerate(configs.items()) if i in keep}
-    results = recording_cost.bench_recording(configs, args.sim_seconds, folder=args.folder)
+    results = recording_cost.bench_recording(configs, args.sim_seconds or 60.0,
+                                             folder=args.folder)
     print(recording_cost.format_table(results))
     return 0

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import io
 import math
+import time
 from collections.abc import Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
 
@@ -74,15 +75,19 @@ class EyeEncoder:
 
     :meth:`submit` takes a list of (t, step, agent, left, right) frames with pixel arrays and
     returns a Future of the same list with ``encode(image)`` in place of the pixels.
+    :attr:`cpu_s`: CPU seconds the worker spent encoding (read after a flush or close).
     """
 
     def __init__(self, encode):
         self._encode = encode
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="mimo-eye-encoder")
+        self.cpu_s = 0.0
 
     def _run(self, frames: list) -> list:
-        enc = self._encode
-        return [(t, step, i, enc(left), enc(right)) for t, step, i, left, right in frames]
+        enc, c0 = self._encode, time.thread_time()
+        out = [(t, step, i, enc(left), enc(right)) for t, step, i, left, right in frames]
+        self.cpu_s += time.thread_time() - c0
+        return out
 
     def submit(self, frames: list) -> Future:
         return self._pool.submit(self._run, frames)
@@ -133,6 +138,7 @@ class EyeLog:
                                   "'png' needs nothing") from None
         self._renders: dict[int, int] = {}
         self._encoder: EyeEncoder | None = None      # started at the first frame to encode
+        self._encoded_cpu_s = 0.0
         self._build_schema()
 
     def _build_schema(self) -> None:
@@ -197,7 +203,13 @@ class EyeLog:
         """Wait for the frames being encoded and end the worker thread (idempotent)."""
         if self._encoder is not None:
             self._encoder.close()
+            self._encoded_cpu_s += self._encoder.cpu_s
             self._encoder = None
+
+    @property
+    def encode_cpu_s(self) -> float:
+        """CPU seconds spent encoding images on the worker thread so far."""
+        return self._encoded_cpu_s + (self._encoder.cpu_s if self._encoder is not None else 0.0)
 
     def encode(self, image: np.ndarray):
         """One image in this log's format (PNG / JPEG bytes, or the raw pixel bytes)."""
