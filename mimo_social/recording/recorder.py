@@ -128,11 +128,12 @@ def parallel_of(env):
     if there is none."""
     seen = 0
     while env is not None and seen < 64:
-        if hasattr(env, "world") and hasattr(env, "possible_agents"):
-            return env
         inner = env.__dict__.get("parallel") if hasattr(env, "__dict__") else None
         if inner is None:
             inner = getattr(env, "env", None)
+        # (a wrapper such as ScriptedPartners forwards `world` but lists only its learners)
+        if hasattr(env, "world") and hasattr(env, "possible_agents") and inner is None:
+            return env
         if inner is None and isinstance(env, gym.Env) and env.unwrapped is not env:
             inner = env.unwrapped
         env, seen = inner, seen + 1
@@ -433,6 +434,7 @@ class Recorder:
         """Copy the poses, time, rewards and motor actions (NaN: none) into the next buffer row."""
         rows = self._rows
         n = rows.n
+        self._plots.note(n, self._episode_steps > 0)   # first: a failing plot adds no row
         rows.xpos[n] = self._xpos
         rows.xquat[n] = self._xquat
         self._last_time = self._time_offset + self._data.time
@@ -451,7 +453,6 @@ class Recorder:
                 rows.motors[i][n] = np.nan
         if self._skin is not None:
             self._skin.note(rows, n, self._xmat)
-        self._plots.note(n, self._episode_steps > 0)
         for k, fn in enumerate(self._scalar_fns):
             try:
                 rows.scalars[n, k] = fn(self._user_env)

@@ -117,6 +117,9 @@ class HighFiveOptions(TaskOptions):
         self._bool("shaping")
 
 
+GAP_CAP = 0.1   # m: the hand gap plot's top (the hands' surfaces are not measured farther)
+
+
 class HighFive(Task):
     name = "high_five"
     n_agents_range = (2, 2)
@@ -157,6 +160,7 @@ class HighFive(Task):
         self._gaze = [Gaze(w, i) for i in range(2)] if self.options.assisted_gaze else []
         self._palms = np.array([w.agents[i].palm_sites[0] for i in range(2)], dtype=np.intp)
         hands = [hand_geoms(w, i) for i in range(2)]
+        self._hand_pairs = [(int(a), int(b)) for a in hands[0] for b in hands[1]]
         self._hands_meet = ContactProbe(w.model.ngeom, hands[0], hands[1])
         touch = env.systems.get("touch")
         self._feels = [SkinSource(w, touch, i, hands[i], right_hand_parts(w.tables[i]), 1 - i)
@@ -210,12 +214,22 @@ class HighFive(Task):
         return np.array([r, r])
 
     def plots(self):
-        """The shared reward (one line), the distance between the right palms, success (both
-        right hands feel the partner's) and whether each right hand feels the partner."""
+        """The shared reward (one line), the distance between the right palms' centres (the
+        reward's), the gap between the right hands' surfaces (0: touching), success (both right
+        hands feel the partner's) and whether each right hand feels the partner."""
         return [Plot.reward(shared=True),
                 Plot("hand_distance", "m", lambda env: self._distance, per_agent=False),
+                Plot("hand_gap", f"m, up to {GAP_CAP:g}", self._hand_gap, per_agent=False),
                 Plot("success", "0/1", lambda env: self._touching, per_agent=False),
                 Plot("hand_feels_partner", "0/1", lambda env: self._felt)]
+
+    def _hand_gap(self, env) -> float:
+        """The least distance (m) between the two right hands' geoms (negative: pressed into
+        each other), or GAP_CAP when farther (measured only with the palms within 0.2 m)."""
+        if not self._distance < 0.2:
+            return GAP_CAP
+        m, d = env.world.model, env.world.data
+        return min(mujoco.mj_geomDistance(m, d, a, b, GAP_CAP, None) for a, b in self._hand_pairs)
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""

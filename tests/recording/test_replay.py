@@ -551,7 +551,7 @@ def test_blueprint_puts_each_agents_eyes_side_by_side(vision_env, tmp_path):
         assert len(eyes) == 1, f"no Horizontal with {agent}'s left and right eye side by side"
     views = {n.name: n for n in nodes if isinstance(n, (rrb.Spatial3DView, rrb.TimeSeriesView))}
     assert views["world"].origin == "/world"
-    assert isinstance(views["reward"], rrb.TimeSeriesView)
+    assert isinstance(views["head_height (m)"], rrb.TimeSeriesView)   # free play: no reward
 
 
 def test_blueprint_without_vision_has_no_eyes_but_touch_totals(tmp_path):
