@@ -60,14 +60,17 @@ def blueprint(agents: list[str], face_paths: list[str],
     agents with touch totals; ``scalars``: a view of ``/scalars``; ``contacts``: the contact
     events' log; ``eye``: the 3D view's camera; ``plots``: the task's plot views (objects with
     ``title`` and ``paths``; None: a reward view of every agent); ``legend``: entity paths of the
-    skin-force legend (shown beside the 3D view)."""
+    skin-force legend, shown beside the 3D view (the first a 2D space: the colour bar; the others
+    text documents)."""
     eye_paths = eye_paths or {}
     # -- left: the world, its legend, the logs
     world = rrb.Spatial3DView(origin="/world", name="world", eye_controls=eye)
-    if legend:
-        world = rrb.Horizontal(world, rrb.Spatial2DView(origin="/", contents=list(legend),
-                                                        name="skin force (N)"),
-                               column_shares=[6, 1])
+    if legend:   # the colour bar (a 2D space), then text documents under it
+        keys = [rrb.Spatial2DView(origin=legend[0], name="skin force (N)")]
+        keys += [rrb.TextDocumentView(origin=p, name="skin legend") for p in legend[1:]]
+        key = keys[0] if len(keys) == 1 else rrb.Vertical(*keys, row_shares=[2] + [1] * (
+            len(keys) - 1), name="skin legend")
+        world = rrb.Horizontal(world, key, column_shares=[6, 1])
     logs = [_text_log("/agents", "expressions", entity_column=True),
             rrb.TimeSeriesView(origin="/", name="action norms",
                                contents=[entity("agents", a, "action_norm") for a in agents])]

@@ -327,7 +327,8 @@ class Recorder:
                           self._eyes.paths if self._eyes is not None else None,
                           self._skin.agents if self._skin is not None else (),
                           bool(self._scalar_paths), self._contacts is not None,
-                          scene_eye(self.env), self._plots.views)
+                          scene_eye(self.env), self._plots.views,
+                          getattr(self._skin, "legend_paths", ()))
 
     # -- logging ----------------------------------------------------------------------------------
     def log_reset(self, observations: Mapping[str, Any] | None = None) -> None:
