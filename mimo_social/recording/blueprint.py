@@ -1,13 +1,14 @@
 """The default Rerun viewer layout of a recording, made for a 1920x1080 browser page.
 
-Left (about 55 % of the width): the 3D world, large, with the skin-force legend beside it (touch
+Left (60 % of the width): the 3D world, large, with the skin-force legend beside it (touch
 on); under it the contact events between agents in a wide text log (only the time and the text:
 no column cuts the sentence) beside tabs with the expression log and the action norms. Right:
-one panel per agent with its face and its two eyes side by side (each ~280 px wide, so a 64x64
-eye shows at >= 200 px: rows for one or two agents, a tab per agent for more), and under them
+one panel per agent with its face and its two eyes side by side (each ~250 px wide, so a 64x64
+eye shows at >= 200 px; rows for one or two agents, a tab per agent for more), and under them
 the task's plots (:meth:`~mimo_social.core.task.Task.plots`, one time-series view per plot), the
-touch totals and the recorder's ``scalars``, in a grid of two columns. The selection and
-blueprint panels start collapsed and the time panel compact (each is one click away).
+touch totals and the recorder's ``scalars``, in a grid (two columns, three beyond four views).
+The selection and blueprint panels start collapsed and the time panel compact (each is one click
+away). Plot lines have the agents' clothes colours (:mod:`.plots`).
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ def blueprint(agents: list[str], face_paths: list[str],
         keys += [rrb.TextDocumentView(origin=p, name="skin legend") for p in legend[1:]]
         key = keys[0] if len(keys) == 1 else rrb.Vertical(*keys, row_shares=[2] + [1] * (
             len(keys) - 1), name="skin legend")
-        world = rrb.Horizontal(world, key, column_shares=[6, 1])
+        world = rrb.Horizontal(world, key, column_shares=[7, 1])
     logs = [_text_log("/agents", "expressions", entity_column=True),
             rrb.TimeSeriesView(origin="/", name="action norms",
                                contents=[entity("agents", a, "action_norm") for a in agents])]
@@ -110,7 +111,7 @@ def blueprint(agents: list[str], face_paths: list[str],
         shares.append(max(1.0, 2.0 - 0.4 * agent_rows) if agent_rows else 1.5)
     right = rrb.Vertical(*right_parts, row_shares=shares)
     return rrb.Blueprint(
-        rrb.Horizontal(left, right, column_shares=[11, 9]),
+        rrb.Horizontal(left, right, column_shares=[3, 2]),
         rrb.TimePanel(timeline=SIM_TIME, state="collapsed"),
         # the selection panel took a fifth of the page, empty until one clicks; the blueprint
         # tree is for rearranging: both one click away
