@@ -22,7 +22,14 @@ from .eyes import EYE_FORMATS
 from .geometry import HIDDEN_GEOM_GROUP, geom_archetype, geom_rgba
 from .recorder import Recorder, parallel_of
 from .streams import RecordingFileError
-from .skin import SKIN_FORCE_RANGE, SKIN_POINT_RADIUS, force_colors
+from .skin import (
+                   SKIN_FORCE_RANGE,
+                   SKIN_LEGEND_PATH,
+                   SKIN_LEGEND_TEXT_PATH,
+                   SKIN_RADIUS_RANGE,
+                   force_colors,
+                   force_radii,
+)
 from .summary import format_summary, summarize
 
 __all__ = [
@@ -32,13 +39,16 @@ __all__ = [
                        "HIDDEN_GEOM_GROUP",
                        "SIM_TIME",
                        "SKIN_FORCE_RANGE",
-                       "SKIN_POINT_RADIUS",
+                       "SKIN_LEGEND_PATH",
+                       "SKIN_LEGEND_TEXT_PATH",
+                       "SKIN_RADIUS_RANGE",
                        "STEP",
                        "RecordSubEnv",
                        "Recorder",
                        "RecordingFileError",
                        "RecordingParallelEnv",
                        "force_colors",
+                       "force_radii",
                        "format_summary",
                        "geom_archetype",
                        "geom_rgba",

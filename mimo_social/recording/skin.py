@@ -1,8 +1,12 @@
 """Skin points in a recording: the points of every agent with touch that feel a force.
 
 Each logged row notes which points feel a force (one pass over the touch system's force array);
-at flush time they are placed in the world, coloured by the force (yellow 0.01 N -> dark red
-10 N, log scale) and summed per agent, for all buffered rows at once.
+at flush time they are placed in the world, coloured and sized by the magnitude of the force
+(log scale, :data:`SKIN_FORCE_RANGE`: yellow and 2.5 mm at 0.01 N or less, orange 5 mm at 0.1 N,
+red 7.5 mm at 1 N, dark red and 10 mm at 10 N or more) and summed per agent, for all buffered
+rows at once. A legend is logged once (static): a colour bar with a dot per decade, coloured,
+sized and labelled in newtons, at :data:`SKIN_LEGEND_PATH` (a 2D space), and a short text at
+:data:`SKIN_LEGEND_TEXT_PATH` (markdown).
 """
 
 from __future__ import annotations
@@ -25,12 +29,20 @@ from .columns import (
     optional_scalars,
 )
 
-__all__ = ["SKIN_FORCE_RANGE", "SKIN_POINT_RADIUS", "SkinLog", "force_colors"]
+__all__ = ["SKIN_FORCE_RANGE", "SKIN_LEGEND_PATH", "SKIN_LEGEND_TEXT_PATH", "SKIN_RADIUS_RANGE",
+           "SkinLog", "force_colors", "force_level", "force_radii", "legend_text"]
 
 # skin points: colour and radius grow with the force on the point, on a log scale from
 # SKIN_FORCE_RANGE[0] (yellow, smallest) to SKIN_FORCE_RANGE[1] newtons (dark red, largest)
 SKIN_FORCE_RANGE = (0.01, 10.0)
-SKIN_POINT_RADIUS = 0.004                         # metres (one static radius for all points)
+SKIN_RADIUS_RANGE = (0.0025, 0.010)               # metres, at the ends of SKIN_FORCE_RANGE
+#: the skin-force legend: a 2D space with a colour bar (``bar``, Image) and a dot per decade of
+#: force (``ticks``, Points2D: coloured, sized and labelled like the skin points)
+SKIN_LEGEND_PATH = "/legend/skin_force"
+#: the legend's text (TextDocument, markdown): what colour and size say, in newtons
+SKIN_LEGEND_TEXT_PATH = "/legend/skin_force_text"
+_LEGEND_PX = 256                                  # colour bar height (pixels); 24 wide
+RADII = pa.list_(pa.field("item", pa.float32(), nullable=False))
 _SKIN_STOPS = np.array([0.0, 0.35, 0.7, 1.0])
 _SKIN_RGB = np.array([[255, 235, 0], [255, 140, 0], [225, 20, 0], [120, 0, 30]], np.float64)
 
@@ -45,16 +57,54 @@ def _colour_table(levels: int = 256) -> np.ndarray:
 _SKIN_COLOURS = _colour_table()
 
 
+def force_level(force: np.ndarray) -> np.ndarray:
+    """Where ``force`` newtons lie on the legend's log scale: 0 at ``SKIN_FORCE_RANGE[0]`` or
+    less, 1 at ``SKIN_FORCE_RANGE[1]`` or more."""
+    lo, hi = SKIN_FORCE_RANGE
+    t = np.asarray(np.log(np.maximum(np.asarray(force, np.float64), lo) * (1.0 / lo)))
+    t *= 1.0 / math.log(hi / lo)
+    return np.clip(t, 0.0, 1.0, out=t)
+
+
 def force_colors(force: np.ndarray) -> np.ndarray:
     """Rerun colours (uint32 0xRRGGBBAA) of skin points feeling ``force`` newtons: yellow at
     ``SKIN_FORCE_RANGE[0]`` or less, through orange and red to dark red at
     ``SKIN_FORCE_RANGE[1]`` or more (log scale, 256 steps)."""
-    lo, hi = SKIN_FORCE_RANGE
-    t = np.log(np.maximum(np.asarray(force, np.float64), lo) * (1.0 / lo))
-    t *= (len(_SKIN_COLOURS) - 1) / math.log(hi / lo)
-    np.clip(t, 0.0, len(_SKIN_COLOURS) - 1, out=t)
+    t = force_level(force)
+    t *= len(_SKIN_COLOURS) - 1
     t += 0.5
     return _SKIN_COLOURS.take(t.astype(np.intp))
+
+
+def force_radii(force: np.ndarray) -> np.ndarray:
+    """Radii (metres, float32) of skin points feeling ``force`` newtons: from
+    ``SKIN_RADIUS_RANGE[0]`` at ``SKIN_FORCE_RANGE[0]`` or less to ``SKIN_RADIUS_RANGE[1]`` at
+    ``SKIN_FORCE_RANGE[1]`` or more, linear in the log of the force."""
+    r0, r1 = SKIN_RADIUS_RANGE
+    return (r0 + (r1 - r0) * force_level(force)).astype(np.float32)
+
+
+def _decades() -> np.ndarray:
+    lo, hi = SKIN_FORCE_RANGE
+    return 10.0 ** np.arange(round(math.log10(lo)), round(math.log10(hi)) + 1)
+
+
+def legend_text() -> str:
+    """The legend's text (markdown): what the colour and the size of a skin point say."""
+    names = {0.0: "yellow", 0.35: "orange", 0.7: "red", 1.0: "dark red"}
+    rows = []
+    for f in _decades():
+        t = float(force_level(f))
+        name = names[min(names, key=lambda s: abs(s - t))]
+        rows.append(f"| {f:g} N | {name} | {1e3 * float(force_radii(f)):g} mm |")
+    lo, hi = SKIN_FORCE_RANGE
+    return "\n".join([
+        "### Skin forces",
+        "Each skin point that feels a force is a dot in the 3D view, **coloured and sized by "
+        "the magnitude of the force** on it (log scale):", "",
+        "| force | colour | radius |", "|---|---|---|", *rows, "",
+        f"Forces below {lo:g} N look like {lo:g} N, above {hi:g} N like {hi:g} N. "
+        "`touch_total`: the summed normal force on an agent's skin (N)."])
 
 
 class SkinLog:
@@ -76,22 +126,39 @@ class SkinLog:
         self._mask = np.empty(len(touch.force_normal), dtype=bool)
         self.total_paths = [entity("agents", agents[i], "touch_total") for i in self.agents]
         self.point_paths = [entity("world", agents[i], "skin") for i in self.agents]
+        #: the legend's entity paths: the 2D colour bar with its dots, the text
+        self.legend_paths = [SKIN_LEGEND_PATH, SKIN_LEGEND_TEXT_PATH]
 
     def fields(self) -> list[pa.Field]:
-        """Per agent: its touch total (Scalars) and its points' positions and colours."""
+        """Per agent: its touch total (Scalars) and its points' positions, colours and radii."""
         out = []
         s_desc = rr.Scalars.descriptor_scalars()
         for total, points in zip(self.total_paths, self.point_paths):
             out.append(component_field(f"{total}:scalars", total, s_desc, SCALARS))
             for desc, dtype in ((rr.Points3D.descriptor_positions(), POINTS),
-                                (rr.Points3D.descriptor_colors(), COLORS)):
+                                (rr.Points3D.descriptor_colors(), COLORS),
+                                (rr.Points3D.descriptor_radii(), RADII)):
                 out.append(component_field(f"{points}:{desc.component}", points, desc, dtype))
         return out
 
     def log_static(self, rec: rr.RecordingStream) -> None:
-        """One radius for every skin point (the colour shows the force)."""
-        for p in self.point_paths:
-            rec.log(p, rr.Points3D.from_fields(radii=[SKIN_POINT_RADIUS]), static=True)
+        """The legend (colour bar, a dot per decade of force, the text), once."""
+        h = _LEGEND_PX
+        level = np.linspace(1.0, 0.0, h)                       # top row: the largest force
+        rgba = _SKIN_COLOURS.take(np.round(level * (len(_SKIN_COLOURS) - 1)).astype(np.intp))
+        rgb = np.stack([(rgba >> s) & 0xFF for s in (24, 16, 8)], axis=-1).astype(np.uint8)
+        rec.log(f"{SKIN_LEGEND_PATH}/bar", rr.Image(np.repeat(rgb[:, None, :], 24, axis=1)),
+                static=True)
+        forces = _decades()
+        px_per_m = 1000.0                                      # a dot's radius: 1 px per mm
+        rec.log(f"{SKIN_LEGEND_PATH}/ticks", rr.Points2D(
+            np.stack([np.full(len(forces), 24 + 6 + px_per_m * SKIN_RADIUS_RANGE[1]),
+                      (1.0 - force_level(forces)) * (h - 1)], axis=1),
+            radii=px_per_m * force_radii(forces), colors=force_colors(forces),
+            labels=[f"{f:g} N" for f in forces], show_labels=True), static=True)
+        rec.log(SKIN_LEGEND_TEXT_PATH, rr.TextDocument(legend_text(),
+                                                       media_type=rr.MediaType.MARKDOWN),
+                static=True)
 
     def note(self, rows: Rows, n: int, xmat: np.ndarray) -> None:
         """Note in row ``n`` the skin points with force of all touch agents (one pass over all
@@ -122,7 +189,8 @@ class SkinLog:
         for k in range(3):
             world[:, k] += R[:, 3 * k] * x + R[:, 3 * k + 1] * y + R[:, 3 * k + 2] * z
         xyz = np.concatenate(rows.skin_xyz)
-        colors = force_colors(np.sqrt(np.einsum("ij,ij->i", xyz, xyz)))
+        magnitude = np.sqrt(np.einsum("ij,ij->i", xyz, xyz))
+        colors, radii = force_colors(magnitude), force_radii(magnitude)
         normal = np.concatenate(rows.skin_normal)
         columns = []
         for j in range(len(self.agents)):
@@ -141,5 +209,6 @@ class SkinLog:
                 optional_scalars(total, np.ones(n, dtype=bool)),
                 pa.ListArray.from_arrays(offs, pa.FixedSizeListArray.from_arrays(
                     pa.array(world[sel].ravel()), type=VEC3), type=POINTS),
-                pa.ListArray.from_arrays(offs, pa.array(colors[sel]), type=COLORS)]
+                pa.ListArray.from_arrays(offs, pa.array(colors[sel]), type=COLORS),
+                pa.ListArray.from_arrays(offs, pa.array(radii[sel]), type=RADII)]
         return columns

@@ -18,7 +18,7 @@ from mimo_social.cli import demo as demo_cli
 from mimo_social.experiments import demo
 from mimo_social.envs import free_play_v0
 from mimo_social.expressions.faces import EXPRESSIONS, face_image
-from mimo_social.recording import HIDDEN_GEOM_GROUP, SKIN_POINT_RADIUS, Recorder, record_episode
+from mimo_social.recording import HIDDEN_GEOM_GROUP, Recorder, force_radii, record_episode
 
 N_STEPS = 50
 CHANGE_STEP = 20          # infant_1 turns happy at this step (1-based env.step count)
@@ -608,8 +608,8 @@ def test_skin_points_with_force_every_step_in_world_coordinates(touch_episode):
         want = force_colors(np.array([f for _, f, _ in on]))
         assert sorted(colors) == sorted(want.tolist())
         assert len(set(colors)) > 3                           # the forces differ
-        radius = static_value(data, f"/world/{agent}/skin", "Points3D:radii")
-        np.testing.assert_allclose(radius, [SKIN_POINT_RADIUS])
+        radii = rows(data, f"/world/{agent}/skin", "Points3D:radii")[-1][2]   # grow with force
+        assert sorted(radii) == sorted(force_radii(np.array([f for _, f, _ in on])).tolist())
         total = rows(data, f"/agents/{agent}/touch_total", "Scalars:scalars")
         assert [s for s, _, _ in total] == list(range(31))
         assert total[-1][2][0] == pytest.approx(sum(n for _, _, n in on), rel=1e-9)
