@@ -1,7 +1,6 @@
-"""Rerun recordings (`mimo_social.recording`) and the `demo` subcommand, checked by reading the .rrd
-files back with Rerun's own reader (`rerun.chunk.RrdReader`)."""
+"""Rerun recordings (`mimo_social.recording`), checked by reading the .rrd files back with Rerun's
+own reader (`rerun.chunk.RrdReader`); the demo's recording: tests/recording/test_demo.py."""
 
-import argparse
 import shutil
 import subprocess
 import warnings
@@ -14,8 +13,6 @@ import pytest
 import rerun.blueprint as rrb
 from rerun.chunk import RrdReader
 
-from mimo_social.cli import demo as demo_cli
-from mimo_social.experiments import demo
 from mimo_social.envs import free_play_v0
 from mimo_social.expressions.faces import EXPRESSIONS, face_image
 from mimo_social.recording import HIDDEN_GEOM_GROUP, Recorder, force_radii, record_episode
@@ -310,45 +307,6 @@ def test_single_agent_adapter(tmp_path):
     assert len(rows(data, f"/world/{agent}/hip", "Transform3D:translation")) == 11
     reward = rows(data, f"/agents/{agent}/reward", "Scalars:scalars")
     np.testing.assert_allclose([v[0] for _, _, v in reward], sent)
-
-
-# -- the demo --------------------------------------------------------------------------------------
-
-def test_demo_parser_defaults():
-    parser = argparse.ArgumentParser()
-    demo_cli.add_parser(parser.add_subparsers(dest="command"))
-    args = parser.parse_args(["demo"])
-    assert (args.record, args.seconds, args.n_agents, args.seed) == (
-        "recordings/demo.rrd", 10.0, 2, 0)
-    assert args.func is demo_cli.run
-
-
-def test_demo_noise_is_smooth_and_seeded():
-    env = free_play_v0.parallel_env(n_agents=1)
-    a = demo.demo_actions(env, 2000, 3)
-    b = demo.demo_actions(env, 2000, 3)
-    env.close()
-    xs = np.array([x["infant_0"]["motors"] for x in a])
-    np.testing.assert_array_equal(xs[-1], b[-1]["infant_0"]["motors"])
-    assert 0.25 < xs[500:].std() < 0.6                      # moves over the whole range ...
-    steps = np.abs(np.diff(xs, axis=0))
-    assert steps.mean() < 0.02 and steps.max() < 0.1        # ... without jumping
-
-
-def test_demo_subcommand_writes_a_readable_recording(tmp_path, capsys):
-    from mimo_social.cli import main
-
-    path = tmp_path / "sub" / "demo.rrd"
-    assert main(["demo", "--seconds", "1", "--record", str(path), "--seed", "4"]) == 0
-    out = capsys.readouterr().out
-    assert str(path) in out and "rerun" in out
-    data = read_rrd(path)
-    for agent in ("infant_0", "infant_1"):
-        hip = rows(data, f"/world/{agent}/hip", "Transform3D:translation")
-        assert [s for s, _, _ in hip] == list(range(101))
-        assert rows(data, f"/agents/{agent}/expression", "TextLog:text")[0][2] == ["neutral"]
-        assert len(rows(data, f"/agents/{agent}/action_norm", "Scalars:scalars")) == 100
-    assert path.stat().st_size < 1_000_000
 
 
 # -- eyes, skin, contacts, chosen scalars ----------------------------------------------------------
