@@ -201,11 +201,17 @@ class SelfBody(Task):
         return np.array([self.options.miss_reward])
 
     def plots(self):
-        """Reward, the touch's distance to the target primitive (none without a touch) and
-        success."""
+        """Reward, the right palm's distance to the target primitive's centre, the touch's
+        distance to it (none without a touch: the reward's) and success."""
         nan = float("nan")
-        return [Plot.reward(),
-                Plot("distance", "m",
+
+        def palm(env):
+            d = env.world.data
+            site = env.world.agents[0].palm_sites[0]
+            return (np.linalg.norm(d.site_xpos[site] - d.geom_xpos[self._target_geoms[
+                self._target]]),)
+        return [Plot.reward(), Plot("palm_to_target", "m", palm),
+                Plot("touch_distance", "m",
                      lambda env: (nan if self._distance is None else self._distance,)),
                 Plot("success", "0/1", lambda env: (self._success,))]
 

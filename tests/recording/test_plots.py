@@ -232,3 +232,42 @@ def test_a_failing_plot_names_the_task_and_the_plot(tmp_path):
 def test_plot_errors_name_the_field_and_what_is_allowed(kwargs, match):
     with pytest.raises(ConfigError, match=match):
         Plot(**kwargs)
+
+
+#: plots that may stay constant in a scripted episode (the touch's distance exists only while
+#: the hand touches a primitive other than the target: the scripted reach touches the target)
+_STEADY = {"touch_distance"}
+
+
+@pytest.mark.parametrize("entry", [e for e in catalog.CATALOG if e.controller is not None],
+                         ids=lambda e: e.name)
+def test_plots_follow_the_scripted_solution(entry, tmp_path):
+    """The task's scripted controller as the learner, up to 600 steps: every plot's series
+    changes, and a plot named success reaches 1."""
+    env = entry.scripted_env()
+    inner = env.unwrapped if hasattr(env, "unwrapped") else env
+    ctrl = entry.controller()
+    obs, _ = env.reset(seed=1000)
+    ctrl.reset(inner, "infant_0", np.random.default_rng(1000))
+    path = tmp_path / "run.rrd"
+    with Recorder(env, path, eyes=False) as rec:
+        rec.log_reset(obs)
+        for _ in range(600):
+            if not env.agents:
+                break
+            act = {"infant_0": ctrl.act(inner, "infant_0", obs["infant_0"])}
+            obs, rewards, *_ = env.step(act)
+            rec.log_step(act, rewards, obs)
+    data = read(path)
+    assert set(rec.agents) == set(inner.possible_agents)       # the partner recorded too
+    for plot in inner.task.plots():
+        if plot.fn is None:
+            assert series(data, "/agents/infant_0/reward")
+            continue
+        for path_ in plot_views(rec)[plot.title]:
+            values = list(series(data, path_).values())
+            if plot.name not in _STEADY:
+                assert len(set(values)) >= 2, f"{path_}: {set(values)}"
+            if plot.name == "success" and path_.endswith(("/success", "infant_0")):
+                assert max(values) == 1.0, path_
+    env.close()
