@@ -33,12 +33,13 @@ from pettingzoo import ParallelEnv
 from ..body.actuation import MODELS as ACTUATION_MODELS
 from ..expressions.faces import EXPRESSIONS
 from ..render.scene import make_renderer
+from ..scenery import SCENES, inside_camera
 from ..senses import SENSES
-from ..util.checks import check_seed, number_array, show
+from ..util.checks import check_choice, check_seed, number_array, show
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
 from .delays import MotorDelay, SenseDelay, delay_steps, fill_sensor_history
 from .task import Task, agent_user_settings, check_start_poses
-from .world import World
+from .world import World, check_scene_clear
 
 __all__ = ["MimoParallelEnv", "TIMING_KEYS"]
 
@@ -68,10 +69,13 @@ class MimoParallelEnv(ParallelEnv):
     def __init__(self, task: Task, physics: Mapping[str, Any] | None = None,
                  per_agent: Sequence[Mapping[str, Any]] | None = None,
                  render_mode: str | None = None, max_steps: int | None = None,
-                 render_size: tuple[int, int] = (480, 640), **agent_settings):
+                 render_size: tuple[int, int] = (480, 640), scene: str = "floor",
+                 **agent_settings):
         self.render_mode, self.max_steps, self.render_size = env_settings(
             render_mode, max_steps, render_size, task.default_max_steps,
             self.RENDER_MODES)
+        #: where the agents are: "floor" (the bare floor) or "playroom" (docs/playroom.md)
+        self.scene = check_choice("env", "scene", scene, SCENES)
         self.task = task
         n = task.n_agents
         defaults = [task.agent_defaults(i, own) for i, own in
@@ -85,8 +89,9 @@ class MimoParallelEnv(ParallelEnv):
         self._delays = [delay_steps(cfg, self.dt) for cfg in self.agent_configs]
         task.configs = tuple(self.agent_configs)
         setups = [task.setup(i, cfg) for i, cfg in enumerate(self.agent_configs)]
-        self.world = World(setups, task.props(), self.physics)
+        self.world = World(setups, task.props(), self.physics, scene=self.scene)
         check_start_poses(self.world)   # agents placed inside each other: a ConfigError
+        check_scene_clear(self.world)   # ... or inside the play room's furniture
         self.possible_agents = list(self.world.names)
         self.agents = list(self.possible_agents)
         self._index = {name: i for i, name in enumerate(self.possible_agents)}
@@ -463,6 +468,10 @@ class MimoParallelEnv(ParallelEnv):
         cam.distance = max(1.4 + 2.0 * spread, 2.2 * top)
         cam.azimuth = 60.0
         cam.elevation = -20.0
+        if self.world.room is not None:   # inside the room, looking over the agents at its back
+            cam.azimuth, cam.elevation = 70.0, -22.0
+            cam.distance = inside_camera(self.world.room.centre, cam.lookat, cam.distance,
+                                         cam.azimuth, cam.elevation)
         return cam
 
     def close(self):

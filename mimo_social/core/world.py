@@ -23,10 +23,12 @@ import numpy as np
 from ..body.builder import axis_angle_quat, build_infant, quat_mul
 from ..body.postures import posture_joints, posture_pitch
 from ..expressions.switch import FaceTextures
+from ..scenery import SCENES, add_playroom, clear_toys
+from ..util.checks import ConfigError, check_choice
 from .config import AgentConfig, PhysicsConfig
 from .delays import delay_sensors, delay_steps, fill_sensor_history
 
-__all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE"]
+__all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE", "check_scene_clear"]
 
 CLOTHES_PALETTE = (
     (0.35, 0.55, 0.85, 1.0), (0.90, 0.45, 0.40, 1.0), (0.45, 0.75, 0.45, 1.0),
@@ -124,13 +126,22 @@ def _yaw_quat(position, facing) -> np.ndarray:
 
 
 class World:
-    """N infants, a floor, lights and props, compiled into one model."""
+    """N infants, a floor, lights and props, compiled into one model.
+
+    ``scene``: ``"floor"`` (the bare checkered floor) or ``"playroom"`` (the play room of
+    :mod:`mimo_social.scenery`, centred on the agents' places; its toys, free bodies
+    ``playroom/<toy>``, are in :attr:`room`; with ``floor=False`` no scene at all)."""
+
+    #: the play room's toys may sleep while they rest (MuJoCo's ``mjENBL_SLEEP``, the room only)
+    ROOM_SLEEP = False
 
     def __init__(self, agents: Sequence[AgentSetup], props: Sequence[Prop] = (),
-                 physics: PhysicsConfig = PhysicsConfig(), floor: bool = True):
+                 physics: PhysicsConfig = PhysicsConfig(), floor: bool = True,
+                 scene: str = "floor"):
         if not 1 <= len(agents) <= 8:
             raise ValueError(f"a world holds 1 to 8 infants, got {len(agents)}")
-        self._recipe = (tuple(agents), tuple(props), physics, floor)
+        self.scene = check_choice("env", "scene", scene, SCENES)
+        self._recipe = (tuple(agents), tuple(props), physics, floor, scene)
         self.agent_setups = tuple(agents)
         self.props = tuple(props)
         self.physics = physics
@@ -152,16 +163,26 @@ class World:
 
     # -- building ------------------------------------------------------------------------------
     def _build(self):
-        agents, props, physics, floor = self._recipe
+        agents, props, physics, floor, scene = self._recipe
         spec = mujoco.MjSpec()
         spec.modelname = "mimo_social"
         spec.compiler.degree = False
         self._set_options(spec, physics)
         self.faces = FaceTextures()
         self.faces.add_to(spec)
-        if floor:
-            self._add_floor(spec)
-        self._add_lights(spec)
+        self.room = None
+        if floor and scene == "playroom":
+            xy = np.array([s.position for s in agents], float)
+            centre = (xy.min(axis=0) + xy.max(axis=0)) / 2
+            self.room = add_playroom(spec, centre, sleep=self.ROOM_SLEEP)
+            # the near plane of the cameras as on the floor (2 cm: a tenth of znear x extent)
+            spec.stat.extent = 2.0
+            if self.ROOM_SLEEP:
+                spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
+        else:
+            if floor:
+                self._add_floor(spec)
+            self._add_lights(spec)
         builds = []
         for i, setup in enumerate(agents):
             cfg = setup.config
@@ -186,7 +207,9 @@ class World:
             spec.geom(f"{prefix}head").material = f"{prefix}face"
             builds.append((build, pose_q))
         for p in props:
-            self._add_prop(spec, p)
+            body = self._add_prop(spec, p)
+            if self.room is not None and self.ROOM_SLEEP:
+                body.sleep = mujoco.mjtSleepPolicy.mjSLEEP_NEVER   # tasks move their props
         self.spec = spec
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
@@ -196,6 +219,14 @@ class World:
         for a, (build, pose_q) in zip(self.agents, builds):
             for k, name in enumerate(a.joint_names):
                 self._initial_qpos[a.qpos_adr[k]] = pose_q.get(name, self._initial_qpos[a.qpos_adr[k]])
+        self.toys_moved = []
+        if self.room is not None:   # toys where an agent or a task's prop starts: spare places
+            self.data.qpos[:] = self._initial_qpos
+            mujoco.mj_kinematics(self.model, self.data)
+            others = np.flatnonzero((self.geom_agent >= 0) | np.isin(
+                self.model.geom_bodyid, list(self.prop_bodies.values())))
+            self.toys_moved = clear_toys(self.model, self.data, self.room, others,
+                                         self._initial_qpos)
         self.reset()
         self.hold_welds()
 
@@ -257,6 +288,7 @@ class World:
             data = np.array(eq.data)
             data[:3] = 0.0  # the anchor: the prop's origin
             eq.data = data
+        return body
 
     @staticmethod
     def _rest_pose(build, posture: str, setup: AgentSetup):
@@ -483,3 +515,43 @@ class World:
 
     def expression_of(self, agent: int) -> int:
         return self.faces.shown(self.model, self.agents[agent].head_material)
+
+
+#: how deep (m) an agent or a task's prop may start in the play room's walls or furniture
+ROOM_OVERLAP_DEPTH = 0.005
+
+
+def check_scene_clear(world: World) -> None:
+    """In the play room, a ConfigError naming the agent, where it stands and the piece of
+    furniture or wall when it starts inside one (deeper than :data:`ROOM_OVERLAP_DEPTH`);
+    nothing on the floor. (A task's props are left out: tasks place them at reset.) Reads a
+    scratch copy of the state."""
+    if world.room is None:
+        return
+    m = world.model
+    d = mujoco.MjData(m)
+    d.qpos[:] = world.data.qpos
+    mujoco.mj_kinematics(m, d)
+    mujoco.mj_collision(m, d)
+    n = d.ncon
+    names = [m.geom(g).name for g in range(m.ngeom)]
+    fixed = np.array([m.geom_bodyid[g] == 0 and names[g].startswith("playroom/")
+                      and names[g] not in ("playroom/floor", "playroom/mat")
+                      for g in range(m.ngeom)])
+    c = d.contact
+    for k in np.argsort(c.dist[:n]):
+        g1, g2 = int(c.geom1[k]), int(c.geom2[k])
+        if -c.dist[k] <= ROOM_OVERLAP_DEPTH or fixed[g1] == fixed[g2]:
+            continue
+        room, other = (g1, g2) if fixed[g1] else (g2, g1)
+        i = int(world.geom_agent[other])
+        if i < 0:
+            continue
+        s = world.agent_setups[i]
+        who = f"agent {world.names[i]} (placed at ({s.position[0]:.2f}, {s.position[1]:.2f}) m)"
+        cx, cy = world.room.centre
+        raise ConfigError(
+            f"scene='playroom': {who} starts inside the room's {names[room][len('playroom/'):]!r}"
+            f" ({100 * -c.dist[k]:.1f} cm deep); the room is centred at ({cx:.2f}, {cy:.2f}) m, "
+            "its furniture along the walls 1.2-2 m from the centre: place the agents closer "
+            "together (their position settings) or use scene='floor'")

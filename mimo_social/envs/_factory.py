@@ -10,7 +10,7 @@ from pettingzoo.utils.conversions import parallel_to_aec
 from ..core.env import MimoParallelEnv
 from ..util.checks import ConfigError
 
-TASK_ARGS = ("physics", "per_agent", "render_mode", "max_steps", "render_size")
+TASK_ARGS = ("physics", "per_agent", "render_mode", "max_steps", "render_size", "scene")
 
 
 def make_parallel(task_cls, n_agents=None, task_options=None, **kwargs) -> MimoParallelEnv:

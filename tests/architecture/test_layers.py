@@ -19,7 +19,7 @@ PKG = Path(__file__).resolve().parents[2] / "mimo_social"
 #: the rank of each top-level unit of the package; a unit imports only from lower ranks
 LAYERS = {
     "util": 0,
-    "body": 1, "expressions": 1, "render": 1,
+    "body": 1, "expressions": 1, "render": 1, "scenery": 1,
     "senses": 2,
     "core": 3,
     "partners": 4,

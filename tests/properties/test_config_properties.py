@@ -179,7 +179,7 @@ def test_task_options(task, name, data):
 
 # -- whole envs -----------------------------------------------------------------------------------
 ENV_ARGS = ("max_steps", "render_size", "render_mode", "n_agents", "physics", "per_agent",
-            "task_options")
+            "task_options", "scene")
 
 
 def _zero_step(env):

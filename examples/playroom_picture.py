@@ -1,0 +1,65 @@
+"""The play room's pictures for docs/playroom.md: an overview from inside the room and an eye view.
+
+Run (headless, OpenGL through EGL)::
+
+    MUJOCO_GL=egl python examples/playroom_picture.py [docs/playroom.png]
+
+It builds the high five in the play room (``scene="playroom"``) with an infant and the kneeling
+adult caregiver, lets the scripted pair play until their hands meet (at most 1.5 s), and writes
+one PNG: the env's own scene camera (inside the room, looking over the pair) on the left, and
+on the right what the infant's left eye sees (120 x 120, enlarged) and a second view across the
+room, from the shelf's side.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from mimo_social.envs import high_five_v0
+from mimo_social.envs.catalog import entry
+from mimo_social.render.png import write_png
+
+
+def _enlarge(img: np.ndarray, k: int) -> np.ndarray:
+    return np.repeat(np.repeat(img, k, axis=0), k, axis=1)
+
+
+def main(out: str = "docs/playroom.png") -> None:
+    env = high_five_v0.scripted_env(
+        scene="playroom", render_mode="rgb_array", render_size=(720, 960),
+        per_agent=[{"vision": {"width": 120, "height": 120}},
+                   {"body": "adult", "posture": "kneeling"}])
+    inner = env.unwrapped
+    obs, _ = env.reset(seed=0)
+    ctrl = entry("high_five").controller()
+    ctrl.reset(inner, "infant_0", np.random.default_rng(0))
+    for _ in range(150):        # until the high five (the episode ends on success)
+        obs, _, term, trunc, _ = env.step({"infant_0": ctrl.act(inner, "infant_0",
+                                                                obs["infant_0"])})
+        if term["infant_0"] or trunc["infant_0"]:
+            break
+    overview = inner.render()                                   # 720 x 960
+    eye = obs["infant_0"]["eye_left"]
+    eye = eye if eye.ndim == 3 and eye.shape[-1] == 3 else np.moveaxis(eye, 0, -1)
+    eye = _enlarge(np.asarray(eye, np.uint8), 360 // eye.shape[0])   # 360 x 360
+    cam = inner.scene_camera()
+    cam.azimuth, cam.elevation = cam.azimuth + 150.0, -28.0
+    cx, cy = inner.world.room.centre
+    cam.lookat[:] = (cx + 0.3, cy - 0.1, 0.35)
+    cam.distance = 2.0
+    across = inner.render_rgb(cam)
+    across = across[::2, ::2][:, 60:420]                          # 360 x 360
+    right = np.concatenate([eye, across], axis=0)
+    gap = np.full((720, 8, 3), 255, np.uint8)
+    picture = np.concatenate([overview, gap, right], axis=1)
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    write_png(out, picture)
+    env.close()
+    print(f"wrote {out} ({picture.shape[1]} x {picture.shape[0]})")
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:])
