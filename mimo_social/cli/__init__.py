@@ -20,9 +20,11 @@ from . import soak
 from . import bench_engines
 from . import bench_development
 from . import paradigm
+from . import check_viewer
 
 SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, bench_vision, figure, docs,
-               bench_recording, baselines, soak, bench_engines, bench_development, paradigm)
+               bench_recording, baselines, soak, bench_engines, bench_development, paradigm,
+               check_viewer)
 
 
 class UsageError(SystemExit):

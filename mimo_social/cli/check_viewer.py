@@ -1,0 +1,86 @@
+"""``mimo-social check-viewer FILE.rrd``: open a recording in Rerun's web viewer in headless
+Chromium, take a screenshot and check that the 3D view shows the bodies.
+
+See :mod:`mimo_social.recording.viewer_check` for what is served, started and looked for. Needs
+Chromium (``chromium`` on the ``PATH`` or ``$MIMO_SOCIAL_CHROMIUM``), the Python package
+``playwright`` (no browser download: the system Chromium is driven) and ``rerun`` (rerun-sdk).
+Exit code 0 when the bodies show, 1 when they do not (the message says which colours were
+missing and where the screenshot is), 2 for a bad argument.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+from ..recording.viewer_check import ViewerCheckError, check_viewer
+from ._args import float_above, input_file, output_file
+
+__all__ = ["add_parser", "run"]
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(t) for t in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not WIDTHxHEIGHT; allowed: e.g. "
+                                         f"1920x1080") from None
+    if not (640 <= w <= 7680 and 480 <= h <= 4320):
+        raise argparse.ArgumentTypeError(f"{text!r} not allowed; allowed: width 640 to 7680, "
+                                         f"height 480 to 4320")
+    return w, h
+
+
+def _number(lo: float, hi: float | None, allowed: str):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number; allowed: {allowed}") \
+                from None
+        if not math.isfinite(value) or value < lo or (hi is not None and value > hi):
+            raise argparse.ArgumentTypeError(f"{text} not allowed; allowed: {allowed}")
+        return value
+
+    parse.__name__ = "number"
+    return parse
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    parser = subparsers.add_parser(
+        "check-viewer", help="open a recording in Rerun's web viewer in headless Chromium; "
+                             "screenshot it and check that the 3D view shows the bodies",
+        description="Serve FILE.rrd over HTTP, start `rerun --web-viewer`, open it in headless "
+                    "Chromium (software WebGL), wait for the recording to load, save a "
+                    "screenshot and check that the 3D view shows every agent's clothes colour. "
+                    "Loading takes about a minute with software rendering.")
+    parser.add_argument("file", metavar="FILE.rrd", type=input_file,
+                        help="the recording to open")
+    parser.add_argument("--screenshot", metavar="PATH", type=output_file, default=None,
+                        help="where the PNG goes (default: next to the recording, "
+                             "<name>_viewer.png)")
+    parser.add_argument("--timeout", metavar="S", type=float_above(0.0), default=180.0,
+                        help="seconds to wait for the bodies to show (default 180)")
+    parser.add_argument("--size", metavar="WxH", type=_size, default=(1920, 1080),
+                        help="the browser page's size in pixels (default 1920x1080)")
+    parser.add_argument("--at", metavar="FRACTION", type=_number(0.0, 1.0, "a fraction from 0 to 1"),
+                        default=None,
+                        help="move the time cursor to this fraction (0 to 1) of the recording "
+                             "before the screenshot (a click on the time bar)")
+    parser.add_argument("--wait", metavar="S", type=_number(0.0, None, "seconds >= 0"), default=0.0,
+                        help="seconds more to wait after the bodies show, before the screenshot "
+                             "(images decoded, playback on; default 0)")
+    parser.set_defaults(func=run)
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        result = check_viewer(args.file, screenshot=args.screenshot, timeout=args.timeout,
+                              size=args.size, at=args.at, wait=args.wait)
+    except ViewerCheckError as e:
+        print(f"mimo-social check-viewer: FAILED: {e}", file=sys.stderr)
+        return 1
+    print(result.format())
+    return 0
