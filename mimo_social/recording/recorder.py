@@ -25,19 +25,19 @@ Layout of a recording::
     /world/<agent>/<body>           Transform3D of the body in the world, every logged step
     /world/<agent>/<body>/<geom>    static shape of each visible geom, in its body's frame
     /world/<agent>/skin             Points3D (world frame): the skin points that feel a force,
-                                    coloured by its magnitude (yellow 0.01 N -> dark red 10 N,
-                                    log scale; touch on); every logged step, empty when nothing
-                                    touches
+                                    coloured and sized by its magnitude (yellow 2.5 mm at 0.01 N
+                                    -> dark red 10 mm at 10 N, log scale; touch on); every logged
+                                    step, empty when nothing touches
+    /legend/skin_force[_text]       the legend of those (static; :mod:`.skin`)
     /world/props/<body>[/<geom>]    the same for every other body (props)
     /agents/<agent>/reward          Scalars: reward, summed over the steps since the last row
     /agents/<agent>/action_norm     Scalars: L2 norm of the motor action, clipped to [-1, 1]
     /agents/<agent>/touch_total     Scalars: summed normal force (N) on the agent's skin (touch on)
     /agents/<agent>/expression      TextLog at reset and at every change of the expression
     /agents/<agent>/face            Image of the face at reset and at every change (see below)
-    /agents/<agent>/eyes/left|right EncodedImage (PNG, lossless) of each eye (vision on)
-    /events/contacts                TextLog, one row when a body part of one agent starts
-                                    touching a body part of another ("infant_0 right_hand touches
-                                    infant_1 right_fingers")
+    /agents/<agent>/eyes/left|right EncodedImage (PNG, lossless) of each eye (vision on), 25 Hz
+    /events/contacts                TextLog, a full line when a body part of one agent starts or
+                                    stops touching one of another, with the force (:mod:`.contacts`)
     /scalars/<name>                 Scalars: the ``scalars={name: fn(env)}`` given to the Recorder
     /plots/<name>[/<agent>]         Scalars: the task's plots (``Task.plots()``, :mod:`.plots`)
 
@@ -343,6 +343,8 @@ class Recorder:
         # views into the model/data memory, valid for the life of the world; taken anew per episode
         self._data, self._xpos, self._xquat = w.data, w.data.xpos, w.data.xquat
         self._xmat = w.data.xmat
+        if self._contacts is not None and self._last_time is not None:
+            self._note_contacts(end="episode reset")
         if self._last_time is not None:  # later episodes continue the timeline
             self._time_offset = self._last_time + self._dt - float(w.data.time)
         self._started = True
@@ -410,12 +412,12 @@ class Recorder:
         self._faces.note(self._rows, agents, t, self._global_step, at_once)
         self._last_time = t
 
-    def _note_contacts(self) -> None:
-        new = self._contacts.note(self._data)
-        if new:
-            t, step = self._now(), self._global_step
-            self._rows.contacts.extend((t, step, text) for text in new)
-            self.contact_events += len(new)
+    def _note_contacts(self, end: str | None = None) -> None:
+        """Contacts between agents that started or stopped; ``end``: end all still on (why)."""
+        c, out = self._contacts, self._rows.contacts
+        self.contact_events += (c.note(self._data, out, self._now(), self._global_step)
+                                if end is None else
+                                c.end_all(out, self._last_time, self._global_step, end))
 
     def _note_eyes(self, observations) -> None:
         if observations is not None and self._single:
@@ -556,6 +558,8 @@ class Recorder:
         t0 = time.perf_counter()
         try:
             self._faces.commit(self._rows, self._global_step, everything=True)
+            if self._contacts is not None and self._started:
+                self._note_contacts(end="end of recording")
             self._flush()                      # (waits for the eye frames still being encoded)
             self._rec = None                   # the stream's last reference is the FileStream's
             self._stream.close()
