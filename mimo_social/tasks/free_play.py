@@ -62,15 +62,17 @@ class FreePlay(Task):
 
     def _head_height(self, env):
         w = env.world
-        if getattr(self, "_heads", None) is None or self._plot_world is not w:
+        if getattr(self, "_plot_world", None) is not w:   # index tables, once per world
             self._plot_world = w
             self._heads = np.array([a.head_site for a in w.agents], np.intp)
             self._roots = np.array([a.root_body for a in w.agents], np.intp)
+            self._self_pair = np.eye(len(w.agents), dtype=bool)
         return w.data.site_xpos[self._heads, 2]
 
     def _nearest(self, env):
         self._head_height(env)
         xy = env.world.data.xpos[self._roots, :2]
-        gap = np.linalg.norm(xy[:, None, :] - xy[None, :, :], axis=2)
-        np.fill_diagonal(gap, np.inf)
-        return gap.min(axis=1)
+        diff = xy[:, None, :] - xy[None, :, :]
+        gap = np.einsum("ijk,ijk->ij", diff, diff)
+        gap[self._self_pair] = np.inf
+        return np.sqrt(gap.min(axis=1))

@@ -24,6 +24,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import mujoco
@@ -208,8 +209,7 @@ class SelfBody(Task):
         def palm(env):
             d = env.world.data
             site = env.world.agents[0].palm_sites[0]
-            return (np.linalg.norm(d.site_xpos[site] - d.geom_xpos[self._target_geoms[
-                self._target]]),)
+            return (math.dist(d.site_xpos[site], d.geom_xpos[self._target_geoms[self._target]]),)
         return [Plot.reward(), Plot("palm_to_target", "m", palm),
                 Plot("touch_distance", "m",
                      lambda env: (nan if self._distance is None else self._distance,)),
