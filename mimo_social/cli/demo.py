@@ -69,9 +69,12 @@ def report(out: demo.DemoRun, wall_s: float, summary: dict | None = None) -> str
         lines.append(f"  faces of {agent}: {' -> '.join(shown)}")
     contacts = summary["contact_events"] if summary else []
     first = f" (first: step {contacts[0][0]}, {contacts[0][1]})" if contacts else ""
-    lines.append(f"  contact events between the two: {out.contact_events}{first}")
-    lines.append(f"  eye images: {out.eye_frames} pairs ({demo.EYE_SIZE}x{demo.EYE_SIZE}); "
-                 "skin points of both agents' arms and hands")
+    count = len(contacts) if summary else out.contact_events
+    lines.append(f"  contact events between the two: {count}{first}")
+    eyes = summary["eye_images"] if summary else {}
+    counts = ", ".join(f"{a} {n['left']} + {n['right']}" for a, n in eyes.items())
+    lines.append(f"  eye images ({demo.EYE_SIZE}x{demo.EYE_SIZE}, left + right): "
+                 f"{counts or out.eye_frames}; skin points of both agents' arms and hands")
     if out.stopped:
         lines.append(f"The run ended early: {out.stopped}")
     lines.append("Open it with:\n" + _open_hint(out.path))

@@ -3,7 +3,8 @@ the infant a ball; recorded, with both agents' eyes and skin, to one Rerun ``.rr
 
 One env (:func:`demo_env`: :class:`~mimo_social.experiments.demo_task.HighFiveThenHandover`,
 ``infant_0`` the published 18-month-old, ``infant_1`` the adult body kneeling, both with 64x64
-eyes, skin on both arms and hands, faces) runs two episodes one after the other, recorded by one
+eyes, skin on both arms and hands, faces), in the play room by default (``scene="playroom"``;
+``"floor"``: the bare floor), runs two episodes one after the other, recorded by one
 :class:`~mimo_social.recording.recorder.Recorder` on one continuous timeline (one recording):
 
 1. **high five**: the caregiver holds its right hand out, palm forward; the infant's scripted
@@ -13,6 +14,8 @@ eyes, skin on both arms and hands, faces) runs two episodes one after the other,
    beside it, the caregiver tips the ball into it and lets go once the infant's hand carries
    it. The infant looks surprised when the ball first touches its hand; both smile once the
    infant holds it alone. The scene then runs on (the infant holding the ball) to the end.
+   (The ball waits on the mat beside the caregiver during the high five; the handover's reset
+   lays it in the caregiver's palm.)
 
 A phase that has not succeeded after :data:`HIGH_FIVE_WAIT_S` / :data:`HANDOVER_WAIT_S` is
 reported as such (the high five then gives way to the handover). Every agent acts only through
@@ -30,6 +33,7 @@ from tqdm import tqdm
 from ..envs._factory import make_parallel
 from ..expressions.faces import EXPRESSIONS
 from ..recording.recorder import Recorder
+from ..scenery import SCENES
 from ..util.checks import ConfigError, check_int, check_number, show
 from .demo_task import PHASES, HighFiveThenHandover, phase_partners
 
@@ -40,8 +44,8 @@ __all__ = ["CAREGIVER", "CELEBRATE_S", "DEFAULT_RECORDING", "DEFAULT_SCENE", "DE
 DEFAULT_RECORDING = "recordings/demo.rrd"
 #: simulated seconds the demo runs by default (the interaction takes about 5 s)
 DEFAULT_SECONDS = 6.0
-DEFAULT_SCENE = "floor"
-SCENES = ("floor", "playroom")
+#: where it happens by default: the play room (docs/playroom.md); ``"floor"``: the bare floor
+DEFAULT_SCENE = "playroom"
 #: the shortest run: one control step
 MIN_SECONDS = 0.01
 #: the caregiver's settings (``infant_1``)
@@ -86,13 +90,10 @@ class DemoRun:
 def demo_env(scene: str = DEFAULT_SCENE, eye_size: int = EYE_SIZE):
     """The demo's env: the infant ``infant_0`` and the kneeling caregiver ``infant_1`` with
     faces, ``eye_size`` eyes and the handover's skin, in ``scene``."""
-    check_scene(scene)
-    kwargs = {}
-    if scene != "floor":
-        kwargs["scene"] = scene
     return make_parallel(HighFiveThenHandover, per_agent=[{}, dict(CAREGIVER)],
                          expressions=True, vision={"width": eye_size, "height": eye_size},
-                         task_options={"end_on_success": False}, max_steps=10**9, **kwargs)
+                         task_options={"end_on_success": False}, max_steps=10**9,
+                         scene=check_scene(scene))
 
 
 def check_scene(scene) -> str:
