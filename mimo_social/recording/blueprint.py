@@ -71,14 +71,14 @@ def blueprint(agents: list[str], face_paths: list[str],
         keys += [rrb.TextDocumentView(origin=p, name="skin legend") for p in legend[1:]]
         key = keys[0] if len(keys) == 1 else rrb.Vertical(*keys, row_shares=[2] + [1] * (
             len(keys) - 1), name="skin legend")
-        world = rrb.Horizontal(world, key, column_shares=[7, 1])
+        world = rrb.Horizontal(world, key, column_shares=[6, 1])
     logs = [_text_log("/agents", "expressions", entity_column=True),
             rrb.TimeSeriesView(origin="/", name="action norms",
                                contents=[entity("agents", a, "action_norm") for a in agents])]
     bottom = rrb.Tabs(*logs)
     if contacts:
         bottom = rrb.Horizontal(_text_log(CONTACTS_PATH, "contacts between agents", False),
-                                bottom, column_shares=[3, 2])
+                                bottom, column_shares=[5, 2])
     left = rrb.Vertical(world, bottom, row_shares=[3, 1])
     # -- right: one panel per agent, then the plots
     panels = [_agent_panel(a, face_paths[i] if i < len(face_paths) else None,

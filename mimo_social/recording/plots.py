@@ -23,8 +23,9 @@ from .columns import SCALARS, component_field, entity, optional_scalars
 
 __all__ = ["ONE_SERIES_RGB", "PlotLog", "PlotView", "agent_colors"]
 
-#: the colour of a series that is no agent's (one value for the pair, a shared reward)
-ONE_SERIES_RGB = (225, 225, 225)
+#: the colour of a series that is no agent's (one value for the pair, a shared reward): a mid
+#: grey, seen on the viewer's light and dark themes alike, and no infant's clothes
+ONE_SERIES_RGB = (105, 105, 110)
 _WIDTH = 2.0
 
 
