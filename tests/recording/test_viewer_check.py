@@ -1,0 +1,179 @@
+"""The real-browser check of a replay (issue 20): Rerun's web viewer in headless Chromium shows
+the bodies of a recording in its 3D view, and does not pass a recording without bodies.
+
+The browser tests are skipped (with the reason) where Chromium, Playwright or ``rerun`` is
+missing; the pixel and colour tests run everywhere. Each browser test takes about 30-60 s here
+(software WebGL); the demo's full recording is the slow variant.
+"""
+
+from __future__ import annotations
+
+import colorsys
+
+import numpy as np
+import pytest
+import rerun as rr
+
+from mimo_social.cli import main
+from mimo_social.core.world import CLOTHES_PALETTE
+from mimo_social.envs import high_five_v0
+from mimo_social.recording.recorder import Recorder
+from mimo_social.recording.viewer_check import (SEPARATOR_RGB, ViewerCheckError, browser_missing,
+                                                check_viewer, colour_pixels, find_3d_view,
+                                                recording_colours, time_bar)
+
+MISSING = browser_missing()
+needs_browser = pytest.mark.skipif(MISSING is not None, reason=f"viewer check: {MISSING}")
+BLUE, RED = (tuple(round(255 * c) for c in CLOTHES_PALETTE[i][:3]) for i in (0, 1))
+
+
+def _record(path, steps: int = 300):
+    """A short run of the high five pair (random actions, eyes, faces), recorded."""
+    env = high_five_v0.scripted_env(vision={"width": 32, "height": 32}, expressions=True)
+    try:
+        obs, _ = env.reset(seed=0)
+        rng = np.random.default_rng(0)
+        with Recorder(env, path) as rec:
+            rec.log_reset(obs)
+            for k in range(steps):
+                acts = {}
+                for a in env.agents:
+                    space = env.action_space(a)
+                    space.seed(int(rng.integers(2**31)))
+                    acts[a] = space.sample()
+                obs, rewards, _, _, _ = env.step(acts)
+                rec.log_step(acts, rewards, obs)
+                if not env.agents:
+                    break
+    finally:
+        env.close()
+    return path
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    return _record(tmp_path_factory.mktemp("viewer") / "high_five.rrd")
+
+
+def _no_bodies(path):
+    """A recording of the floor alone: no agent, nothing of the clothes colours."""
+    rec = rr.RecordingStream("mimo_social", recording_id="no-bodies")
+    rec.save(str(path))
+    rec.log("world/scene/floor", rr.Boxes3D(half_sizes=[[2, 2, 0.01]], colors=[[198, 188, 168]],
+                                            fill_mode="solid"), static=True)
+    for k in range(5):
+        rec.set_time("sim_time", duration=0.1 * k)
+        rec.log("agents/nobody/reward", rr.Scalars(0.0))
+    rec.flush()
+    rec.disconnect()
+    return path
+
+
+# ---------------------------------------------------------------- pixels and colours (no browser)
+
+def _page(panel_colour=None, small_colour=None):
+    """A fake viewer page: white, a 1-px grey frame around a large panel (left) and two small
+    ones (right); the large panel optionally holds a patch of ``panel_colour``, lit darker, the
+    small ones ``small_colour``."""
+    img = np.full((540, 960, 3), 255, np.uint8)
+    img[20, :] = img[:, 600] = img[280, 600:] = SEPARATOR_RGB
+    if panel_colour is not None:
+        img[200:260, 200:260] = np.array(panel_colour) * 0.6        # in shadow
+        img[260:280, 200:260] = panel_colour
+    if small_colour is not None:
+        img[60:200, 650:900] = small_colour
+        img[320:500, 650:900] = small_colour
+    return img
+
+
+def test_the_3d_view_is_the_largest_panel_and_only_its_pixels_count():
+    img = _page(panel_colour=BLUE, small_colour=RED)
+    x0, y0, x1, y1 = find_3d_view(img)
+    assert x0 < 10 and 20 < y0 < 30 and 590 < x1 <= 600 and y1 == 540
+    box = (x0, y0, x1, y1)
+    assert colour_pixels(img, BLUE, box) == 60 * 80            # lit and in shadow
+    assert colour_pixels(img, RED, box) == 0                    # only in the small panels
+    assert colour_pixels(img, RED) > 10_000
+
+
+def test_background_floor_skin_and_grey_are_not_clothes_colours():
+    img = np.zeros((4, 1, 3), np.uint8)
+    img[:, 0] = [(255, 255, 255), (198, 188, 168), (240, 199, 171), (140, 140, 140)]
+    for rgb in (BLUE, RED, (115, 191, 115)):
+        assert colour_pixels(img, rgb) == 0
+    hue = colorsys.rgb_to_hsv(*(c / 255 for c in RED))[0] * 360
+    near = colorsys.hsv_to_rgb(((hue + 10) % 360) / 360, 0.55, 0.7)
+    far = colorsys.hsv_to_rgb(((hue + 40) % 360) / 360, 0.55, 0.7)
+    assert colour_pixels(np.array([[[round(255 * c) for c in near]]], np.uint8), RED) == 1
+    assert colour_pixels(np.array([[[round(255 * c) for c in far]]], np.uint8), RED) == 0
+
+
+def test_time_bar_is_the_long_dark_run_at_the_bottom():
+    img = np.full((300, 800, 3), 255, np.uint8)
+    img[285:289, 100:700] = 40
+    x0, x1, y = time_bar(img)
+    assert (x0, x1) == (100, 699) and 285 <= y < 289
+    assert time_bar(np.full((300, 800, 3), 255, np.uint8)) is None
+
+
+def test_the_colours_looked_for_are_the_agents_clothes(recording):
+    colours = recording_colours(recording)
+    assert list(colours) == ["infant_0", "infant_1"]
+    assert np.abs(np.subtract(colours["infant_0"], BLUE)).max() <= 1
+    assert np.abs(np.subtract(colours["infant_1"], RED)).max() <= 1
+
+
+def test_a_recording_without_bodies_has_nothing_to_look_for(tmp_path):
+    path = _no_bodies(tmp_path / "floor.rrd")
+    assert recording_colours(path) == {}
+    with pytest.raises(ViewerCheckError, match="nothing to look for"):
+        check_viewer(path, progress=None)
+
+
+def test_cli_refuses_a_bad_size_and_a_missing_file(tmp_path, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["check-viewer", str(tmp_path / "none.rrd")])
+    assert e.value.code == 2 and "no such file" in capsys.readouterr().err
+    path = _no_bodies(tmp_path / "floor.rrd")
+    for bad, why in (("1920", "WIDTHxHEIGHT"), ("axb", "WIDTHxHEIGHT"),
+                     ("10x10", "width 640 to 7680")):
+        with pytest.raises(SystemExit) as e:
+            main(["check-viewer", str(path), "--size", bad])
+        assert e.value.code == 2 and why in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------------------ in the browser
+
+@needs_browser
+def test_the_web_viewer_shows_both_bodies_in_its_3d_view(recording, tmp_path, capsys):
+    shot = tmp_path / "shot.png"
+    code = main(["check-viewer", str(recording), "--screenshot", str(shot), "--timeout", "150"])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "viewer check passed" in out and "loading the data" in out     # progress shown
+    assert shot.is_file() and shot.stat().st_size > 50_000
+    from PIL import Image
+    assert Image.open(shot).size == (1920, 1080)
+
+
+@needs_browser
+def test_a_recording_without_bodies_fails_the_check(tmp_path):
+    path = _no_bodies(tmp_path / "floor.rrd")
+    shot = tmp_path / "floor.png"
+    with pytest.raises(ViewerCheckError) as e:
+        check_viewer(path, screenshot=shot, colours={"infant_0": BLUE, "infant_1": RED},
+                     timeout=120, settle=8, progress=None)
+    text = str(e.value)
+    assert "does not show the bodies" in text and "infant_0 (#" in text and ": 0 px)" in text
+    assert str(shot) in text and shot.is_file()
+
+
+@pytest.mark.slow
+@needs_browser
+def test_the_demo_in_the_viewer(tmp_path):
+    from mimo_social.experiments.demo import record_demo
+
+    run = record_demo(tmp_path / "demo.rrd", progress=False)
+    result = check_viewer(run.path, screenshot=tmp_path / "demo.png", timeout=300, at=0.5,
+                          wait=5, progress=None)
+    assert len(result.pixels) == 2 and min(result.pixels.values()) >= 150
