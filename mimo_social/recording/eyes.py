@@ -112,12 +112,14 @@ class EyeLog:
     """The eye images of the agents with vision (``eye_left`` / ``eye_right`` observations).
 
     ``env``: the ParallelEnv; ``vision``: its shared vision system; ``agents``: the names of all
-    agents (by index). :attr:`agents` holds the indices of those with eye images.
+    agents (by index); ``single``: the observations given to :meth:`note` are the one agent's
+    (a single-agent adapter's). :attr:`agents` holds the indices of those with eye images.
     """
 
     def __init__(self, env, vision, agents: list[str], eye_format: str = "png",
-                 jpeg_quality: int = 90):
+                 jpeg_quality: int = 90, single: bool = False):
         self.vision = vision
+        self._single = single
         self.names = agents
         self.format = eye_format
         self._jpeg_quality = int(jpeg_quality)
@@ -175,6 +177,8 @@ class EyeLog:
         futures.Future` of those tuples per call, encoded on the worker thread); return how
         many pairs."""
         renders = getattr(self.vision, "renders", None)
+        if self._single and observations is not None:
+            observations = {self.names[0]: observations}
         frames = []
         for i in self.agents:
             if renders is not None:

@@ -51,31 +51,31 @@ Two timelines: ``sim_time`` (simulated seconds: ``data.time`` in the first episo
 without overlap across later resets) and ``step`` (env steps since the recording started, the
 reset of each episode counting as one).
 
-Cost: entity paths, index arrays and the Arrow schema are built once. Per step the recorder only
-copies ``data.xpos``/``data.xquat`` and the motor actions into preallocated buffers, notes an
-expression change (seen as a change of the head materials' texture), looks for new contacts
-between agents (one lookup of all ``data.contact`` geom pairs in a table of "two different
-agents"), with touch on notes which skin points of all agents feel a force (one pass over the
-skin's force array), and with vision on encodes the eye images as PNG (zlib level 1). Every ``flush_every_s`` of simulated time the buffer goes out as
-**one** Arrow record batch with the poses of all bodies, the scalars of all agents and their skin
-points (placed in the world and coloured then, for all rows at once), followed by a batch each of
-expression changes, eye images and contact events of that interval (Rerun splits a batch into one
-chunk per entity, which its file sink writes on its own thread). The next flush first waits until
-the previous one is written (by then it long is), so a crash keeps every row up to
-:attr:`Recorder.flushed_step` and loses at most the last two intervals. Rerun's cost is mostly per
-chunk, i.e. per entity and flush, so the interval sets the price. With 2 infants without images
-(44 entities; measured on a 2-core VM busy with other work, against the plain env's step): 4 s
-(the default) costs 7-8 % in the stepping thread and ~10 % with Rerun's own threads, 13.5 MB
-per simulated minute; 2 s ~9 % and ~12 %. A crash then loses at most 8 simulated seconds (well
-under a second of wall-clock time). Touch adds ~15 MB/min of skin points (``every_k_steps=2``
-halves everything); 2 x 64x64 eyes per infant add ~24 MB/min as PNG.
-``mimo-social bench-recording`` measures cost and file size (see
-:func:`mimo_social.bench.recording_cost.bench_recording`). Call :meth:`Recorder.close` (or use
-``with``): it sends the rest, writes the file's footer and frees the recorder's Rerun stream.
+Cost: paths, index arrays and the Arrow schema are built once. Per step the recorder copies
+``data.xpos``/``data.xquat`` and the motor actions into preallocated buffers, notes an expression
+change (a change of the head materials' texture), looks for contacts between agents (one lookup of
+all ``data.contact`` geom pairs in a table of "two different agents"), with touch notes which skin
+points feel a force (one pass over the force array), and with vision copies the eye images for a
+worker thread that encodes them (:mod:`.eyes`). Every ``flush_every_s`` of simulated time the
+buffer goes out as **one** Arrow record batch (poses of all bodies, scalars, skin points placed,
+coloured and sized then, for all rows at once), then a batch each of expression changes, eye
+images and contact events (Rerun splits a batch into a chunk per entity, written on its own
+thread). The next flush first waits until the previous one is written (long done by then), so a
+crash keeps every row up to :attr:`Recorder.flushed_step`, losing at most two intervals. Rerun's
+cost is mostly per chunk (entity and flush): the interval sets the price. Measured on a 2-core VM
+busy with other work, stepping thread's CPU time against the plain step's: 2 infants without
+images 7-16 % (the busier the machine, the more), ~16 MB per simulated minute (touch adds ~18,
+eyes at 25 Hz ~5: ``mimo-social bench-recording``); with touch and 2 x 64x64 eyes each
+(``mimo-social bench-recording --eyes``, medians of interleaved runs) 4-7 % without eyes, 6 %
+with eyes at 25 Hz (the default; +4 % on the encoder thread), 10 % with every frame
+(``eye_every_k_steps=1``; +14 % on the encoder thread). ``every_k_steps=2`` halves poses and
+skin. Call :meth:`Recorder.close` (or use ``with``): it sends the rest, writes the footer, ends
+the eye encoder's thread and frees the recorder's Rerun stream.
 
 Resources (:mod:`.streams`): an open recorder holds one Rerun stream (2 OS threads, and Rerun's
-file writer thread); :meth:`Recorder.close` frees them, so any number of successive recordings
-cost the threads of one (Rerun's runtime adds 3 threads to the process at its first use). While a
+file writer thread) and, with eyes, one encoder thread; :meth:`Recorder.close` frees them, so any
+number of successive recordings cost the threads of one (Rerun's runtime adds 3 threads to the
+process at its first use). While a
 file is open, Rerun keeps an index entry per chunk for its footer: ~0.3 MB per 1000 steps with 2
 infants (~0.5 MB with 2 x 32x32 eyes each), freed at close; record long runs as episodes
 (:class:`~mimo_social.recording.episodes.RecordingParallelEnv`). A path that cannot be written
@@ -286,7 +286,8 @@ class Recorder:
         self._skin = SkinLog(touch, self.agents) if touch is not None and skin else None
         if self._skin is not None and not self._skin.agents:
             self._skin = None
-        self._eyes = (EyeLog(self.env, vision, self.agents, eye_format, eye_jpeg_quality)
+        self._eyes = (EyeLog(self.env, vision, self.agents, eye_format, eye_jpeg_quality,
+                             self._single)
                       if vision is not None and eyes else None)
         if self._eyes is not None and not self._eyes.agents:
             self._eyes = None
@@ -360,7 +361,8 @@ class Recorder:
             self._note_contacts()
         if self._eyes is not None:
             self._eyes.reset()
-            self._note_eyes(observations)
+            self.eye_frames += self._eyes.note(self._rows.eyes, self._now(), self._global_step,
+                                               observations)
         self._append_row([math.nan] * na, None)
         self.overhead_s += time.perf_counter() - t0
 
@@ -401,7 +403,8 @@ class Recorder:
         if self._contacts is not None:
             self._note_contacts()
         if self._eyes is not None and self._episode_steps % self.eye_every_k_steps == 0:
-            self._note_eyes(observations)
+            self.eye_frames += self._eyes.note(self._rows.eyes, self._now(), self._global_step,
+                                               observations)
         if self._episode_steps % self.every_k_steps == 0:
             reward, self._reward_acc = self._reward_acc, [math.nan] * len(self.agents)
             self._append_row(reward, actions)
@@ -419,11 +422,6 @@ class Recorder:
                                 if end is None else
                                 c.end_all(out, self._last_time, self._global_step, end))
 
-    def _note_eyes(self, observations) -> None:
-        if observations is not None and self._single:
-            observations = {self.agents[0]: observations}
-        self.eye_frames += self._eyes.note(self._rows.eyes, self._now(), self._global_step,
-                                           observations)
 
     @staticmethod
     def _motor_count(space) -> int:
