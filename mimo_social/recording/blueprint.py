@@ -2,9 +2,10 @@
 
 Left (60 % of the width): the 3D world, large, with the skin-force legend beside it (touch
 on); under it the contact events between agents in a wide text log (only the time and the text:
-no column cuts the sentence) beside tabs with the expression log and the action norms. Right:
-one panel per agent with its face and its two eyes side by side (each ~250 px wide, so a 64x64
-eye shows at >= 200 px; rows for one or two agents, a tab per agent for more), and under them
+no column cuts the sentence) beside tabs with the expression logs (one per agent up to three,
+named for it) and the action norms. Right: one panel per agent with its face and its two eyes
+side by side (each ~250 px wide, so a 64x64 eye shows at >= 200 px; rows for one or two
+agents, a tab per agent for more), and under them
 the task's plots (:meth:`~mimo_social.core.task.Task.plots`, one time-series view per plot), the
 touch totals and the recorder's ``scalars``, in a grid (two columns, three beyond four views).
 The selection and blueprint panels start collapsed and the time panel compact (each is one click
@@ -72,7 +73,13 @@ def blueprint(agents: list[str], face_paths: list[str],
         key = keys[0] if len(keys) == 1 else rrb.Vertical(*keys, row_shares=[2] + [1] * (
             len(keys) - 1), name="skin legend")
         world = rrb.Horizontal(world, key, column_shares=[6, 1])
-    logs = [_text_log("/agents", "expressions", entity_column=True),
+    if len(agents) <= 3:   # one log per agent: its name in the title, no path column to cut
+        expressions = rrb.Horizontal(*[_text_log(entity("agents", a, "expression"),
+                                                 f"{a} expression", entity_column=False)
+                                       for a in agents], name="expressions")
+    else:
+        expressions = _text_log("/agents", "expressions", entity_column=True)
+    logs = [expressions,
             rrb.TimeSeriesView(origin="/", name="action norms",
                                contents=[entity("agents", a, "action_norm") for a in agents])]
     bottom = rrb.Tabs(*logs)

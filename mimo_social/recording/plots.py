@@ -6,7 +6,8 @@ or one series (``/plots/<name>``); the reward plot is the recorder's own per-age
 write their values into one preallocated buffer row (at reset: no value); at flush the columns
 go out in the recorder's Arrow batch, like every other scalar. Every per-agent series (the
 plots', rewards, action norms, touch totals) is styled once, statically, with the agent's name
-and its clothes colour, so that the lines match the bodies in the 3D view.
+and its clothes colour, so that the lines match the bodies in the 3D view; the first agent's
+line is the widest, so equal values of two agents show both colours.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ __all__ = ["ONE_SERIES_RGB", "PlotLog", "PlotView", "agent_colors"]
 #: the colour of a series that is no agent's (one value for the pair, a shared reward): a mid
 #: grey, seen on the viewer's light and dark themes alike, and no infant's clothes
 ONE_SERIES_RGB = (105, 105, 110)
-_WIDTH = 2.0
+_WIDTH = 2.0               # px: a line's width (the last agent's)
+_WIDEST = 3.0              # px more for the first agent's line
 
 
 def agent_colors(world) -> list[tuple[int, int, int]]:
@@ -124,8 +126,17 @@ class PlotLog:
             styles[entity("agents", self.agents[i], "touch_total")] = (self.colors[i],
                                                                       self.agents[i])
         for path, (rgb, name) in styles.items():
-            rec.log(path, rr.SeriesLines(colors=[rgb], names=[name], widths=[_WIDTH]),
+            rec.log(path, rr.SeriesLines(colors=[rgb], names=[name], widths=[self._width(name)]),
                     static=True)
+
+    def _width(self, name: str) -> float:
+        """Line width (px): the agents' lines narrower from the first to the last, each drawn
+        over the ones before, so that equal values show as a line with a border in the first
+        agent's colour (both right hands feel the partner at once, touch totals of a contact)."""
+        n = len(self.agents)
+        if name not in self.agents or n == 1:
+            return _WIDTH
+        return _WIDTH + _WIDEST * (n - 1 - self.agents.index(name)) / (n - 1)
 
     # -- per row --------------------------------------------------------------------------------
     def note(self, n: int, stepped: bool = True) -> None:

@@ -175,6 +175,9 @@ def test_series_colours_are_the_clothes_colours(tmp_path):
     record(env, tmp_path / "c.rrd", 3, eyes=False)
     data = read(tmp_path / "c.rrd")
     expect = [rgb(CLOTHES_PALETTE[0]), rgb(own), rgb(CLOTHES_PALETTE[2])]
+    widths = [static(data, f"/plots/head_height/{a}", "SeriesLines:widths")[0]
+              for a in env.possible_agents]
+    assert widths[0] > widths[1] > widths[2] >= 2.0   # later lines drawn inside earlier ones
     for i, agent in enumerate(env.possible_agents):
         for path in (f"/plots/head_height/{agent}", f"/plots/nearest_infant/{agent}",
                      f"/agents/{agent}/action_norm", f"/agents/{agent}/touch_total"):
