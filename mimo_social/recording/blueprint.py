@@ -75,7 +75,7 @@ def blueprint(agents: list[str], face_paths: list[str],
         world = rrb.Horizontal(world, key, column_shares=[6, 1])
     if len(agents) <= 3:   # one log per agent: its name in the title, no path column to cut
         expressions = rrb.Horizontal(*[_text_log(entity("agents", a, "expression"),
-                                                 f"{a} expression", entity_column=False)
+                                                 a, entity_column=False)
                                        for a in agents], name="expressions")
     else:
         expressions = _text_log("/agents", "expressions", entity_column=True)
