@@ -132,8 +132,15 @@ class World:
     :mod:`mimo_social.scenery`, centred on the agents' places; its toys, free bodies
     ``playroom/<toy>``, are in :attr:`room`; with ``floor=False`` no scene at all)."""
 
-    #: the play room's toys may sleep while they rest (MuJoCo's ``mjENBL_SLEEP``, the room only)
+    #: the play room's toys may sleep while they rest (MuJoCo's ``mjENBL_SLEEP``, in the room
+    #: only; agents and a task's props never sleep). Off: it saves ~18 % of the room's physics
+    #: but solving by islands changes every agent's trajectory (the reach controller then misses
+    #: with seed 0); without it agents move exactly as on the floor until they touch the room
+    #: (docs/playroom.md)
     ROOM_SLEEP = False
+    #: MjData counters of the awake part that MuJoCo 4.0.0's pickling of MjData leaves out (a
+    #: copy with sleeping trees then fails in ``mj_sleep``): they travel with the world
+    _SLEEP_COUNTERS = ("nbody_awake", "ntree_awake", "nv_awake")
 
     def __init__(self, agents: Sequence[AgentSetup], props: Sequence[Prop] = (),
                  physics: PhysicsConfig = PhysicsConfig(), floor: bool = True,
@@ -153,11 +160,16 @@ class World:
         # MjData pickles with its model: every model field a task changed (a ball's size and
         # mass, weld and contact settings) and every quantity of the last step (qfrc_bias,
         # contacts, the solver's warm start) travel, so a copy continues exactly.
-        return {"recipe": self._recipe, "data": self.data, "bad_count": self._bad_count}
+        state = {"recipe": self._recipe, "data": self.data, "bad_count": self._bad_count}
+        if self.model.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP:
+            state["awake"] = {k: getattr(self.data, k) for k in self._SLEEP_COUNTERS}
+        return state
 
     def __setstate__(self, state):
         self.__init__(*state["recipe"])   # the index tables, faces and spec of the recipe
         self.data = state["data"]
+        for k, v in state.get("awake", {}).items():
+            setattr(self.data, k, v)
         self.model = self.data.model
         self._bad_count = state["bad_count"]
 
@@ -208,7 +220,7 @@ class World:
             builds.append((build, pose_q))
         for p in props:
             body = self._add_prop(spec, p)
-            if self.room is not None and self.ROOM_SLEEP:
+            if self.room is not None and self.ROOM_SLEEP and not p.fixed:
                 body.sleep = mujoco.mjtSleepPolicy.mjSLEEP_NEVER   # tasks move their props
         self.spec = spec
         self.model = spec.compile()

@@ -5,8 +5,9 @@ along its width, y from its back (+y) to its front (-y), z up. :func:`place` tur
 and puts every part into the world body as a geom ``playroom/<piece>/<part>``: furniture does
 not move. A part is ``contact`` (it collides: what a body or a toy rests on or bumps into) or
 visual only; a visual part that many small ones make (crib slats) is backed by one invisible
-contact panel (group 3: neither drawn by the eyes nor recorded), so a crib side costs the
-collision detector one box, not fifteen.
+contact panel, so a crib side costs the collision detector one box, not fifteen. :func:`place`
+draws every piece as one mesh per material (:mod:`.meshes`) and makes its colliding parts
+invisible boxes (group 3: neither drawn by the eyes nor recorded).
 
 Sizes (half sizes in the parts below; sources for typical dimensions):
 
@@ -23,6 +24,8 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+
+from .meshes import add_box_mesh
 
 __all__ = ["Part", "crib", "low_table", "shelf", "sofa", "window", "PIECES", "place",
            "shelf_boards", "table_top"]
@@ -141,29 +144,32 @@ def _yaw_rot(yaw_deg: float) -> np.ndarray:
 
 def place(spec: mujoco.MjSpec, name: str, parts: list[Part], origin, yaw_deg: float,
           materials: dict[str, str], contact: dict) -> list[str]:
-    """Every part of a piece as a world-body box geom ``playroom/<name>/<part>`` at
-    ``origin`` (x, y, z of the piece's frame) turned by ``yaw_deg`` about z; ``materials``:
-    texture name -> material name; ``contact``: geom attributes of the colliding parts
-    (friction, solref ...). Returns the geom names."""
+    """A piece in the world body at ``origin`` (x, y, z of the piece's frame) turned by
+    ``yaw_deg`` about z: its visible parts merged into one mesh per material
+    (``playroom/<name>/<material>``, :mod:`.meshes`: one geom for the eyes to draw, not
+    dozens), its colliding parts as invisible boxes ``playroom/<name>/<part>`` (group 3) with
+    the geom attributes ``contact`` (friction, solref ...). ``materials``: texture name ->
+    material name. Returns the geom names."""
     R = _yaw_rot(yaw_deg)
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, R.ravel())
-    names = []
+    names, visible = [], {}
     for p in parts:
-        g = spec.worldbody.add_geom(
-            name=f"playroom/{name}/{p.name}", type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=list(p.half), pos=list(np.asarray(origin) + R @ np.asarray(p.centre)),
-            quat=list(quat))
-        if p.rgba is not None:      # a plain colour, no texture
-            g.rgba = list(p.rgba)
-        else:
-            g.material = materials[p.material]
+        centre = np.asarray(origin, float) + R @ np.asarray(p.centre, float)
         if p.contact:
+            g = spec.worldbody.add_geom(name=f"playroom/{name}/{p.name}",
+                                        type=mujoco.mjtGeom.mjGEOM_BOX, size=list(p.half),
+                                        pos=list(centre), quat=list(quat), group=3)
             for k, v in contact.items():
                 setattr(g, k, v)
-        else:
-            g.contype = g.conaffinity = 0
-        if not p.visible:
-            g.group = 3
+            names.append(g.name)
+        if p.visible:
+            key = p.material if p.rgba is None else tuple(p.rgba)
+            visible.setdefault(key, []).append((centre, R, p.half))
+    for k, (key, boxes) in enumerate(visible.items()):
+        plain = isinstance(key, tuple)
+        g = add_box_mesh(spec, f"playroom/{name}/{f'colour_{k}' if plain else key}", boxes,
+                         material=None if plain else materials[key],
+                         rgba=key if plain else None)
         names.append(g.name)
     return names

@@ -25,10 +25,12 @@ is soft (a longer ``solref`` time constant and a wider ``solimp``: it gives unde
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+
+from .meshes import add_box_mesh
 
 __all__ = ["Primitive", "Toy", "TOYS", "add_toy", "rest_height"]
 
@@ -89,7 +91,9 @@ class Toy:
     solref: tuple[float, float] | None = None
     solimp: tuple[float, ...] | None = None
     source: str = ""
-    extra: dict = field(default_factory=dict)
+    #: drawn as one mesh of its box parts (the colliding parts invisible): one geom for the
+    #: eyes to draw instead of many (:mod:`.meshes`)
+    one_mesh: bool = False
 
 
 def _block(name, rgba):
@@ -108,7 +112,7 @@ def _cup(name, rgba, r=0.035, h=0.03, wall=0.002, n=10):
                                axis=(np.cos(a), np.sin(a), 0),
                                name=f"wall_{k}"))
     return Toy(name, tuple(parts), 0.025, rgba, (0.5, 0.005, 0.0001),
-               source="a stacking cup, 2 mm plastic")
+               source="a stacking cup, 2 mm plastic", one_mesh=True)
 
 
 def _teddy(name, rgba):
@@ -190,4 +194,14 @@ def add_toy(spec: mujoco.MjSpec, toy: Toy, pos, yaw_deg: float = 0.0,
             imp = np.array([0.9, 0.95, 0.001, 0.5, 2.0])
             imp[:len(toy.solimp)] = toy.solimp
             g.solimp = imp
+        if toy.one_mesh:
+            g.group = 3
+    if toy.one_mesh:
+        boxes = []
+        for p in toy.parts:
+            a = np.arctan2(p.axis[1], p.axis[0]) if p.shape == "box" else 0.0
+            R = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+            half = p.size if p.shape == "box" else (0.85 * p.size[0], 0.85 * p.size[0], p.size[1])
+            boxes.append((np.asarray(p.pos, float), R, np.asarray(half, float)))
+        add_box_mesh(spec, f"{name}/look", boxes, rgba=toy.rgba, body=body)
     return name

@@ -11,6 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from mimo_social.core.world import World
 from mimo_social.envs import free_play_v0, high_five_v0
 from mimo_social.envs.catalog import CATALOG, entry
 from mimo_social.scenery import SCENES
@@ -205,13 +206,19 @@ def test_the_playroom_is_deterministic_under_a_seed():
     assert np.array_equal(a, b)
 
 
-def test_a_pickled_env_in_the_playroom_continues_identically():
-    env = high_five_v0.scripted_env(scene="playroom", per_agent=ADULT)
+@pytest.mark.parametrize("sleep", [False, True], ids=["awake", "toys_asleep"])
+def test_a_pickled_env_in_the_playroom_continues_identically(sleep, monkeypatch):
+    """Also with the toys asleep (``World.ROOM_SLEEP``, off by default): MuJoCo 4.0.0's pickle
+    of MjData drops the awake counters, which the world carries itself."""
+    monkeypatch.setattr(World, "ROOM_SLEEP", sleep)
+    env = high_five_v0.scripted_env(scene="playroom", per_agent=ADULT,
+                                    task_options={"end_on_touch": False})
     inner = env.unwrapped
     obs, _ = env.reset(seed=2)
     rng = np.random.default_rng(0)
-    for _ in range(5):
+    for _ in range(60):
         env.step(random_actions(env, rng))
+    assert np.any(inner.world.data.tree_asleep >= 0) == sleep   # resting toys asleep
     copy = pickle.loads(pickle.dumps(env))
     assert copy.unwrapped.world.room == inner.world.room
     for _ in range(10):
@@ -220,3 +227,25 @@ def test_a_pickled_env_in_the_playroom_continues_identically():
         o2, r2, *_ = copy.step(a)
         assert r1 == r2
     assert np.array_equal(inner.state(), copy.unwrapped.state())
+
+
+@pytest.mark.parametrize("task", ["reach", "high_five"])
+def test_agents_move_as_on_the_floor_until_they_touch_the_room(task):
+    """The room adds bodies and geoms, not forces: a scripted episode's agents follow the same
+    trajectory in the play room as on the floor (the toys on the mat lie out of their reach)."""
+    e = entry(task)
+    out = {}
+    for scene in ("floor", "playroom"):
+        env = e.scripted_env(scene=scene)
+        inner = env.unwrapped
+        obs, _ = env.reset(seed=0)
+        ctrl = e.controller()
+        ctrl.reset(inner, "infant_0", np.random.default_rng(0))
+        for _ in range(40):
+            obs, _, term, trunc, _ = env.step(
+                {"infant_0": ctrl.act(inner, "infant_0", obs["infant_0"])})
+            if term["infant_0"] or trunc["infant_0"]:
+                break
+        w = inner.world
+        out[scene] = np.concatenate([w.data.qpos[a.qpos_adr] for a in w.agents])
+    np.testing.assert_allclose(out["playroom"], out["floor"], atol=1e-9)
