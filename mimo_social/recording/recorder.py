@@ -225,7 +225,8 @@ class Recorder:
         self.world = world
         self.path = Path(path)
         self.every_k_steps = int(every_k_steps)
-        self._single = isinstance(env, gym.Env) and len(penv.possible_agents) == 1
+        # a Gymnasium adapter: actions, rewards and observations are its learner's, infant_0
+        self._single = isinstance(env, gym.Env)
         self.agents = list(penv.possible_agents)
         self._dt = float(penv.dt)
         self._textured_heads = textured_heads

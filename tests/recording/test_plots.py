@@ -274,3 +274,30 @@ def test_plots_follow_the_scripted_solution(entry, tmp_path):
             if plot.name == "success" and path_.endswith(("/success", "infant_0")):
                 assert max(values) == 1.0, path_
     env.close()
+
+
+def test_scripted_env_and_its_gym_form_record_the_partner_too(tmp_path):
+    """A scripted env (ScriptedPartners lists only its learner) and its Gymnasium form record
+    both agents: the partner's body, plots and skin are in the file."""
+    entry = catalog.entry("high_five")
+    for k, env in enumerate((entry.scripted_env(), entry.gym_env())):
+        obs, _ = env.reset(seed=0)
+        path = tmp_path / f"g{k}.rrd"
+        with Recorder(env, path, eyes=False) as rec:
+            rec.log_reset(obs)
+            for _ in range(3):
+                if k:
+                    action = env.action_space.sample()
+                    obs, reward, *_ = env.step(action)
+                    rec.log_step(action, reward, obs)
+                else:
+                    action = {"infant_0": env.action_space("infant_0").sample()}
+                    obs, reward, *_ = env.step(action)
+                    rec.log_step(action, reward, obs)
+        data = read(path)
+        assert rec.agents == ["infant_0", "infant_1"]
+        assert len(series(data, "/agents/infant_0/reward")) == 3
+        assert len(series(data, "/agents/infant_0/action_norm")) == 3
+        assert len(series(data, "/plots/hand_feels_partner/infant_1")) == 3
+        assert "/world/infant_1/skin" in data
+        env.close()
