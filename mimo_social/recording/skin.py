@@ -36,8 +36,9 @@ __all__ = ["SKIN_FORCE_RANGE", "SKIN_LEGEND_PATH", "SKIN_LEGEND_TEXT_PATH", "SKI
 # SKIN_FORCE_RANGE[0] (yellow, smallest) to SKIN_FORCE_RANGE[1] newtons (dark red, largest)
 SKIN_FORCE_RANGE = (0.01, 10.0)
 SKIN_RADIUS_RANGE = (0.0025, 0.010)               # metres, at the ends of SKIN_FORCE_RANGE
-#: the skin-force legend: a 2D space with a colour bar (``bar``, Image) and a dot per decade of
-#: force (``ticks``, Points2D: coloured, sized and labelled like the skin points)
+#: the skin-force legend: a 2D space with a colour bar (``bar``, Image), a dot per decade of
+#: force (``ticks``, Points2D: coloured and sized like the skin points) and their ``labels``
+#: ("0.01 N" ... "10 N", Points2D under the dots)
 SKIN_LEGEND_PATH = "/legend/skin_force"
 #: the legend's text (TextDocument, markdown): what colour and size say, in newtons
 SKIN_LEGEND_TEXT_PATH = "/legend/skin_force_text"
@@ -96,13 +97,12 @@ def legend_text() -> str:
     for f in _decades():
         t = float(force_level(f))
         name = names[min(names, key=lambda s: abs(s - t))]
-        rows.append(f"| {f:g} N | {name} | {1e3 * float(force_radii(f)):g} mm |")
+        rows.append(f"- **{f:g} N**: {name}, {1e3 * float(force_radii(f)):g} mm")
     lo, hi = SKIN_FORCE_RANGE
     return "\n".join([
         "### Skin forces",
         "Each skin point that feels a force is a dot in the 3D view, **coloured and sized by "
-        "the magnitude of the force** on it (log scale):", "",
-        "| force | colour | radius |", "|---|---|---|", *rows, "",
+        "the magnitude of the force** on it (log scale; colour, radius):", "", *rows, "",
         f"Forces below {lo:g} N look like {lo:g} N, above {hi:g} N like {hi:g} N. "
         "`touch_total`: the summed normal force on an agent's skin (N)."])
 
@@ -150,12 +150,16 @@ class SkinLog:
         rec.log(f"{SKIN_LEGEND_PATH}/bar", rr.Image(np.repeat(rgb[:, None, :], 24, axis=1)),
                 static=True)
         forces = _decades()
-        px_per_m = 1000.0                                      # a dot's radius: 1 px per mm
+        r = 1000.0 * force_radii(forces)                       # a dot's radius: 1 px per mm
+        x, y = 24 + 8 + r.max(), (1.0 - force_level(forces)) * (h - 1)
         rec.log(f"{SKIN_LEGEND_PATH}/ticks", rr.Points2D(
-            np.stack([np.full(len(forces), 24 + 6 + px_per_m * SKIN_RADIUS_RANGE[1]),
-                      (1.0 - force_level(forces)) * (h - 1)], axis=1),
-            radii=px_per_m * force_radii(forces), colors=force_colors(forces),
-            labels=[f"{f:g} N" for f in forces], show_labels=True), static=True)
+            np.stack([np.full(len(forces), x), y], axis=1), radii=r,
+            colors=force_colors(forces)), static=True)
+        # the labels under the dots, in dark grey (a label takes its point's colour)
+        rec.log(f"{SKIN_LEGEND_PATH}/labels", rr.Points2D(
+            np.stack([np.full(len(forces), x), y + r + 4], axis=1), radii=0.5,
+            colors=[(60, 60, 60)], labels=[f"{f:g} N" for f in forces], show_labels=True),
+            static=True)
         rec.log(SKIN_LEGEND_TEXT_PATH, rr.TextDocument(legend_text(),
                                                        media_type=rr.MediaType.MARKDOWN),
                 static=True)

@@ -107,8 +107,12 @@ def test_legend_colour_bar_dots_and_text(touch_file):
     assert tuple(bar[0, 0]) == rgb(force_colors(hi))            # strongest on top
     assert tuple(bar[-1, 0]) == rgb(force_colors(lo))
     ticks = f"{SKIN_LEGEND_PATH}/ticks"
-    labels = column(data, ticks, "Points2D:labels")[0]
-    assert labels == ["0.01 N", "0.1 N", "1 N", "10 N"]
+    labels = f"{SKIN_LEGEND_PATH}/labels"
+    assert column(data, labels, "Points2D:labels")[0] == ["0.01 N", "0.1 N", "1 N", "10 N"]
+    label_xy = np.array(column(data, labels, "Points2D:positions")[0])
+    tick_xy = np.array(column(data, ticks, "Points2D:positions")[0])
+    np.testing.assert_allclose(label_xy[:, 0], tick_xy[:, 0])
+    assert np.all(label_xy[:, 1] > tick_xy[:, 1])                  # each under its dot
     forces = np.array([0.01, 0.1, 1.0, 10.0])
     assert column(data, ticks, "Points2D:colors")[0] == force_colors(forces).tolist()
     radii = column(data, ticks, "Points2D:radii")[0]
@@ -120,8 +124,8 @@ def test_legend_colour_bar_dots_and_text(touch_file):
     text = column(data, SKIN_LEGEND_TEXT_PATH, "TextDocument:text")[0][0]
     media = column(data, SKIN_LEGEND_TEXT_PATH, "TextDocument:media_type")[0][0]
     assert media == "text/markdown"
-    assert "coloured and sized" in text and "| 10 N | dark red | 10 mm |" in text
-    assert "| 0.01 N | yellow | 2.5 mm |" in text
+    assert "coloured and sized" in text and "- **10 N**: dark red, 10 mm" in text
+    assert "- **0.01 N**: yellow, 2.5 mm" in text
 
 
 def test_no_legend_without_touch(tmp_path):
