@@ -171,9 +171,9 @@ class Recorder:
     textured_heads:
         Draw sphere heads as meshes textured with the current face.
     blueprint:
-        Store a default viewer layout: the 3D world; faces; each agent's two eyes side by side
-        (vision on); rewards, touch totals (touch on) and chosen scalars over time; action
-        norms, expressions and contact events in tabs.
+        Store a default viewer layout (:mod:`.blueprint`): the 3D world with the skin legend,
+        the contact events; per agent its face and two eyes; the task's plots, touch totals and
+        chosen scalars over time; expressions and action norms in tabs.
     scalars:
         ``{name: fn}``: ``fn(env) -> float`` is called with the env given here at every logged
         step and goes to ``/scalars/<name>`` (a ``/`` in the name makes sub-paths); NaN: none.
@@ -322,9 +322,8 @@ class Recorder:
         self._head_paths = log_shapes(self._rec, self.world, self._bodies, self._textured_heads)
 
     def blueprint(self) -> rrb.Blueprint:
-        """The default viewer layout: the 3D world beside faces, each agent's two eyes side by
-        side (vision on), time series of rewards, touch totals (touch on) and chosen scalars, and
-        tabs with the action norms, the expressions and the contact events."""
+        """The default viewer layout (:func:`.blueprint.blueprint`; the ``blueprint``
+        parameter)."""
         return _blueprint(self.agents, self._faces.face_paths,
                           self._eyes.paths if self._eyes is not None else None,
                           self._skin.agents if self._skin is not None else (),
