@@ -19,6 +19,7 @@ The configurations (:data:`CONFIGS`; the default set is every one but ``jacobian
 * scaling: ``agents_1``, ``agents_2``, ``agents_4``, ``agents_8`` infants in one world with every
   sense (vision 64^2, touch x1), as the grid otherwise (``agents_1`` is ``v64``: the two are the
   run's noise check);
+* ``playroom_2``: ``agents_2`` in the play room (``scene="playroom"``, docs/playroom.md);
 * ``jacobian_dense_1`` ... ``jacobian_sparse_4``: the dense against the sparse constraint
   Jacobian (free play without props or recording; only with ``--only``).
 """
@@ -159,6 +160,8 @@ CONFIGS: dict[str, BenchConfig] = {c.name: c for c in (
     _scene("agents_2", "2 infants in one world (as agents_1)", n=2, vision=64, group="scaling"),
     _scene("agents_4", "4 infants in one world (as agents_1)", n=4, vision=64, group="scaling"),
     _scene("agents_8", "8 infants in one world (as agents_1)", n=8, vision=64, group="scaling"),
+    _scene("playroom_2", "2 infants in the play room (scene='playroom': furniture, 9 toys; as "
+           "agents_2 otherwise)", n=2, vision=64, group="scenes", scene="playroom"),
     _jacobian("jacobian_dense_1", 1, "dense"),
     _jacobian("jacobian_sparse_1", 1, "sparse"),
     _jacobian("jacobian_dense_4", 4, "dense"),

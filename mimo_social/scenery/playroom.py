@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 
 from .furniture import PIECES, place, shelf_boards, table_top
+from .meshes import add_box_mesh
 from .textures import add_texture
 from .toys import TOYS, add_toy, rest_height
 
@@ -119,31 +120,16 @@ def add_playroom(spec: mujoco.MjSpec, centre=(0.0, 0.0), sleep: bool = False,
     mats = _materials(spec)
     wb = spec.worldbody
     floor_z = -MAT_THICKNESS
-    wb.add_geom(name="playroom/floor", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                pos=[cx, cy, floor_z], size=[ROOM_HALF, ROOM_HALF, 0.1],
-                material=mats["wood_boards"], condim=3)
     mat = wb.add_geom(name="playroom/mat", type=mujoco.mjtGeom.mjGEOM_BOX,
                       pos=[cx, cy, -MAT_THICKNESS / 2],
                       size=[MAT_HALF, MAT_HALF, MAT_THICKNESS / 2], material=mats["foam_mat"])
     for k, v in MAT_CONTACT.items():
         setattr(mat, k, v)
-    h, t = WALL_HEIGHT / 2, WALL_THICKNESS / 2
-    L = ROOM_HALF + WALL_THICKNESS
-    for name, pos, size in (("north", (0, ROOM_HALF + t), (L, t)),
-                            ("south", (0, -ROOM_HALF - t), (L, t)),
-                            ("east", (ROOM_HALF + t, 0), (t, L)),
-                            ("west", (-ROOM_HALF - t, 0), (t, L))):
-        wb.add_geom(name=f"playroom/wall_{name}", type=mujoco.mjtGeom.mjGEOM_BOX,
-                    pos=[cx + pos[0], cy + pos[1], floor_z + h], size=[size[0], size[1], h],
-                    material=mats["wallpaper"])
-    ceiling = wb.add_geom(name="playroom/ceiling", type=mujoco.mjtGeom.mjGEOM_BOX,
-                          pos=[cx, cy, floor_z + WALL_HEIGHT + t], size=[L, L, t],
-                          rgba=[0.98, 0.97, 0.94, 1.0])
-    ceiling.contype = ceiling.conaffinity = 0
     furniture = []
     for name, kind, x, y, yaw in layout["furniture"]:
         furniture += place(spec, name, PIECES[kind](), (cx + x, cy + y, floor_z), yaw, mats,
                            FURNITURE_CONTACT)
+    _add_shell(spec, (cx, cy), mats)
     toys, spares = [], {}
     for spot in layout["toys"]:
         toy = TOYS[spot.toy]
@@ -155,6 +141,36 @@ def add_playroom(spec: mujoco.MjSpec, centre=(0.0, 0.0), sleep: bool = False,
             spares[body] = (cx + sx, cy + sy, sz + rest_height(toy) + 0.001)
     _add_lights(spec, (cx, cy))
     return Room((cx, cy), tuple(toys), spares, tuple(furniture))
+
+
+def _add_shell(spec, centre, mats) -> None:
+    """The boards' floor, the walls (drawn as one mesh, colliding as four invisible boxes)
+    and the ceiling (drawn only)."""
+    wb = spec.worldbody
+    cx, cy = centre
+    floor_z = -MAT_THICKNESS
+    wb.add_geom(name="playroom/floor", type=mujoco.mjtGeom.mjGEOM_PLANE,
+                pos=[cx, cy, floor_z], size=[ROOM_HALF, ROOM_HALF, 0.1],
+                material=mats["wood_boards"], condim=3)
+    h, t = WALL_HEIGHT / 2, WALL_THICKNESS / 2
+    L = ROOM_HALF + WALL_THICKNESS
+    boxes = []
+    for name, pos, size in (("north", (0, ROOM_HALF + t), (L, t)),
+                            ("south", (0, -ROOM_HALF - t), (L, t)),
+                            ("east", (ROOM_HALF + t, 0), (t, L)),
+                            ("west", (-ROOM_HALF - t, 0), (t, L))):
+        centre = (cx + pos[0], cy + pos[1], floor_z + h)
+        wb.add_geom(name=f"playroom/wall_{name}", type=mujoco.mjtGeom.mjGEOM_BOX,
+                    pos=list(centre), size=[size[0], size[1], h], group=3)
+        boxes.append((centre, np.eye(3), (size[0], size[1], h)))
+    add_box_mesh(spec, "playroom/walls", boxes, material=mats["wallpaper"])
+    # lit from below by nothing but the ambient light: a little emission keeps it white
+    spec.add_material(name="playroom/ceiling", rgba=[0.98, 0.97, 0.94, 1.0], emission=0.35,
+                      specular=0.0)
+    ceiling = wb.add_geom(name="playroom/ceiling", type=mujoco.mjtGeom.mjGEOM_BOX,
+                          pos=[cx, cy, floor_z + WALL_HEIGHT + t], size=[L, L, t],
+                          material="playroom/ceiling")
+    ceiling.contype = ceiling.conaffinity = 0
 
 
 def _add_lights(spec, centre) -> None:
