@@ -7,6 +7,7 @@ without eyes and with eyes side by side in one run
 from __future__ import annotations
 
 import argparse
+import sys
 
 from ..bench import recording_cost
 from ._args import comma_choices, output_dir, positive_float
@@ -40,6 +41,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.eyes and args.only:
+        print("bench-recording: --only picks configurations of the size and cost table; --eyes "
+              "runs its own comparison; allowed: one of them", file=sys.stderr)
+        return 2
     if args.eyes:
         results = recording_cost.bench_eye_cost(args.sim_seconds or 40.0, folder=args.folder)
         print(recording_cost.format_eye_table(results))

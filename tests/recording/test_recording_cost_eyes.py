@@ -61,3 +61,8 @@ def test_bench_recording_eyes_command_prints_the_table(tmp_path, capsys, monkeyp
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("| run | ms/step (wall) |")
     assert [x.split(" | ")[0] for x in lines[2:]] == [f"| {k}" for k in EYE_COST_VARIANTS]
+
+
+def test_bench_recording_eyes_with_only_is_refused(capsys):
+    assert cli.main(["bench-recording", "--eyes", "--only", "0"]) == 2
+    assert "--only" in capsys.readouterr().err
