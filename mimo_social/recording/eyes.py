@@ -13,10 +13,11 @@ every logged frame up to :attr:`~mimo_social.recording.Recorder.flushed_step`; `
 the worker and ends its thread.
 
 Rate: by default eye images are logged at :data:`EYE_LOG_HZ` (25 per simulated second, every
-4th step at the default 100 Hz control): a replay is watched at about video rate, and encoding
-every frame of two agents' four 64x64 eyes at 100 Hz would cost about a fifth of a step's CPU
-time (``mimo-social bench-recording --eyes``). ``Recorder(eye_every_k_steps=1)`` logs every
-rendered frame.
+4th step at the default 100 Hz control): a replay is watched at about video rate, and every
+frame of two agents' four 64x64 eyes at 100 Hz costs about a quarter of the step's CPU time
+(10-13 % on the stepping thread, 14-15 % on the encoder's; at 25 Hz 6-9 % and 4 %, of which the
+recording without eyes takes 4-7 %: ``mimo-social bench-recording --eyes`` on a 2-core VM busy
+with other work). ``Recorder(eye_every_k_steps=1)`` logs every rendered frame.
 """
 
 from __future__ import annotations
