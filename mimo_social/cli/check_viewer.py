@@ -71,6 +71,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--wait", metavar="S", type=_number(0.0, None, "seconds >= 0"), default=0.0,
                         help="seconds more to wait after the bodies show, before the screenshot "
                              "(images decoded, playback on; default 0)")
+    parser.add_argument("--no-baseline", action="store_true",
+                        help="skip the second page (the recording without the agents): count "
+                             "every pixel of the clothes' hues, the scene's included (faster)")
     parser.set_defaults(func=run)
     return parser
 
@@ -78,7 +81,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     try:
         result = check_viewer(args.file, screenshot=args.screenshot, timeout=args.timeout,
-                              size=args.size, at=args.at, wait=args.wait)
+                              size=args.size, at=args.at, wait=args.wait,
+                              baseline=not args.no_baseline)
     except ViewerCheckError as e:
         print(f"mimo-social check-viewer: FAILED: {e}", file=sys.stderr)
         return 1

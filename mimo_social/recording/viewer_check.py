@@ -4,10 +4,12 @@
 header: the viewer's page comes from another port), starts ``rerun --web-viewer`` on a free port
 (no browser opened; the process group is ended at the end, also on errors), opens the viewer
 with the file's URL in headless Chromium (driven by Playwright; software WebGL through
-SwiftShader), and polls screenshots until the 3D view shows every agent's clothes colour (read
-from the recording's own body shapes). It then saves the screenshot and returns a
-:class:`ViewerCheck`; when the colours do not show up it raises :class:`ViewerCheckError`
-naming what is missing and where the screenshot is.
+SwiftShader), and polls screenshots until the data is loaded and the 3D view shows every
+agent's clothes colour (read from the recording's own body shapes). A play room has furniture
+and toys of the same hues (a red table, a blue sofa), so it then opens, the same way, a copy of
+the recording without the agents (``rerun rrd filter``; same layout and camera) and counts
+only the pixels the bodies add. It returns a :class:`ViewerCheck`, or raises
+:class:`ViewerCheckError` naming what is missing and where the screenshots are.
 
 The 3D view is found in the screenshot itself: the viewer separates its panels with one-pixel
 lines of one grey; the largest region they enclose is the 3D view in the layout of
@@ -20,20 +22,12 @@ the grey grid do not count.
 from __future__ import annotations
 
 import colorsys
-import functools
-import importlib.util
-import http.server
 import io
 import os
 import shutil
-import signal
-import socket
-import subprocess
-import sys
-import threading
+import tempfile
 import time
 import urllib.parse
-import urllib.request
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,10 +36,12 @@ from typing import Callable
 import numpy as np
 
 from ..util.checks import ConfigError, check_int, check_number
+from .web_viewer import (Browser, FileServer, ViewerCheckError, WebViewer, browser_missing,
+                         chromium_path, without_agents)
 
 __all__ = ["HUE_TOLERANCE", "MIN_PIXELS", "ViewerCheck", "ViewerCheckError", "browser_missing",
            "check_viewer", "chromium_path", "colour_pixels", "find_3d_view", "time_bar",
-           "recording_colours"]
+           "recording_colours", "without_agents"]
 
 #: degrees of hue a lit pixel may be off its clothes colour
 HUE_TOLERANCE = 14.0
@@ -53,36 +49,43 @@ HUE_TOLERANCE = 14.0
 MIN_PIXELS = 150
 #: the colour of the viewer's one-pixel panel separators (light theme)
 SEPARATOR_RGB = (223, 223, 223)
-_CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
-
-
-class ViewerCheckError(RuntimeError):
-    """The viewer did not show what it should (or could not be started)."""
 
 
 @dataclass(frozen=True)
 class ViewerCheck:
-    """What :func:`check_viewer` saw: the screenshot, each agent's colour (``#rrggbb``) and its
-    pixel count in the 3D view, the 3D view's box (x0, y0, x1, y1 in page pixels), the seconds
-    from opening the page to the data loaded (None when the viewer did not say) and to the
-    bodies shown, and the page size."""
+    """What :func:`check_viewer` saw: the screenshot; each agent's colour (``#rrggbb``); the
+    pixels of that colour in the 3D view (``shown``), in the same view of the recording without
+    the agents (``scene``: furniture and toys of the same hue; None without a baseline) and
+    their difference, the bodies' own (``pixels``); the 3D view's box (x0, y0, x1, y1 in page
+    pixels); the seconds from opening the page to the data loaded (None when the viewer did not
+    say) and to the colours shown; the baseline's load time; the page size."""
 
     screenshot: Path
     colours: dict[str, str]
     pixels: dict[str, int]
+    shown: dict[str, int]
+    scene: dict[str, int] | None
     view: tuple[int, int, int, int]
     load_s: float | None
     shown_s: float
+    baseline_load_s: float | None
     size: tuple[int, int]
     console_errors: list[str] = field(default_factory=list)
 
     def format(self) -> str:
-        found = ", ".join(f"{a} {self.colours[a]} {n} px" for a, n in self.pixels.items())
+        def one(a):
+            scene = "" if self.scene is None else (
+                f" ({self.shown[a]} in the view, {self.scene[a]} without the agents)")
+            return f"{a} {self.colours[a]} {self.pixels[a]} px{scene}"
+
         load = "?" if self.load_s is None else f"{self.load_s:.1f} s"
+        base = ("" if self.scene is None else ", the recording without the agents after "
+                + ("?" if self.baseline_load_s is None else f"{self.baseline_load_s:.1f} s"))
         x0, y0, x1, y1 = self.view
         return (f"viewer check passed: the 3D view ({x1 - x0}x{y1 - y0} px at {x0},{y0}) shows "
-                f"{found}\ndata loaded after {load}, bodies shown after {self.shown_s:.1f} s "
-                f"(page {self.size[0]}x{self.size[1]})\nscreenshot: {self.screenshot}")
+                f"the bodies: " + ", ".join(one(a) for a in self.pixels)
+                + f"\ndata loaded after {load} (colours shown after {self.shown_s:.1f} s){base};"
+                f" page {self.size[0]}x{self.size[1]}\nscreenshot: {self.screenshot}")
 
 
 # ----------------------------------------------------------------------------------- colours
@@ -91,10 +94,11 @@ def _hex(rgb) -> str:
     return "#" + "".join(f"{int(round(c)):02x}" for c in rgb[:3])
 
 
-def recording_colours(path: str | Path, min_saturation: float = 0.25) -> dict[str, tuple]:
+def recording_colours(path: str | Path, min_saturation: float = 0.35) -> dict[str, tuple]:
     """Each agent's clothes colour (RGB, 0-255) as logged in the recording: the most common
-    saturated colour of the static shapes under ``/world/<agent>/`` (skin, eyes and grey are
-    not saturated). Agents without a saturated colour are left out."""
+    saturated colour of the static shapes under ``/world/<agent>/`` that not every agent
+    wears (skin, eyes and grey are not saturated, or shared). Agents without one are left
+    out."""
     from rerun.chunk import RrdReader
 
     counts: dict[str, Counter] = {}
@@ -110,11 +114,12 @@ def recording_colours(path: str | Path, min_saturation: float = 0.25) -> dict[st
                     for packed in cell or []:
                         rgb = ((packed >> 24) & 255, (packed >> 16) & 255, (packed >> 8) & 255)
                         counts.setdefault(parts[1], Counter())[rgb] += 1
+    shared = set.intersection(*(set(c) for c in counts.values())) if len(counts) > 1 else set()
     out = {}
     for agent, counter in counts.items():
         for rgb, _ in counter.most_common():
             _, s, _ = colorsys.rgb_to_hsv(*(c / 255 for c in rgb))
-            if s >= min_saturation:
+            if s >= min_saturation and rgb not in shared:
                 out[agent] = rgb
                 break
     return dict(sorted(out.items(), key=lambda kv: _natural(kv[0])))
@@ -185,138 +190,6 @@ def find_3d_view(img: np.ndarray) -> tuple[int, int, int, int]:
     return (int(xs.start), int(ys.start), int(xs.stop), int(ys.stop))
 
 
-# ------------------------------------------------------------------------------- processes
-
-def chromium_path() -> str | None:
-    """The Chromium (or Chrome) executable: ``$MIMO_SOCIAL_CHROMIUM`` or the first on the
-    ``PATH``; None when there is none."""
-    env = os.environ.get("MIMO_SOCIAL_CHROMIUM")
-    if env:
-        return env if Path(env).is_file() else None
-    return next((p for p in map(shutil.which, _CHROMIUM_NAMES) if p), None)
-
-
-def browser_missing() -> str | None:
-    """Why the check cannot run here (no Chromium, no Playwright, no ``rerun``), else None."""
-    if chromium_path() is None:
-        return f"no Chromium executable ({' / '.join(_CHROMIUM_NAMES)} on the PATH)"
-    if importlib.util.find_spec("playwright") is None:
-        return "the Python package playwright is not installed (pip install playwright)"
-    if _rerun_command() is None:
-        return "the `rerun` executable (pip install rerun-sdk) is not on the PATH"
-    return None
-
-
-def _rerun_command() -> list[str] | None:
-    exe = shutil.which("rerun") or str(Path(sys.executable).with_name("rerun"))
-    return [exe] if Path(exe).is_file() else None
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-class _CorsHandler(http.server.SimpleHTTPRequestHandler):
-    """Serves one folder with ``Access-Control-Allow-Origin: *``, quietly."""
-
-    def end_headers(self):
-        self.send_header("Access-Control-Allow-Origin", "*")
-        super().end_headers()
-
-    def log_message(self, format, *args):  # noqa: A002 - the base class's name
-        pass
-
-
-class _FileServer:
-    """The recording's folder over HTTP on a free port, in a thread."""
-
-    def __init__(self, folder: Path):
-        handler = functools.partial(_CorsHandler, directory=str(folder))
-        self.server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
-        self.port = self.server.server_address[1]
-        self.thread = threading.Thread(target=self.server.serve_forever, daemon=True)
-
-    def __enter__(self):
-        self.thread.start()
-        return self
-
-    def __exit__(self, *exc):
-        self.server.shutdown()
-        self.server.server_close()
-
-
-class _WebViewer:
-    """``rerun --web-viewer`` on free ports, in its own process group (ended on exit)."""
-
-    def __init__(self, log_path: Path, start_timeout: float = 30.0):
-        self.port, self.grpc_port = _free_port(), _free_port()
-        self.log_path, self.start_timeout = log_path, start_timeout
-        self.proc: subprocess.Popen | None = None
-
-    def __enter__(self):
-        cmd = _rerun_command()
-        if cmd is None:
-            raise ViewerCheckError("the `rerun` executable (pip install rerun-sdk) is not on "
-                                   "the PATH")
-        env = dict(os.environ, BROWSER="true")       # the viewer opens no browser itself
-        self._log = open(self.log_path, "wb")
-        self.proc = subprocess.Popen(
-            cmd + ["--web-viewer", "--web-viewer-port", str(self.port), "--port",
-                   str(self.grpc_port), "--bind", "127.0.0.1", "--hide-welcome-screen"],
-            stdin=subprocess.DEVNULL, stdout=self._log, stderr=subprocess.STDOUT, env=env,
-            start_new_session=True)
-        try:
-            self._wait_up()
-        except BaseException:
-            self.__exit__()
-            raise
-        return self
-
-    def _wait_up(self):
-        deadline = time.monotonic() + self.start_timeout
-        while time.monotonic() < deadline:
-            if self.proc.poll() is not None:
-                raise ViewerCheckError(f"`rerun --web-viewer` exited with code "
-                                       f"{self.proc.returncode}: {self._tail()}")
-            try:
-                with urllib.request.urlopen(f"http://127.0.0.1:{self.port}/", timeout=2):
-                    return
-            except OSError:
-                time.sleep(0.3)
-        raise ViewerCheckError(f"`rerun --web-viewer` did not answer on port {self.port} "
-                               f"within {self.start_timeout:.0f} s: {self._tail()}")
-
-    def _tail(self) -> str:
-        try:
-            return self.log_path.read_text(errors="replace")[-600:].strip() or "(no output)"
-        except OSError:
-            return "(no output)"
-
-    def __exit__(self, *exc):
-        if self.proc is not None and self.proc.poll() is None:
-            for sig, wait in ((signal.SIGTERM, 5.0), (signal.SIGKILL, 5.0)):
-                try:
-                    os.killpg(self.proc.pid, sig)       # the group started here, no other
-                except ProcessLookupError:
-                    break
-                try:
-                    self.proc.wait(wait)
-                    break
-                except subprocess.TimeoutExpired:
-                    continue
-        self._log.close()
-
-
-def _launch_args() -> list[str]:
-    args = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist",
-            "--disable-dev-shm-usage", "--no-first-run"]
-    if hasattr(os, "geteuid") and os.geteuid() == 0:
-        args.append("--no-sandbox")                  # Chromium refuses its sandbox as root
-    return args
-
-
 # ---------------------------------------------------------------------------------- the check
 
 def _parse_size(size) -> tuple[int, int]:
@@ -335,20 +208,22 @@ def _parse_size(size) -> tuple[int, int]:
 def check_viewer(path: str | Path, screenshot: str | Path | None = None, timeout: float = 180.0,
                  size="1920x1080", colours: dict | None = None, min_pixels: int = MIN_PIXELS,
                  settle: float = 20.0, view=None, at: float | None = None, wait: float = 0.0,
-                 poll: float = 2.0, progress: Callable[[str], None] | None = print
-                 ) -> ViewerCheck:
+                 baseline: bool = True, poll: float = 2.0,
+                 progress: Callable[[str], None] | None = print) -> ViewerCheck:
     """Open ``path`` in Rerun's web viewer in headless Chromium and check that its 3D view shows
     the bodies (module docstring). ``screenshot``: where the PNG goes (default: next to the
-    recording, ``<name>_viewer.png``); ``timeout``: seconds to wait for the bodies; ``size``:
+    recording, ``<name>_viewer.png``); ``timeout``: seconds to wait for each page; ``size``:
     the page, ``"WxH"`` or (w, h); ``colours``: agent -> RGB (0-255) to look for (default:
     :func:`recording_colours`); ``min_pixels``: of each colour, scaled with the page's area
     from 1920x1080; ``settle``: seconds to wait once the viewer has said the data is loaded
     before failing; ``view``: the 3D view's box (x0, y0, x1, y1) instead of finding it;
-    ``at``: once the bodies show, move the time cursor to this fraction (0 to 1) of the
-    recording (a click on the collapsed time panel's bar; playback goes on from there);
-    ``wait``: seconds more before the last screenshot (the check is made on that one);
-    ``progress``: called with a line per poll (None: quiet). Raises :class:`ViewerCheckError`
-    when the bodies do not show (the screenshot is saved first) or a tool is missing."""
+    ``at``: once loaded, move the time cursor to this fraction (0 to 1) of the recording (a
+    click on the collapsed time panel's bar; playback goes on from there); ``wait``: seconds
+    more before the last screenshot; ``baseline``: also open the recording without the agents
+    (:func:`without_agents`) and count only the pixels the bodies add (a play room has
+    furniture and toys of the clothes' hues); ``progress``: called with a line per poll (None:
+    quiet). Raises :class:`ViewerCheckError` when the bodies do not show (the screenshots are
+    saved first) or a tool is missing."""
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"viewer check: recording {str(path)!r} is not a file")
@@ -374,13 +249,34 @@ def check_viewer(path: str | Path, screenshot: str | Path | None = None, timeout
     say = progress or (lambda _line: None)
     say(f"viewer check of {path} ({path.stat().st_size / 1e6:.1f} MB) at {width}x{height}; "
         f"looking for " + ", ".join(f"{a} {_hex(c)}" for a, c in colours.items()))
-    with _FileServer(path.resolve().parent) as files, \
-            _WebViewer(shot.with_name(shot.stem + "_rerun.log")) as viewer:
-        file_url = f"http://127.0.0.1:{files.port}/{urllib.parse.quote(path.name)}"
-        page_url = (f"http://127.0.0.1:{viewer.port}/?url="
-                    f"{urllib.parse.quote(file_url, safe='')}")
-        with _Page(page_url, file_url, (width, height), colours, view, say) as page:
-            return _watch(page, shot, need, timeout, settle, at, wait, poll)
+    opts = dict(size=(width, height), colours=colours, view=view, say=say, timeout=timeout,
+                settle=settle, at=at, wait=wait, poll=poll, need=need)
+    with tempfile.TemporaryDirectory(prefix="mimo_viewer_check_") as tmp:
+        folder = Path(tmp)
+        try:
+            os.symlink(path.resolve(), folder / "recording.rrd")
+        except OSError:
+            shutil.copyfile(path, folder / "recording.rrd")
+        if baseline:
+            without_agents(path, list(colours), folder / "without_agents.rrd")
+        with FileServer(folder) as files, \
+                WebViewer(shot.with_name(shot.stem + "_rerun.log")) as viewer, \
+                Browser() as browser:
+            def urls(name):
+                file_url = f"http://127.0.0.1:{files.port}/{name}"
+                return (f"http://127.0.0.1:{viewer.port}/?url="
+                        f"{urllib.parse.quote(file_url, safe='')}", file_url)
+
+            first = _watch(browser, *urls("recording.rrd"), shot, must_show=True, **opts)
+            scene = None
+            if baseline and all(n >= need for n in first.counts.values()):
+                say("the same view of the recording without the agents (the scene's own "
+                    "pixels of these colours):")
+                scene = _watch(browser, *urls("without_agents.rrd"),
+                               shot.with_name(shot.stem + "_without_agents.png"),
+                               must_show=False, view=first.box, **{k: v for k, v in opts.items()
+                                                                   if k != "view"})
+    return _verdict(first, scene, shot, colours, need, (width, height))
 
 
 def time_bar(img: np.ndarray) -> tuple[int, int, int] | None:
@@ -399,111 +295,121 @@ def time_bar(img: np.ndarray) -> tuple[int, int, int] | None:
     return best
 
 
-class _Page:
-    """Headless Chromium on the viewer's page; :meth:`look` screenshots and counts."""
+@dataclass
+class _Seen:
+    """One page's last look: the image, the 3D view's box, each agent's pixel count, when the
+    data loaded and when the colours first showed, the console errors."""
 
-    def __init__(self, page_url, file_url, size, colours, view, say):
-        self.page_url, self.file_url, self.size = page_url, file_url, size
-        self.colours, self.view, self.say = colours, view, say
-        self.loaded: list[float] = []
-        self.errors: list[str] = []
-
-    def __enter__(self):
-        from playwright.sync_api import sync_playwright
-
-        self._pw = sync_playwright().start()
-        try:
-            self.browser = self._pw.chromium.launch(executable_path=chromium_path(),
-                                                    headless=True, args=_launch_args())
-            self.page = self.browser.new_page(
-                viewport={"width": self.size[0], "height": self.size[1]}, color_scheme="light")
-            self.page.on("console", self._on_console)
-            self.t0 = time.monotonic()
-            self.page.goto(self.page_url, wait_until="load", timeout=120_000)
-        except BaseException:
-            self.__exit__()
-            raise
-        return self
-
-    def __exit__(self, *exc):
-        try:
-            if getattr(self, "browser", None) is not None:
-                self.browser.close()
-        finally:
-            self._pw.stop()
-
-    def _on_console(self, msg):
-        text = msg.text
-        if "has finished" in text and self.file_url in text and not self.loaded:
-            self.loaded.append(self.elapsed())
-        elif msg.type == "error" and "ERR_NAME_NOT_RESOLVED" not in text \
-                and "Failed to fetch" not in text:    # the page's web fonts: no network
-            self.errors.append(text.strip().splitlines()[0][:200])
-
-    def elapsed(self) -> float:
-        return time.monotonic() - self.t0
-
-    def look(self):
-        """A screenshot, the 3D view's box and each agent's pixel count in it."""
-        from PIL import Image
-
-        img = np.asarray(Image.open(io.BytesIO(self.page.screenshot())).convert("RGB"))
-        box = tuple(self.view) if self.view is not None else find_3d_view(img)
-        counts = {a: colour_pixels(img, c, box) for a, c in self.colours.items()}
-        state = (f"data loaded after {self.loaded[0]:.1f} s" if self.loaded
-                 else "loading the data")
-        self.say(f"  {self.elapsed():5.1f} s: {state}; 3D view {box[2] - box[0]}x"
-                 f"{box[3] - box[1]} px; " + ", ".join(f"{a} {n} px" for a, n in counts.items()))
-        return img, box, counts
+    img: np.ndarray
+    box: tuple
+    counts: dict
+    loaded: float | None
+    shown: float | None
+    elapsed: float
+    errors: list
 
 
-def _watch(page: _Page, shot: Path, need: int, timeout, settle, at, wait, poll) -> ViewerCheck:
+def _watch(browser: Browser, page_url: str, file_url: str, shot: Path, *, size, colours,
+           view, say, timeout, settle, at, wait, poll, need, must_show: bool) -> _Seen:
+    """Open the viewer on ``file_url``, poll screenshots until the data is loaded and (when
+    ``must_show``) every colour shows, or it gives up; then ``at`` and ``wait``; save the last
+    screenshot to ``shot``."""
     from PIL import Image
 
-    streak, first_shown = 0, None
-    while True:                                   # until the bodies show, or it gives up
-        time.sleep(poll)
-        img, box, counts = page.look()
-        elapsed = page.elapsed()
-        shown = all(n >= need for n in counts.values())
-        streak = streak + 1 if shown else 0
-        if shown and first_shown is None:
-            first_shown = elapsed
-        if streak >= 2 and (page.loaded or streak >= 5):     # shown on polls in a row
-            break
-        if (page.errors and not page.loaded) or elapsed >= timeout \
-                or (page.loaded and elapsed - page.loaded[0] >= settle):
-            break
-    if streak >= 2 and (at is not None or wait > 0):
-        bar = time_bar(img)
-        if at is not None and bar is not None:
-            x0, x1, y = bar
-            page.page.mouse.click(x0 + at * (x1 - x0), y)
-            page.say(f"  time cursor moved to {at:.0%} of the recording")
-        elif at is not None:
-            page.say("  no time bar found: the time cursor stays")
-        end = time.monotonic() + wait
-        while True:
+    loaded: list[float] = []
+    errors: list[str] = []
+    page = browser.browser.new_page(viewport={"width": size[0], "height": size[1]},
+                                    color_scheme="light")
+    t0 = time.monotonic()
+
+    def on_console(msg):
+        text = msg.text
+        if "has finished" in text and file_url in text and not loaded:
+            loaded.append(time.monotonic() - t0)
+        elif msg.type == "error" and "ERR_NAME_NOT_RESOLVED" not in text \
+                and "Failed to fetch" not in text:    # the page's web fonts: no network
+            errors.append(text.strip().splitlines()[0][:200])
+
+    def look():
+        img = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB"))
+        box = tuple(view) if view is not None else find_3d_view(img)
+        counts = {a: colour_pixels(img, c, box) for a, c in colours.items()}
+        state = f"data loaded after {loaded[0]:.1f} s" if loaded else "loading the data"
+        say(f"  {time.monotonic() - t0:5.1f} s: {state}; 3D view {box[2] - box[0]}x"
+            f"{box[3] - box[1]} px; " + ", ".join(f"{a} {n} px" for a, n in counts.items()))
+        return img, box, counts
+
+    try:
+        page.on("console", on_console)
+        page.goto(page_url, wait_until="load", timeout=timeout * 1000)
+        streak, shown_at, prev, after = 0, None, None, 0
+        while True:     # until two polls after the load agree (and show), or it gives up
             time.sleep(poll)
-            img, box, counts = page.look()
-            if time.monotonic() >= end:
+            after += bool(loaded)                 # this poll's screenshot is after the load
+            img, box, counts = look()
+            elapsed = time.monotonic() - t0
+            ok = all(n >= need for n in counts.values()) or not must_show
+            if ok and must_show and shown_at is None:
+                shown_at = elapsed
+            steady = prev is not None and all(
+                abs(n - prev[a]) <= max(need, 0.15 * max(n, prev[a])) for a, n in counts.items())
+            prev = counts
+            streak = streak + 1 if ok and steady else 0
+            if streak and (after >= 2 or streak >= 4):
                 break
-        streak = 2 if all(n >= need for n in counts.values()) else 0
+            if (errors and not loaded) or elapsed >= timeout \
+                    or (loaded and elapsed - loaded[0] >= settle):
+                break
+        if loaded and (at is not None or wait > 0):
+            bar = time_bar(img)
+            if at is not None and bar is not None:
+                x0, x1, y = bar
+                page.mouse.click(x0 + at * (x1 - x0), y)
+                say(f"  time cursor moved to {at:.0%} of the recording")
+            elif at is not None:
+                say("  no time bar found: the time cursor stays")
+            end = time.monotonic() + wait
+            while True:
+                time.sleep(poll)
+                img, box, counts = look()
+                if time.monotonic() >= end:
+                    break
+    finally:
+        page.close()
     Image.fromarray(img).save(shot)
-    loaded = page.loaded[0] if page.loaded else None
-    if streak >= 2:
-        return ViewerCheck(shot, {a: _hex(c) for a, c in page.colours.items()}, counts, box,
-                           loaded, first_shown, page.size, page.errors)
-    colours = page.colours
-    lacking = [f"{a} ({_hex(colours[a])}: {counts[a]} px)" for a in colours if counts[a] < need]
-    if page.errors and not page.loaded:
-        why = "the viewer reported errors: " + " | ".join(page.errors[:3])
-    else:
-        why = (f"after {page.elapsed():.0f} s ("
-               + (f"data loaded after {loaded:.1f} s" if loaded is not None
-                  else "the viewer never said the data had loaded") + ")")
-    x0, y0, x1, y1 = box
-    raise ViewerCheckError(
-        f"the 3D view (x {x0}-{x1}, y {y0}-{y1} of the page) does not show the bodies: too few "
-        f"pixels (need {need}) of " + ", ".join(lacking or ["(none)"])
-        + f"; {why}; screenshot: {shot}")
+    return _Seen(img, box, counts, loaded[0] if loaded else None, shown_at,
+                 time.monotonic() - t0, errors)
+
+
+def _verdict(first: _Seen, scene: _Seen | None, shot: Path, colours: dict, need: int,
+             size) -> ViewerCheck:
+    """The check's result, or :class:`ViewerCheckError` saying what was missing."""
+    x0, y0, x1, y1 = first.box
+    where = f"the 3D view (x {x0}-{x1}, y {y0}-{y1} of the page)"
+    if first.errors and first.loaded is None:
+        raise ViewerCheckError("the viewer reported errors before the data loaded: "
+                               + " | ".join(first.errors[:3]) + f"; screenshot: {shot}")
+    own = dict(first.counts)
+    if scene is not None and scene.loaded is None:
+        raise ViewerCheckError(f"the recording without the agents (the baseline) did not load "
+                               f"within the timeout; screenshot: {shot}")
+    if scene is not None:
+        own = {a: max(0, n - scene.counts[a]) for a, n in first.counts.items()}
+    lacking = [a for a in colours if own[a] < need]
+    if lacking:
+        when = (f"after {first.elapsed:.0f} s ("
+                + (f"data loaded after {first.loaded:.1f} s" if first.loaded is not None
+                   else "the viewer never said the data had loaded") + ")")
+        what = ", ".join(
+            f"{a} ({_hex(colours[a])}: {first.counts[a]} px"
+            + ("" if scene is None else f", {scene.counts[a]} px without the agents") + ")"
+            for a in lacking)
+        base = "" if scene is None else (
+            f"; without the agents: {shot.with_name(shot.stem + '_without_agents.png')}")
+        raise ViewerCheckError(
+            f"{where} does not show the bodies: too few pixels (need {need} the bodies add) of "
+            f"{what}; {when}; screenshot: {shot}{base}")
+    return ViewerCheck(shot, {a: _hex(c) for a, c in colours.items()}, own, dict(first.counts),
+                       None if scene is None else dict(scene.counts), first.box, first.loaded,
+                       first.shown if first.shown is not None else first.elapsed,
+                       None if scene is None else scene.loaded, size, first.errors)

@@ -1,9 +1,11 @@
 """The real-browser check of a replay (issue 20): Rerun's web viewer in headless Chromium shows
-the bodies of a recording in its 3D view, and does not pass a recording without bodies.
+the bodies of a play-room recording in its 3D view, and does not pass a recording without
+bodies.
 
 The browser tests are skipped (with the reason) where Chromium, Playwright or ``rerun`` is
-missing; the pixel and colour tests run everywhere. Each browser test takes about 30-60 s here
-(software WebGL); the demo's full recording is the slow variant.
+missing; the pixel and colour tests run everywhere. The default browser tests take about 2 min
+here (software WebGL, two shared cores); the demo's recording, and the play room without its
+agents (the scene alone has furniture of the clothes' hues), are the slow variants.
 """
 
 from __future__ import annotations
@@ -20,16 +22,17 @@ from mimo_social.envs import high_five_v0
 from mimo_social.recording.recorder import Recorder
 from mimo_social.recording.viewer_check import (SEPARATOR_RGB, ViewerCheckError, browser_missing,
                                                 check_viewer, colour_pixels, find_3d_view,
-                                                recording_colours, time_bar)
+                                                recording_colours, time_bar, without_agents)
 
 MISSING = browser_missing()
 needs_browser = pytest.mark.skipif(MISSING is not None, reason=f"viewer check: {MISSING}")
 BLUE, RED = (tuple(round(255 * c) for c in CLOTHES_PALETTE[i][:3]) for i in (0, 1))
 
 
-def _record(path, steps: int = 300):
-    """A short run of the high five pair (random actions, eyes, faces), recorded."""
-    env = high_five_v0.scripted_env(vision={"width": 32, "height": 32}, expressions=True)
+def _record(path, steps: int = 200):
+    """A short run of the high five pair in the play room (random actions, eyes, faces)."""
+    env = high_five_v0.scripted_env(vision={"width": 32, "height": 32}, expressions=True,
+                                    scene="playroom")
     try:
         obs, _ = env.reset(seed=0)
         rng = np.random.default_rng(0)
@@ -52,7 +55,7 @@ def _record(path, steps: int = 300):
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
-    return _record(tmp_path_factory.mktemp("viewer") / "high_five.rrd")
+    return _record(tmp_path_factory.mktemp("viewer") / "play_room.rrd")
 
 
 def _no_bodies(path):
@@ -151,6 +154,7 @@ def test_the_web_viewer_shows_both_bodies_in_its_3d_view(recording, tmp_path, ca
     out = capsys.readouterr().out
     assert code == 0, out
     assert "viewer check passed" in out and "loading the data" in out     # progress shown
+    assert "without the agents" in out                  # the scene's own pixels were counted
     assert shot.is_file() and shot.stat().st_size > 50_000
     from PIL import Image
     assert Image.open(shot).size == (1920, 1080)
@@ -164,8 +168,19 @@ def test_a_recording_without_bodies_fails_the_check(tmp_path):
         check_viewer(path, screenshot=shot, colours={"infant_0": BLUE, "infant_1": RED},
                      timeout=120, settle=8, progress=None)
     text = str(e.value)
-    assert "does not show the bodies" in text and "infant_0 (#" in text and ": 0 px)" in text
+    assert "does not show the bodies" in text and "infant_0 (#" in text and ": 0 px" in text
     assert str(shot) in text and shot.is_file()
+
+
+@pytest.mark.slow
+@needs_browser
+def test_the_play_room_without_its_agents_fails_the_check(recording, tmp_path):
+    """The room has a blue sofa and red table legs: their pixels alone must not pass."""
+    empty = without_agents(recording, ["infant_0", "infant_1"], tmp_path / "empty.rrd")
+    with pytest.raises(ViewerCheckError, match="without the agents") as e:
+        check_viewer(empty, screenshot=tmp_path / "empty.png", colours=recording_colours(recording),
+                     timeout=150, settle=10, progress=None)
+    assert "does not show the bodies" in str(e.value)
 
 
 @pytest.mark.slow
@@ -174,6 +189,7 @@ def test_the_demo_in_the_viewer(tmp_path):
     from mimo_social.experiments.demo import record_demo
 
     run = record_demo(tmp_path / "demo.rrd", progress=False)
-    result = check_viewer(run.path, screenshot=tmp_path / "demo.png", timeout=300, at=0.5,
-                          wait=5, progress=None)
+    result = check_viewer(run.path, screenshot=tmp_path / "demo.png", timeout=300, at=0.3,
+                          wait=4, progress=None)
     assert len(result.pixels) == 2 and min(result.pixels.values()) >= 150
+    assert result.scene is not None

@@ -1,0 +1,205 @@
+"""The processes of the viewer check (:mod:`mimo_social.recording.viewer_check`): the
+recording's folder over HTTP with a CORS header, ``rerun --web-viewer`` on free ports, headless
+Chromium driven by Playwright, and ``rerun rrd filter`` for a copy without the agents."""
+
+from __future__ import annotations
+
+import functools
+import http.server
+import importlib.util
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+import urllib.request
+from pathlib import Path
+
+__all__ = ["Browser", "FileServer", "ViewerCheckError", "WebViewer", "browser_missing",
+           "chromium_path", "launch_args", "rerun_command", "without_agents"]
+
+_CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
+
+
+class ViewerCheckError(RuntimeError):
+    """The viewer did not show what it should (or could not be started)."""
+
+
+
+def chromium_path() -> str | None:
+    """The Chromium (or Chrome) executable: ``$MIMO_SOCIAL_CHROMIUM`` or the first on the
+    ``PATH``; None when there is none."""
+    env = os.environ.get("MIMO_SOCIAL_CHROMIUM")
+    if env:
+        return env if Path(env).is_file() else None
+    return next((p for p in map(shutil.which, _CHROMIUM_NAMES) if p), None)
+
+
+def browser_missing() -> str | None:
+    """Why the check cannot run here (no Chromium, no Playwright, no ``rerun``), else None."""
+    if chromium_path() is None:
+        return f"no Chromium executable ({' / '.join(_CHROMIUM_NAMES)} on the PATH)"
+    if importlib.util.find_spec("playwright") is None:
+        return "the Python package playwright is not installed (pip install playwright)"
+    if rerun_command() is None:
+        return "the `rerun` executable (pip install rerun-sdk) is not on the PATH"
+    return None
+
+
+def rerun_command() -> list[str] | None:
+    exe = shutil.which("rerun") or str(Path(sys.executable).with_name("rerun"))
+    return [exe] if Path(exe).is_file() else None
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class _CorsHandler(http.server.SimpleHTTPRequestHandler):
+    """Serves one folder with ``Access-Control-Allow-Origin: *``, quietly."""
+
+    def end_headers(self):
+        self.send_header("Access-Control-Allow-Origin", "*")
+        super().end_headers()
+
+    def log_message(self, format, *args):  # noqa: A002 - the base class's name
+        pass
+
+
+class FileServer:
+    """The recording's folder over HTTP on a free port, in a thread."""
+
+    def __init__(self, folder: Path):
+        handler = functools.partial(_CorsHandler, directory=str(folder))
+        self.server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+        self.port = self.server.server_address[1]
+        self.thread = threading.Thread(target=self.server.serve_forever, daemon=True)
+
+    def __enter__(self):
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.server.shutdown()
+        self.server.server_close()
+
+
+class WebViewer:
+    """``rerun --web-viewer`` on free ports, in its own process group (ended on exit)."""
+
+    def __init__(self, log_path: Path, start_timeout: float = 30.0):
+        self.port, self.grpc_port = _free_port(), _free_port()
+        self.log_path, self.start_timeout = log_path, start_timeout
+        self.proc: subprocess.Popen | None = None
+
+    def __enter__(self):
+        cmd = rerun_command()
+        if cmd is None:
+            raise ViewerCheckError("the `rerun` executable (pip install rerun-sdk) is not on "
+                                   "the PATH")
+        env = dict(os.environ, BROWSER="true")       # the viewer opens no browser itself
+        self._log = open(self.log_path, "wb")
+        self.proc = subprocess.Popen(
+            cmd + ["--web-viewer", "--web-viewer-port", str(self.port), "--port",
+                   str(self.grpc_port), "--bind", "127.0.0.1", "--hide-welcome-screen"],
+            stdin=subprocess.DEVNULL, stdout=self._log, stderr=subprocess.STDOUT, env=env,
+            start_new_session=True)
+        try:
+            self._wait_up()
+        except BaseException:
+            self.__exit__()
+            raise
+        return self
+
+    def _wait_up(self):
+        deadline = time.monotonic() + self.start_timeout
+        while time.monotonic() < deadline:
+            if self.proc.poll() is not None:
+                raise ViewerCheckError(f"`rerun --web-viewer` exited with code "
+                                       f"{self.proc.returncode}: {self._tail()}")
+            try:
+                with urllib.request.urlopen(f"http://127.0.0.1:{self.port}/", timeout=2):
+                    return
+            except OSError:
+                time.sleep(0.3)
+        raise ViewerCheckError(f"`rerun --web-viewer` did not answer on port {self.port} "
+                               f"within {self.start_timeout:.0f} s: {self._tail()}")
+
+    def _tail(self) -> str:
+        try:
+            return self.log_path.read_text(errors="replace")[-600:].strip() or "(no output)"
+        except OSError:
+            return "(no output)"
+
+    def __exit__(self, *exc):
+        if self.proc is not None and self.proc.poll() is None:
+            for sig, wait in ((signal.SIGTERM, 5.0), (signal.SIGKILL, 5.0)):
+                try:
+                    os.killpg(self.proc.pid, sig)       # the group started here, no other
+                except ProcessLookupError:
+                    break
+                try:
+                    self.proc.wait(wait)
+                    break
+                except subprocess.TimeoutExpired:
+                    continue
+        self._log.close()
+
+
+def launch_args() -> list[str]:
+    args = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist",
+            "--disable-dev-shm-usage", "--no-first-run"]
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        args.append("--no-sandbox")                  # Chromium refuses its sandbox as root
+    return args
+
+
+class Browser:
+    """Headless Chromium driven by Playwright (software WebGL)."""
+
+    def __enter__(self):
+        from playwright.sync_api import sync_playwright
+
+        self._pw = sync_playwright().start()
+        try:
+            self.browser = self._pw.chromium.launch(executable_path=chromium_path(),
+                                                    headless=True, args=launch_args())
+        except BaseException:
+            self._pw.stop()
+            raise
+        return self
+
+    def __exit__(self, *exc):
+        try:
+            self.browser.close()
+        finally:
+            self._pw.stop()
+
+
+def without_agents(path: str | Path, agents, out: str | Path) -> Path:
+    """A copy of the recording at ``out`` without the entities under ``/world/<agent>/`` of
+    ``agents`` (their bodies and skin points; ``rerun rrd filter``): the scene alone, in the
+    recording's own layout."""
+    from rerun.chunk import RrdReader
+
+    prefixes = tuple(f"/world/{a}" for a in agents)
+    drop = sorted({c.entity_path for c in RrdReader(Path(path)).stream().to_chunks()
+                   if c.entity_path.startswith(prefixes)
+                   and c.entity_path[len("/world/"):].split("/")[0] in agents})
+    cmd = rerun_command()
+    if cmd is None:
+        raise ViewerCheckError("the `rerun` executable (pip install rerun-sdk) is not on the PATH")
+    args = cmd + ["rrd", "filter", str(path), "-o", str(out)]
+    for e in drop:
+        args += ["--drop-entity", e]
+    done = subprocess.run(args, stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                          timeout=300)
+    if done.returncode != 0 or not Path(out).is_file():
+        raise ViewerCheckError(f"`rerun rrd filter` could not remove the agents from {path}: "
+                               f"{done.stderr.strip()[-400:]}")
+    return Path(out)
