@@ -4,8 +4,9 @@ Each toy is a :class:`Toy` (data): its primitives in the toy's frame, its total 
 over the primitives by volume), its friction and contact softness. :func:`add_toy` puts one in
 a spec as a free body ``playroom/<toy>`` (geoms ``playroom/<toy>`` or ``playroom/<toy>/<part>``).
 
-Sizes and masses, with where they come from (an 18-month-old's hand is about 9.5 cm long and
-4.5 cm across the palm, so one hand closes round 3-5 cm and two hands hold 8-15 cm):
+Sizes and masses, with where they come from (the infant's own mitten hand is 10 cm long, palm
+5.6 cm and fingers 4.6 cm, and 4.2 cm wide: one hand closes round 3-5 cm, two hands hold
+8-15 cm):
 
 ===========  ==============================  =======  ========  ==============================
 toy          shape                           mass     friction  reasoning
