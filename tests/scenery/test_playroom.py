@@ -249,3 +249,21 @@ def test_agents_move_as_on_the_floor_until_they_touch_the_room(task):
         w = inner.world
         out[scene] = np.concatenate([w.data.qpos[a.qpos_adr] for a in w.agents])
     np.testing.assert_allclose(out["playroom"], out["floor"], atol=1e-9)
+
+
+@pytest.mark.parametrize("posture", ["standing", "lying"])
+def test_eight_infants_fit_and_crowded_toys_go_to_their_spare_places(posture):
+    """Free play's circle of 8 infants fits inside the furniture; the mat's toys in its way
+    start on the furniture instead, and stay there."""
+    env = free_play_v0.parallel_env(n_agents=8, posture=posture, scene="playroom")
+    w = env.world
+    moved = w.toys_moved
+    assert moved and set(moved) <= set(w.room.spares)
+    env.reset(seed=0)
+    for _ in range(30):
+        env.step(zero_actions(env))
+    for body in moved:
+        xyz = w.data.xpos[w.model.body(body).id]
+        spare = np.array(w.room.spares[body])
+        assert np.linalg.norm(xyz[:2] - spare[:2]) < 0.05, body
+        assert abs(xyz[2] - spare[2]) < 0.02, body     # on the furniture, not fallen off
