@@ -33,13 +33,13 @@ from pettingzoo import ParallelEnv
 from ..body.actuation import MODELS as ACTUATION_MODELS
 from ..expressions.faces import EXPRESSIONS
 from ..render.scene import make_renderer
-from ..scenery import SCENES, inside_camera
+from ..scenery import SCENES, check_scene_clear, inside_camera
 from ..senses import SENSES
 from ..util.checks import check_choice, check_seed, number_array, show
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
 from .delays import MotorDelay, SenseDelay, delay_steps, fill_sensor_history
 from .task import Task, agent_user_settings, check_start_poses
-from .world import World, check_scene_clear
+from .world import World
 
 __all__ = ["MimoParallelEnv", "TIMING_KEYS"]
 

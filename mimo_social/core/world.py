@@ -24,11 +24,11 @@ from ..body.builder import axis_angle_quat, build_infant, quat_mul
 from ..body.postures import posture_joints, posture_pitch
 from ..expressions.switch import FaceTextures
 from ..scenery import SCENES, add_playroom, clear_toys
-from ..util.checks import ConfigError, check_choice
+from ..util.checks import check_choice
 from .config import AgentConfig, PhysicsConfig
 from .delays import delay_sensors, delay_steps, fill_sensor_history
 
-__all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE", "check_scene_clear"]
+__all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE"]
 
 CLOTHES_PALETTE = (
     (0.35, 0.55, 0.85, 1.0), (0.90, 0.45, 0.40, 1.0), (0.45, 0.75, 0.45, 1.0),
@@ -527,43 +527,3 @@ class World:
 
     def expression_of(self, agent: int) -> int:
         return self.faces.shown(self.model, self.agents[agent].head_material)
-
-
-#: how deep (m) an agent or a task's prop may start in the play room's walls or furniture
-ROOM_OVERLAP_DEPTH = 0.005
-
-
-def check_scene_clear(world: World) -> None:
-    """In the play room, a ConfigError naming the agent, where it stands and the piece of
-    furniture or wall when it starts inside one (deeper than :data:`ROOM_OVERLAP_DEPTH`);
-    nothing on the floor. (A task's props are left out: tasks place them at reset.) Reads a
-    scratch copy of the state."""
-    if world.room is None:
-        return
-    m = world.model
-    d = mujoco.MjData(m)
-    d.qpos[:] = world.data.qpos
-    mujoco.mj_kinematics(m, d)
-    mujoco.mj_collision(m, d)
-    n = d.ncon
-    names = [m.geom(g).name for g in range(m.ngeom)]
-    fixed = np.array([m.geom_bodyid[g] == 0 and names[g].startswith("playroom/")
-                      and names[g] not in ("playroom/floor", "playroom/mat")
-                      for g in range(m.ngeom)])
-    c = d.contact
-    for k in np.argsort(c.dist[:n]):
-        g1, g2 = int(c.geom1[k]), int(c.geom2[k])
-        if -c.dist[k] <= ROOM_OVERLAP_DEPTH or fixed[g1] == fixed[g2]:
-            continue
-        room, other = (g1, g2) if fixed[g1] else (g2, g1)
-        i = int(world.geom_agent[other])
-        if i < 0:
-            continue
-        s = world.agent_setups[i]
-        who = f"agent {world.names[i]} (placed at ({s.position[0]:.2f}, {s.position[1]:.2f}) m)"
-        cx, cy = world.room.centre
-        raise ConfigError(
-            f"scene='playroom': {who} starts inside the room's {names[room][len('playroom/'):]!r}"
-            f" ({100 * -c.dist[k]:.1f} cm deep); the room is centred at ({cx:.2f}, {cy:.2f}) m, "
-            "its furniture along the walls 1.2-2 m from the centre: place the agents closer "
-            "together (their position settings) or use scene='floor'")

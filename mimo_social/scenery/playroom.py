@@ -14,7 +14,7 @@ task's agents are: the middle of the room stays free for them). The layout is da
 * toys (:mod:`.toys`): free bodies ``playroom/<toy>``; those on the mat lie 0.55-0.7 m to the
   side of the room's centre line (the line the tasks put their agents on), and any that would
   start within :data:`TOY_CLEARANCE` of an agent or a task's prop is put on its spare place on the
-  furniture instead (:func:`clear_toys`).
+  furniture instead (:func:`mimo_social.scenery.clearance.clear_toys`).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from .textures import add_texture
 from .toys import TOYS, add_toy, rest_height
 
 __all__ = ["ROOM_HALF", "WALL_HEIGHT", "MAT_THICKNESS", "MAT_HALF", "LAYOUT", "ToySpot",
-           "Room", "add_playroom", "clear_toys", "TOY_CLEARANCE", "inside_camera"]
+           "Room", "add_playroom", "TOY_CLEARANCE", "inside_camera"]
 
 ROOM_HALF = 2.0          # m, from the centre to the inner face of each wall
 WALL_HEIGHT = 2.4
@@ -183,29 +183,6 @@ def _add_lights(spec, centre) -> None:
                                  castshadow=False, type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
     spec.visual.headlight.ambient = [0.42, 0.42, 0.42]
     spec.visual.headlight.diffuse = [0.22, 0.22, 0.22]
-
-
-def clear_toys(model, data, room: Room, other_geoms: np.ndarray, qpos: np.ndarray) -> list[str]:
-    """Move every toy of ``room`` whose start comes within :data:`TOY_CLEARANCE` (bounding
-    spheres) of one of ``other_geoms`` (the agents' and the task's props' geoms; ``data``'s
-    kinematics up to date) to its spare place: written into ``qpos`` (the world's initial
-    one). Returns the toys moved."""
-    if not len(other_geoms):
-        return []
-    moved = []
-    pos, rb = data.geom_xpos[other_geoms], model.geom_rbound[other_geoms]
-    for body in room.toys:
-        if body not in room.spares:
-            continue
-        b = model.body(body).id
-        geoms = np.flatnonzero(model.geom_bodyid == b)
-        gap = (np.linalg.norm(data.geom_xpos[geoms][:, None] - pos[None], axis=2)
-               - model.geom_rbound[geoms][:, None] - rb[None])
-        if gap.min() < TOY_CLEARANCE:
-            q = int(model.jnt_qposadr[model.body_jntadr[b]])
-            qpos[q:q + 3] = room.spares[body]
-            moved.append(body)
-    return moved
 
 
 def inside_camera(room_centre, lookat, distance: float, azimuth: float, elevation: float,

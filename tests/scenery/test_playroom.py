@@ -55,7 +55,12 @@ def toy_qpos(world, toy: str) -> int:
 
 
 # -- the bare floor stays the default ----------------------------------------------------------
-def test_the_floor_is_the_default_and_unchanged():
+def test_the_floor_is_the_default_and_unchanged(monkeypatch):
+    import mimo_social.core.world as world_module
+
+    def no_room(*args, **kwargs):
+        raise AssertionError("the floor scene built a play room")
+    monkeypatch.setattr(world_module, "add_playroom", no_room)
     default = free_play_v0.parallel_env()
     floor = free_play_v0.parallel_env(scene="floor")
     assert default.scene == "floor" and floor.scene == "floor" and default.world.room is None
