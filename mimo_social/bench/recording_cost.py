@@ -147,14 +147,15 @@ EYE_COST_VARIANTS = {
 def bench_eye_cost(sim_seconds: float = 40.0, rounds: int | None = None, seed: int = 0,
                    variants: Mapping[str, dict | None] | None = None,
                    config: Mapping | None = None, folder: str | Path | None = None,
-                   flush_every_s: float = 4.0) -> list[dict]:
+                   flush_every_s: float = 4.0, turn: int = 50) -> list[dict]:
     """Side by side in one run: the plain step and the same env recorded without and with eyes
     (default :data:`EYE_COST_VARIANTS`, env :data:`EYE_COST_CONFIG`).
 
-    One env per variant, all taking the same smooth random actions; they take turns in blocks
-    of one flush interval (``flush_every_s`` simulated seconds, so that every block holds one
-    flush), the order rotating each round; ``rounds`` blocks each (default: ``sim_seconds``
-    split into blocks). Per variant: the medians over the rounds of the wall-clock and the
+    One env per variant, all taking the same smooth random actions. A round is one flush
+    interval (``flush_every_s`` simulated seconds, so that every round of a recorded env holds
+    one flush) of every env, run in turns of ``turn`` steps (the order rotating each round), so
+    that the envs of a round meet the same load of the machine; ``rounds`` rounds (default:
+    ``sim_seconds`` split into flush intervals). Per variant: the medians over the rounds of the wall-clock and the
     stepping thread's CPU ms per step, and of the cost against the plain step in the same round
     (``main_cpu_pct``: stepping thread's CPU time, which a busy machine hardly changes;
     ``wall_pct``); the eye encoder's CPU ms per step (its worker thread) and its share of the
@@ -183,18 +184,23 @@ def bench_eye_cost(sim_seconds: float = 40.0, rounds: int | None = None, seed: i
                 rec.log_reset(obs)
             recs.append(rec)
         for r in range(rounds):
-            steps = range(r * block, (r + 1) * block)
-            for k in [(r + j) % len(names) for j in range(len(names))]:
-                env, rec = envs[k], recs[k]
-                t0, c0 = time.perf_counter(), time.thread_time()
-                for s in steps:
-                    actions = {a: {"motors": acts[i][0][s], "expression": int(acts[i][1][s])}
-                               for i, a in enumerate(agents)}
-                    o, rewards, _, _, _ = env.step(actions)
-                    if rec is not None:
-                        rec.log_step(actions, rewards, o)
-                wall[k].append(1e3 * (time.perf_counter() - t0) / block)
-                cpu[k].append(1e3 * (time.thread_time() - c0) / block)
+            w_round, c_round = [0.0] * len(names), [0.0] * len(names)
+            for first in range(r * block, (r + 1) * block, turn):
+                for k in [(r + j) % len(names) for j in range(len(names))]:
+                    env, rec = envs[k], recs[k]
+                    t0, c0 = time.perf_counter(), time.thread_time()
+                    for s in range(first, min(first + turn, (r + 1) * block)):
+                        actions = {a: {"motors": acts[i][0][s],
+                                       "expression": int(acts[i][1][s])}
+                                   for i, a in enumerate(agents)}
+                        o, rewards, _, _, _ = env.step(actions)
+                        if rec is not None:
+                            rec.log_step(actions, rewards, o)
+                    w_round[k] += time.perf_counter() - t0
+                    c_round[k] += time.thread_time() - c0
+            for k in range(len(names)):
+                wall[k].append(1e3 * w_round[k] / block)
+                cpu[k].append(1e3 * c_round[k] / block)
         for rec in recs:
             if rec is not None:
                 rec.close()
@@ -215,6 +221,7 @@ def bench_eye_cost(sim_seconds: float = 40.0, rounds: int | None = None, seed: i
             "variant": name, "steps": n_steps, "rounds": rounds, "sim_s": n_steps * dt,
             "ms_per_step": med(wall[k]), "cpu_ms_per_step": med(cpu[k]),
             "main_cpu_pct": 100.0 * med([c / b - 1.0 for c, b in zip(cpu[k], cpu[base])]),
+            "round_cpu_pct": [100.0 * (c / b - 1.0) for c, b in zip(cpu[k], cpu[base])],
             "wall_pct": 100.0 * med([w / b - 1.0 for w, b in zip(wall[k], wall[base])]),
             "encoder_ms_per_step": enc_ms,
             "encoder_pct": 100.0 * enc_ms / med(cpu[base]),

@@ -3,8 +3,9 @@
 Images are taken from the observations given to the recorder when they hold them, else from
 the env's vision system, and stored as PNG (lossless), JPEG (lossy, needs Pillow) or raw pixels.
 
-Cost: the stepping thread only copies the pixels (a few microseconds an image) and hands them
-to one worker thread (:class:`EyeEncoder`), which encodes them meanwhile (zlib and numpy let go
+Cost: the stepping thread only copies the pixels (a few microseconds an image) and hands them,
+those of :data:`EYE_BATCH_STEPS` logged steps at a time, to one worker thread
+(:class:`EyeEncoder`), which encodes them meanwhile (zlib and numpy let go
 of Python's lock while they work, so the worker runs beside the simulation). Each frame keeps
 the time and step it was taken at: the batch of an interval is built with explicit ``sim_time``
 and ``step`` columns (Rerun's own time context is per thread and never used here). A flush waits
@@ -45,12 +46,15 @@ from .columns import (
     sparse_column,
 )
 
-__all__ = ["EYES", "EYE_FORMATS", "EYE_LOG_HZ", "EyeEncoder", "EyeLog", "eye_every_k_steps"]
+__all__ = ["EYES", "EYE_BATCH_STEPS", "EYE_FORMATS", "EYE_LOG_HZ", "EyeEncoder", "EyeLog",
+           "FrameBatch", "eye_every_k_steps"]
 
 EYE_FORMATS = ("png", "jpeg", "raw")   # how eye images are stored (see Recorder)
 EYES = ("left", "right")
 #: default rate (frames per simulated second) of eye images in a recording (see the docstring)
 EYE_LOG_HZ = 25.0
+#: the frames of this many logged steps go to the encoder's thread together
+EYE_BATCH_STEPS = 8
 
 
 def eye_every_k_steps(dt: float, every_k_steps: int, value: int | None = None) -> int:
@@ -69,6 +73,17 @@ def _encode_jpeg(image: np.ndarray, quality: int) -> bytes:
     out = io.BytesIO()
     PILImage.fromarray(np.ascontiguousarray(image)).save(out, format="JPEG", quality=quality)
     return out.getvalue()
+
+
+class FrameBatch:
+    """Eye frames (pixels) gathered over a few logged steps, handed to the encoder together
+    (fewer wake-ups of its thread), then the :class:`~concurrent.futures.Future` of them."""
+
+    __slots__ = ("frames", "future")
+
+    def __init__(self):
+        self.frames: list = []
+        self.future: Future | None = None
 
 
 class EyeEncoder:
@@ -93,14 +108,16 @@ class EyeEncoder:
     def submit(self, frames: list) -> Future:
         return self._pool.submit(self._run, frames)
 
-    @staticmethod
-    def resolve(items: list) -> list:
-        """``items`` with every Future replaced by the frames it gives (waiting for them; an
-        error in the worker is raised here)."""
+    def resolve(self, items: list) -> list:
+        """``items`` with every :class:`FrameBatch` replaced by its encoded frames (handed to
+        the worker now if it was not yet; waits for them; an error in the worker is raised
+        here)."""
         out = []
         for x in items:
-            if isinstance(x, Future):
-                out += x.result()
+            if isinstance(x, FrameBatch):
+                if x.future is None:
+                    x.future = self.submit(x.frames)
+                out += x.future.result()
             else:
                 out.append(x)
         return out
@@ -141,6 +158,7 @@ class EyeLog:
                                   "'png' needs nothing") from None
         self._renders: dict[int, int] = {}
         self._encoder: EyeEncoder | None = None      # started at the first frame to encode
+        self._batch: FrameBatch | None = None         # frames not yet handed to the encoder
         self._encoded_cpu_s = 0.0
         self._build_schema()
 
@@ -173,10 +191,10 @@ class EyeLog:
         self._renders = {}
 
     def note(self, out: list, t: float, step: int, observations) -> int:
-        """Append to ``out`` the eye images, as (t, step, agent, left, right), of every agent
-        with vision rendered anew since the last time (PNG / JPEG: one :class:`~concurrent.
-        futures.Future` of those tuples per call, encoded on the worker thread); return how
-        many pairs."""
+        """Note the eye images, as (t, step, agent, left, right), of every agent with vision
+        rendered anew since the last time (raw: appended to ``out``; PNG / JPEG: gathered in a
+        :class:`FrameBatch` that ``out`` holds, encoded on the worker thread); return how many
+        pairs."""
         renders = getattr(self.vision, "renders", None)
         if self._single and observations is not None:
             observations = {self.names[0]: observations}
@@ -198,10 +216,16 @@ class EyeLog:
             return 0
         if self.format == "raw":
             out += [(t, s, i, left.tobytes(), right.tobytes()) for t, s, i, left, right in frames]
-        else:
-            if self._encoder is None:
-                self._encoder = EyeEncoder(self.encode)
-            out.append(self._encoder.submit(frames))
+            return len(frames)
+        if self._encoder is None:
+            self._encoder = EyeEncoder(self.encode)
+        batch = self._batch
+        if batch is None or batch.future is not None:
+            batch = self._batch = FrameBatch()
+            out.append(batch)
+        batch.frames += frames
+        if len(batch.frames) >= EYE_BATCH_STEPS * len(self.agents):
+            batch.future = self._encoder.submit(batch.frames)
         return len(frames)
 
     def close(self) -> None:
@@ -227,7 +251,9 @@ class EyeLog:
     def batch(self, eyes) -> pa.RecordBatch:
         """Eye images as one record batch: a row per step with images, per agent and eye its
         image where rendered, no data elsewhere (waits for the frames still being encoded)."""
-        eyes = EyeEncoder.resolve(eyes)
+        self._batch = None                             # (the next frames start a new one)
+        if self._encoder is not None:
+            eyes = self._encoder.resolve(eyes)
         steps = sorted({step: t for t, step, _, _, _ in eyes}.items())
         row_of = {step: r for r, (step, _) in enumerate(steps)}
         cells = {(i, e): [None] * len(steps) for i in self.agents for e in range(2)}

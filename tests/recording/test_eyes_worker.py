@@ -12,9 +12,9 @@ from rerun.chunk import RrdReader
 
 from mimo_social.envs import free_play_v0
 from mimo_social.recording import Recorder
-from mimo_social.recording.eyes import EYE_LOG_HZ, eye_every_k_steps
+from mimo_social.recording.eyes import EYE_BATCH_STEPS, EYE_LOG_HZ, eye_every_k_steps
 
-N_STEPS = 13
+N_STEPS = 41               # eyes logged at steps 0 (reset), 4, ..., 40: 11 times
 
 
 def decode_png(blob: bytes) -> np.ndarray:
@@ -94,15 +94,17 @@ def test_default_rate_is_25_hz_and_every_frame_is_at_its_time(vision_env, tmp_pa
     assert EYE_LOG_HZ == 25.0 and eye_every_k_steps(env.dt, 1) == 4
     assert eye_every_k_steps(env.dt, 3) == 6 and eye_every_k_steps(env.dt, 1, 1) == 1
     rec, seen, threads = run(env, path)
-    assert rec.eye_every_k_steps == 4
-    assert any(name.startswith("mimo-eye-encoder") for name in threads)   # off the main thread
+    assert rec.eye_every_k_steps == 4 and EYE_BATCH_STEPS < 11
+    # encoded off the main thread (the frames of EYE_BATCH_STEPS logged steps at a time)
+    assert any(name.startswith("mimo-eye-encoder") for name in threads)
     assert not any(t.name.startswith("mimo-eye-encoder") for t in threading.enumerate())
-    assert rec.eye_frames == 2 * 4                       # steps 0 (reset), 4, 8, 12
+    logged = list(range(0, N_STEPS + 1, 4))
+    assert rec.eye_frames == 2 * len(logged) == 22
     for agent in env.possible_agents:
         for eye in ("left", "right"):
             got = eye_rows(path, agent, eye)
-            assert [s for s, _, _ in got] == [0, 4, 8, 12]
-            assert [t for _, t, _ in got] == [round(s * env.dt * 1e9) for s in (0, 4, 8, 12)]
+            assert [s for s, _, _ in got] == logged
+            assert [t for _, t, _ in got] == [round(s * env.dt * 1e9) for s in logged]
             for step, _, blob in got:
                 np.testing.assert_array_equal(decode_png(blob), seen[step][agent][f"eye_{eye}"])
 
