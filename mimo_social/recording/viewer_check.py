@@ -344,7 +344,7 @@ def _watch(browser: Browser, page_url: str, file_url: str, shot: Path, *, size, 
         page.goto(page_url, wait_until="load", timeout=timeout * 1000)
         streak, shown_at, prev, after = 0, None, None, 0
         while True:     # until two polls after the load agree (and show), or it gives up
-            time.sleep(poll)
+            page.wait_for_timeout(poll * 1000)   # console events come in meanwhile
             after += bool(loaded)                 # this poll's screenshot is after the load
             img, box, counts = look()
             elapsed = time.monotonic() - t0
@@ -370,7 +370,7 @@ def _watch(browser: Browser, page_url: str, file_url: str, shot: Path, *, size, 
                 say("  no time bar found: the time cursor stays")
             end = time.monotonic() + wait
             while True:
-                time.sleep(poll)
+                page.wait_for_timeout(poll * 1000)
                 img, box, counts = look()
                 if time.monotonic() >= end:
                     break

@@ -3,8 +3,8 @@ the bodies of a play-room recording in its 3D view, and does not pass a recordin
 bodies.
 
 The browser tests are skipped (with the reason) where Chromium, Playwright or ``rerun`` is
-missing; the pixel and colour tests run everywhere. The default browser tests take about 2 min
-here (software WebGL, two shared cores); the demo's recording, and the play room without its
+missing; the pixel and colour tests run everywhere. The default browser tests take about
+1.5 min here (software WebGL, two shared cores); the demo's recording, and the play room without its
 agents (the scene alone has furniture of the clothes' hues), are the slow variants.
 """
 
@@ -150,14 +150,15 @@ def test_cli_refuses_a_bad_size_and_a_missing_file(tmp_path, capsys):
 @needs_browser
 def test_the_web_viewer_shows_both_bodies_in_its_3d_view(recording, tmp_path, capsys):
     shot = tmp_path / "shot.png"
-    code = main(["check-viewer", str(recording), "--screenshot", str(shot), "--timeout", "150"])
+    code = main(["check-viewer", str(recording), "--screenshot", str(shot), "--timeout", "150",
+                 "--size", "1280x720"])              # half the pixels of 1920x1080: faster
     out = capsys.readouterr().out
     assert code == 0, out
     assert "viewer check passed" in out and "loading the data" in out     # progress shown
     assert "without the agents" in out                  # the scene's own pixels were counted
     assert shot.is_file() and shot.stat().st_size > 50_000
     from PIL import Image
-    assert Image.open(shot).size == (1920, 1080)
+    assert Image.open(shot).size == (1280, 720)
 
 
 @needs_browser
