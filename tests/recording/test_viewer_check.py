@@ -4,8 +4,8 @@ bodies.
 
 The browser tests are skipped (with the reason) where Chromium, Playwright or ``rerun`` is
 missing; the pixel and colour tests run everywhere. The default browser tests take about
-1.5 min here (software WebGL, two shared cores); the demo's recording, and the play room without its
-agents (the scene alone has furniture of the clothes' hues), are the slow variants.
+1.5 min here (software WebGL, two shared cores); the demo's recording, and the play room
+without its agents (the scene alone has furniture of the clothes' hues), are the slow variants.
 """
 
 from __future__ import annotations
