@@ -15,7 +15,7 @@ import math
 import sys
 
 from ..recording.viewer_check import ViewerCheckError, check_viewer
-from ._args import float_above, input_file, output_file
+from ._args import input_file, output_file
 
 __all__ = ["add_parser", "run"]
 
@@ -60,12 +60,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--screenshot", metavar="PATH", type=output_file, default=None,
                         help="where the PNG goes (default: next to the recording, "
                              "<name>_viewer.png)")
-    parser.add_argument("--timeout", metavar="S", type=float_above(0.0), default=180.0,
-                        help="seconds to wait for the bodies to show (default 180)")
+    parser.add_argument("--timeout", metavar="S", type=_number(1.0, None, "seconds >= 1"),
+                        default=180.0, help="seconds to wait for each page to load and show "
+                                            "(default 180)")
     parser.add_argument("--size", metavar="WxH", type=_size, default=(1920, 1080),
                         help="the browser page's size in pixels (default 1920x1080)")
-    parser.add_argument("--at", metavar="FRACTION", type=_number(0.0, 1.0, "a fraction from 0 to 1"),
-                        default=None,
+    parser.add_argument("--at", metavar="FRACTION", default=None,
+                        type=_number(0.0, 1.0, "a fraction from 0 to 1"),
                         help="move the time cursor to this fraction (0 to 1) of the recording "
                              "before the screenshot (a click on the time bar)")
     parser.add_argument("--wait", metavar="S", type=_number(0.0, None, "seconds >= 0"), default=0.0,
