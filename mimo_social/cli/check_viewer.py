@@ -53,8 +53,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                              "screenshot it and check that the 3D view shows the bodies",
         description="Serve FILE.rrd over HTTP, start `rerun --web-viewer`, open it in headless "
                     "Chromium (software WebGL), wait for the recording to load, save a "
-                    "screenshot and check that the 3D view shows every agent's clothes colour. "
-                    "Loading takes about a minute with software rendering.")
+                    "screenshot and check that the 3D view shows every agent's clothes colour, "
+                    "beyond what the same view of the recording without the agents shows (the "
+                    "play room's furniture has such hues). 1 to 3 minutes with software "
+                    "rendering.")
     parser.add_argument("file", metavar="FILE.rrd", type=input_file,
                         help="the recording to open")
     parser.add_argument("--screenshot", metavar="PATH", type=output_file, default=None,

@@ -260,7 +260,7 @@ def check_viewer(path: str | Path, screenshot: str | Path | None = None, timeout
         if baseline:
             without_agents(path, list(colours), folder / "without_agents.rrd")
         with FileServer(folder) as files, \
-                WebViewer(shot.with_name(shot.stem + "_rerun.log")) as viewer, \
+                WebViewer(folder / "rerun.log") as viewer, \
                 Browser() as browser:
             def urls(name):
                 file_url = f"http://127.0.0.1:{files.port}/{name}"
