@@ -133,9 +133,9 @@ class World:
     ``playroom/<toy>``, are in :attr:`room`; with ``floor=False`` no scene at all)."""
 
     #: the play room's toys may sleep while they rest (MuJoCo's ``mjENBL_SLEEP``, in the room
-    #: only; agents and a task's props never sleep). Off: it saves ~18 % of the room's physics
-    #: but solving by islands changes every agent's trajectory (the reach controller then misses
-    #: with seed 0); without it agents move exactly as on the floor until they touch the room
+    #: only; agents and a task's props never sleep). Off: it saves ~17 % of the room's physics
+    #: but changes the agents' own trajectories too (the reach controller then misses with seed
+    #: 0); without it agents move exactly as on the floor until they touch the room
     #: (docs/playroom.md)
     ROOM_SLEEP = False
     #: MjData counters of the awake part that MuJoCo 4.0.0's pickling of MjData leaves out (a

@@ -16,7 +16,7 @@ ball_red     sphere, 8 cm                    60 g     0.8       a soft rubber ba
 ball_blue    sphere, 12 cm                   110 g    0.8       a vinyl play ball (two hands)
 rattle       handle 2 x 10 cm + 5.6 cm head  50 g     0.7       a plastic rattle, 40-80 g
 cup          cylinder cup, 7 cm x 6 cm       25 g     0.5       a stacking cup, 2 mm plastic
-teddy        plush bear, 16 cm tall          150 g    1.0       plush toys of this size
+teddy        plush bear, 17 cm tall          150 g    1.0       plush toys of this size
 ===========  ==============================  =======  ========  ==============================
 
 Frictions: wood, rubber, plastic and fabric on a foam mat (sliding coefficients 0.5-1.0);
