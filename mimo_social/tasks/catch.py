@@ -37,6 +37,7 @@ from ..core.kinematics import Gaze, hand_geoms
 from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup, Prop
 from ..partners.controllers.catch import torque_controls
+from ..util.checks import ConfigError
 from .common import geoms_touching, parts_outside, settle
 
 # the published task's shoulder and elbow angles: (1.7, 0.8, -1.6, -0.4) rad
@@ -117,8 +118,8 @@ class Catch(Task):
 
     def setup(self, i, config):
         if config.hands != "five_fingers":
-            raise ValueError(f"catch: hands={config.hands!r} not allowed; the task needs "
-                             "hands='five_fingers' (it moves the fingers one by one)")
+            raise ConfigError(f"catch: hands={config.hands!r} not allowed; the task needs "
+                              "hands='five_fingers' (it moves the fingers one by one)")
         tables = load_body(config.hands)
         joints = catch_joints(tables)
         frozen = held_posture(tables, keep=joints + GAZE_JOINTS, angles=ARM_DEG)

@@ -145,13 +145,13 @@ class Handover(Task):
 
     def setup(self, i, config):
         if config.hands != "five_fingers":
-            raise ValueError(f"handover: infant_{i}: hands={config.hands!r} not allowed; the task "
-                             "needs hands='five_fingers' (the ball is held between the fingers)")
+            raise ConfigError(f"handover: infant_{i}: hands={config.hands!r} not allowed; the task "
+                              "needs hands='five_fingers' (the ball is held between the fingers)")
         allowed = ("standing", "kneeling", "sitting") if config.body == "adult" else ("standing",)
         if config.posture not in allowed:
-            raise ValueError(f"handover: infant_{i}: posture={config.posture!r} not allowed; "
-                             f"allowed for body={config.body!r}: {list(allowed)} (the task "
-                             "places infants standing, hip fixed)")
+            raise ConfigError(f"handover: infant_{i}: posture={config.posture!r} not allowed; "
+                              f"allowed for body={config.body!r}: {list(allowed)} (the task "
+                              "places infants standing, hip fixed)")
         # two 18-month-olds stand `distance` apart; other bodies at the distance scaled with
         # their reach, looking at each other's face (tasks/dyad.py)
         plan = task_plan(self, "standing", self.options.distance, self._held,

@@ -36,6 +36,7 @@ from ..body.tables import load_body, subtree
 from ..core.kinematics import hand_geoms, reach_sites
 from ..core.task import Plot, Task, TaskOptions
 from ..core.world import AgentSetup
+from ..util.checks import ConfigError
 from .common import CROSS_LEGGED_DEG
 
 # the right arm at the start: raised to the side, elbow bent a little, touching nothing
@@ -101,11 +102,11 @@ class SelfBody(Task):
         prims = {g.name: g.body for g in tables.geoms}
         unknown = [t for t in targets if t not in prims]
         if unknown or not targets:
-            raise ValueError(f"selfbody: targets {unknown or list(targets)} not allowed; "
+            raise ConfigError(f"selfbody: targets {unknown or list(targets)} not allowed; "
                              f"primitives (geoms) of the {config.hands} body: {list(prims)}")
         fixed = self.options.target
         if fixed is not None and fixed not in targets:
-            raise ValueError(f"selfbody: target={fixed!r} not allowed; one of {list(targets)}")
+            raise ConfigError(f"selfbody: target={fixed!r} not allowed; one of {list(targets)}")
         self.targets = targets
         self.target_parts = tuple(prims[t] for t in targets)
         return AgentSetup(config, position=(0.0, 0.0), facing=(1.0, 0.0), frozen=frozen,
