@@ -24,7 +24,10 @@ from .columns import SIM_TIME, STEP, entity
 from .contacts import CONTACTS_PATH
 from .eyes import EYES
 
-__all__ = ["blueprint", "scene_eye"]
+__all__ = ["CEILING_PATH", "blueprint", "scene_eye"]
+
+#: the play room's ceiling as the recorder logs it (a static geom of the world body)
+CEILING_PATH = entity("world", "scene", "playroom/ceiling")
 
 
 def _text_log(origin: str, name: str, entity_column: bool) -> rrb.TextLogView:
@@ -66,7 +69,10 @@ def blueprint(agents: list[str], face_paths: list[str],
     text documents)."""
     eye_paths = eye_paths or {}
     # -- left: the world, its legend, the logs
-    world = rrb.Spatial3DView(origin="/world", name="world", eye_controls=eye)
+    # the play room's ceiling is left out of the 3D view (it hides the room from above; the
+    # eyes still see it, and the viewer's entity tree can show it again)
+    world = rrb.Spatial3DView(origin="/world", name="world", eye_controls=eye,
+                              contents=["$origin/**", f"- {CEILING_PATH}"])
     if legend:   # the colour bar (a 2D space), then text documents under it
         keys = [rrb.Spatial2DView(origin=legend[0], name="skin force (N)")]
         keys += [rrb.TextDocumentView(origin=p, name="skin legend") for p in legend[1:]]
