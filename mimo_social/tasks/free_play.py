@@ -13,7 +13,7 @@
 | termination | none; truncation at 1000 steps |
 | options | `props` (False) |
 | privileged cues | none |
-| baselines | no reward, so no learning baseline; its speed (the scene of the demo and the benchmarks) is measured by `mimo-social bench` (BENCHMARKS.md) |
+| baselines | no reward, so no learning baseline; its speed (the scene of the benchmarks) is measured by `mimo-social bench` (BENCHMARKS.md) |
 | sources | not in the MIMo paper as a task: the sandbox of this package |
 | version history | v0: first version, with the first env |
 """
