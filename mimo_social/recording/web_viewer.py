@@ -166,9 +166,15 @@ class Browser:
         from playwright.sync_api import sync_playwright
 
         self._pw = sync_playwright().start()
+        exe = chromium_path()
         try:
-            self.browser = self._pw.chromium.launch(executable_path=chromium_path(),
-                                                    headless=True, args=launch_args())
+            self.browser = self._pw.chromium.launch(executable_path=exe, headless=True,
+                                                    args=launch_args())
+        except Exception as e:
+            self._pw.stop()
+            first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+            raise ViewerCheckError(f"Chromium ({exe}) could not be started: {first[:200]}") \
+                from None
         except BaseException:
             self._pw.stop()
             raise
