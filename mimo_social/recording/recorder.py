@@ -436,6 +436,12 @@ class Recorder:
         rows = self._rows
         n = rows.n
         self._plots.note(n, self._episode_steps > 0)   # first: a failing plot adds no row
+        for k, fn in enumerate(self._scalar_fns):
+            try:
+                rows.scalars[n, k] = fn(self._user_env)
+            except Exception as e:
+                raise RuntimeError(f"Recorder scalar {self.scalar_names[k]!r}: {fn!r} failed: "
+                                   f"{type(e).__name__}: {e}") from e
         rows.xpos[n] = self._xpos
         rows.xquat[n] = self._xquat
         self._last_time = self._time_offset + self._data.time
@@ -454,12 +460,6 @@ class Recorder:
                 rows.motors[i][n] = np.nan
         if self._skin is not None:
             self._skin.note(rows, n, self._xmat)
-        for k, fn in enumerate(self._scalar_fns):
-            try:
-                rows.scalars[n, k] = fn(self._user_env)
-            except Exception as e:
-                raise RuntimeError(f"Recorder scalar {self.scalar_names[k]!r}: {fn!r} failed: "
-                                   f"{type(e).__name__}: {e}") from e
         rows.n = n + 1
         self.rows += 1
         if rows.n == self._capacity:
