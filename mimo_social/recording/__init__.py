@@ -30,7 +30,7 @@ from .skin import (
                    force_colors,
                    force_radii,
 )
-from .summary import format_summary, summarize
+from .summary import format_summary, read_batches, summarize
 
 __all__ = [
                        "CONTACTS_PATH",
@@ -53,6 +53,7 @@ __all__ = [
                        "geom_archetype",
                        "geom_rgba",
                        "parallel_of",
+                       "read_batches",
                        "record_episode",
                        "recording_env_fn",
                        "summarize",

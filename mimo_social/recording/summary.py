@@ -19,7 +19,7 @@ import numpy as np
 from .columns import SIM_TIME, STEP
 from .contacts import CONTACTS_PATH
 
-__all__ = ["format_summary", "summarize"]
+__all__ = ["format_summary", "read_batches", "summarize"]
 
 _TRANSLATION = "Transform3D:translation"
 _AGENT_GROUPS = ("world", "agents")
@@ -35,6 +35,17 @@ def _read_chunks(path: Path):
         chunks = reader.stream().to_chunks()
     complete = not any("footer" in str(w.message) for w in caught)
     return stores, chunks, complete
+
+
+def read_batches(path: str | Path) -> dict:
+    """Entity path -> the Arrow record batches of its chunks (static ones included), read with
+    Rerun's own reader: the raw rows, for checks and analyses beyond :func:`summarize`. A file
+    of a run still open or killed (no footer) reads up to its last flush."""
+    _, chunks, _ = _read_chunks(Path(path))
+    out: dict = defaultdict(list)
+    for chunk in chunks:
+        out[chunk.entity_path].append(chunk.to_record_batch())
+    return dict(out)
 
 
 def _non_null(batch, name: str) -> np.ndarray:

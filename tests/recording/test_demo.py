@@ -3,33 +3,19 @@ kneeling caregiver, a high five then a handover, recorded with eyes and skin to 
 Checked by reading the file back (``recording.summary`` and Rerun's ``RrdReader``)."""
 
 import argparse
-import warnings
-from collections import defaultdict
 
 import numpy as np
 import pyarrow as pa
 import pytest
-from rerun.chunk import RrdReader
 
 from mimo_social.cli import demo as demo_cli
 from mimo_social.cli import main
 from mimo_social.experiments import demo
 from mimo_social.experiments.demo_task import PHASES
-from mimo_social.recording.summary import summarize
+from mimo_social.recording.summary import read_batches, summarize
 from mimo_social.util.checks import ConfigError
 
 INFANT, CAREGIVER = "infant_0", "infant_1"
-
-
-def read_rrd(path) -> dict:
-    """Entity path -> the record batches of its chunks."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        chunks = RrdReader(path).stream().to_chunks()
-    out = defaultdict(list)
-    for chunk in chunks:
-        out[chunk.entity_path].append(chunk.to_record_batch())
-    return dict(out)
 
 
 def series(data, path: str, component: str) -> list[tuple[float, object]]:
@@ -50,7 +36,7 @@ def full(tmp_path_factory):
     """The whole demo at its defaults (seed 0), recorded once for the tests of this module."""
     path = tmp_path_factory.mktemp("demo") / "demo.rrd"
     run = demo.record_demo(path, progress=False)
-    return run, summarize(path), read_rrd(path)
+    return run, summarize(path), read_batches(path)
 
 
 def test_the_interaction_succeeds(full):

@@ -3,32 +3,17 @@
 
 from __future__ import annotations
 
-import warnings
-from collections import defaultdict
 
 import numpy as np
-import pyarrow as pa
 import pytest
 import rerun.blueprint as rrb
-from rerun.chunk import RrdReader
 
 from mimo_social.core.task import Plot, Task
 from mimo_social.core.world import CLOTHES_PALETTE
 from mimo_social.envs import catalog, free_play_v0, high_five_v0
 from mimo_social.partners.controllers import HighFiveController
-from mimo_social.recording import Recorder
+from mimo_social.recording import Recorder, read_batches
 from mimo_social.util.checks import ConfigError
-
-
-def read(path) -> dict[str, list[pa.RecordBatch]]:
-    """Entity path -> record batches of its chunks (Rerun's own reader, as summary.py)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        chunks = RrdReader(path).stream().to_chunks()
-    out = defaultdict(list)
-    for chunk in chunks:
-        out[chunk.entity_path].append(chunk.to_record_batch())
-    return dict(out)
 
 
 def series(data, path: str) -> dict[int, float]:
@@ -93,7 +78,7 @@ def test_every_task_logs_its_plots(name, tmp_path):
     plots = env.task.plots()
     assert plots and all(isinstance(p, Plot) for p in plots)
     rec = record(env, tmp_path / f"{name}.rrd", 6, eyes=False)
-    data = read(tmp_path / f"{name}.rrd")
+    data = read_batches(tmp_path / f"{name}.rrd")
     n = len(env.possible_agents)
     views = plot_views(rec)
     assert list(views) == [p.title for p in plots]
@@ -119,7 +104,7 @@ def test_free_play_has_no_reward_plot_but_heights_and_distance(tmp_path):
     titles = [p.title for p in env.task.plots()]
     assert titles == ["head_height (m)", "nearest_infant (m)"]
     record(env, tmp_path / "fp.rrd", 120)
-    data = read(tmp_path / "fp.rrd")
+    data = read_batches(tmp_path / "fp.rrd")
     heights = series(data, "/plots/head_height/infant_0")
     d = env.world.data
     assert heights[max(heights)] == pytest.approx(d.site_xpos[env.world.agents[0].head_site, 2])
@@ -145,7 +130,7 @@ def _scripted_high_five(tmp_path):
             obs, rewards, _, _, infos = env.step(act)
             rec.log_step(act, rewards, obs)
     assert infos["infant_0"]["is_success"]
-    return env, rec, read(path)
+    return env, rec, read_batches(path)
 
 
 def test_high_five_hand_distance_falls_to_contact_at_success(tmp_path):
@@ -173,7 +158,7 @@ def test_series_colours_are_the_clothes_colours(tmp_path):
     env = free_play_v0.parallel_env(n_agents=3, touch=True, per_agent=[{}, {"clothes_rgba": own},
                                                                        {}])
     record(env, tmp_path / "c.rrd", 3, eyes=False)
-    data = read(tmp_path / "c.rrd")
+    data = read_batches(tmp_path / "c.rrd")
     expect = [rgb(CLOTHES_PALETTE[0]), rgb(own), rgb(CLOTHES_PALETTE[2])]
     widths = [static(data, f"/plots/head_height/{a}", "SeriesLines:widths")[0]
               for a in env.possible_agents]
@@ -193,7 +178,7 @@ def test_user_scalars_still_logged_beside_the_plots(tmp_path):
     env = free_play_v0.parallel_env(n_agents=2)
     rec = record(env, tmp_path / "s.rrd", 5, eyes=False,
                  scalars={"time/now": lambda e: float(e.world.data.time)})
-    data = read(tmp_path / "s.rrd")
+    data = read_batches(tmp_path / "s.rrd")
     times = series(data, "/scalars/time/now")
     assert list(times) == list(range(6))
     assert times[5] == pytest.approx(5 * env.dt)
@@ -261,7 +246,7 @@ def test_plots_follow_the_scripted_solution(entry, tmp_path):
             act = {"infant_0": ctrl.act(inner, "infant_0", obs["infant_0"])}
             obs, rewards, *_ = env.step(act)
             rec.log_step(act, rewards, obs)
-    data = read(path)
+    data = read_batches(path)
     assert set(rec.agents) == set(inner.possible_agents)       # the partner recorded too
     for plot in inner.task.plots():
         if plot.fn is None:
@@ -294,7 +279,7 @@ def test_scripted_env_and_its_gym_form_record_the_partner_too(tmp_path):
                     action = {"infant_0": env.action_space("infant_0").sample()}
                     obs, reward, *_ = env.step(action)
                     rec.log_step(action, reward, obs)
-        data = read(path)
+        data = read_batches(path)
         assert rec.agents == ["infant_0", "infant_1"]
         assert len(series(data, "/agents/infant_0/reward")) == 3
         assert len(series(data, "/agents/infant_0/action_norm")) == 3

@@ -2,13 +2,9 @@
 and a legend (colour bar with labelled dots, and a text) says what colour and size mean in newtons;
 checked by reading the .rrd back with Rerun's reader."""
 
-import warnings
-from collections import defaultdict
 
 import numpy as np
-import pyarrow as pa
 import pytest
-from rerun.chunk import RrdReader
 
 from mimo_social.envs import free_play_v0
 from mimo_social.recording import (
@@ -19,19 +15,10 @@ from mimo_social.recording import (
     Recorder,
     force_colors,
     force_radii,
+    read_batches,
 )
 
 N_STEPS = 12
-
-
-def read(path) -> dict[str, list[pa.RecordBatch]]:
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        chunks = RrdReader(path).stream().to_chunks()
-    out = defaultdict(list)
-    for c in chunks:
-        out[c.entity_path].append(c.to_record_batch())
-    return out
 
 
 def column(data, path, name) -> list:
@@ -63,7 +50,7 @@ def touch_file(tmp_path_factory):
                            for k in np.flatnonzero(v["normal_force"])])
               for a in env.possible_agents}
     env.close()
-    return {"data": read(path), "forces": forces, "rec": rec}
+    return {"data": read_batches(path), "forces": forces, "rec": rec}
 
 
 def test_force_radii_grow_on_a_log_scale():
@@ -134,4 +121,4 @@ def test_no_legend_without_touch(tmp_path):
     with Recorder(env, tmp_path / "plain.rrd") as rec:
         rec.log_reset(obs)
     env.close()
-    assert not [p for p in read(tmp_path / "plain.rrd") if p.startswith("/legend")]
+    assert not [p for p in read_batches(tmp_path / "plain.rrd") if p.startswith("/legend")]
