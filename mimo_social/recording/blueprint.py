@@ -74,8 +74,9 @@ def blueprint(agents: list[str], face_paths: list[str],
     world = rrb.Spatial3DView(origin="/world", name="world", eye_controls=eye,
                               contents=["$origin/**", f"- {CEILING_PATH}"])
     if legend:   # the colour bar (a 2D space), then text documents under it
-        keys = [rrb.Spatial2DView(origin=legend[0], name="skin force (N)")]
-        keys += [rrb.TextDocumentView(origin=p, name="skin legend") for p in legend[1:]]
+        # short titles: the legend column is ~165 px wide on a 1920 px page
+        keys = [rrb.Spatial2DView(origin=legend[0], name="skin N")]
+        keys += [rrb.TextDocumentView(origin=p, name="key") for p in legend[1:]]
         key = keys[0] if len(keys) == 1 else rrb.Vertical(*keys, row_shares=[2] + [1] * (
             len(keys) - 1), name="skin legend")
         world = rrb.Horizontal(world, key, column_shares=[6, 1])
