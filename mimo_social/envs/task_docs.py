@@ -71,7 +71,9 @@ those of the default settings.
 How to read a table: *privileged cues* are what of the partner or the target reaches the learner
 other than through its own senses (e.g. the task turning its head and eyes toward the target,
 whose angles it then feels); *baselines* are figures measured on this machine, with the commands
-that give them; *version history* says what changed in each version of the `<task>_v0` module.
+that give them; *version history* says what changed in each version of the `<task>_v0` module;
+*replay plots* (generated from the task's `Task.plots()`) are the time series a recording of the
+task holds (at `/plots/<name>/<agent>`) and its Rerun layout shows, one view each.
 """
 
 OUTRO = """\
@@ -247,6 +249,18 @@ def overview_table(docs: tuple[TaskDoc, ...] | None = None) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _plots(d: TaskDoc) -> str:
+    """The time series a recording of the task shows (``Task.plots()``), read from a task built
+    with its default options: name (unit), per agent or one line."""
+    cls = d.task_cls
+    items = []
+    for p in cls(cls.default_n_agents, None).plots():
+        unit = f" ({p.unit})" if p.unit else ""
+        lines = "per agent" if p.per_agent else "one line"
+        items.append(f"`{p.name}`{unit}, {lines}")
+    return "; ".join(items)
+
+
 def _section(d: TaskDoc) -> str:
     what = d.title.partition(":")[2].strip() or d.title
     cls = d.task_cls
@@ -255,6 +269,7 @@ def _section(d: TaskDoc) -> str:
                  f"`{d.entry.module.__name__}`; Gymnasium id `{d.entry.gym_id}`."), "",
            "| | |", "|---|---|"]
     out += [f"| {k} | {_markdown(v)} |" for k, v in d.rows]
+    out.append(f"| replay plots | {_plots(d)} |")
     for note in d.notes:
         out += ["", _wrap(_markdown(note))]
     return "\n".join(out) + "\n"

@@ -73,3 +73,14 @@ def test_cli_writes_and_checks(tmp_path, capsys):
     out.write_text(out.read_text() + "edited by hand\n")
     assert docs_cli.run(check) == 1
     assert "run `mimo-social docs" in capsys.readouterr().err
+
+
+def test_each_task_section_lists_the_plots_its_replay_shows():
+    from mimo_social.envs.task_docs import render, task_docs
+    page = render()
+    for d in task_docs():
+        section = page.split(f"## {d.heading}\n", 1)[1].split("\n## ", 1)[0]
+        row = next(line for line in section.splitlines() if line.startswith("| replay plots |"))
+        names = [p.name for p in d.task_cls(d.task_cls.default_n_agents, None).plots()]
+        assert all(f"`{n}`" in row for n in names), (d.entry.name, row)
+    assert "`hand_distance` (m), one line" in page and "`gaze_error` (deg), per agent" in page
