@@ -9,7 +9,6 @@ from __future__ import annotations
 import dataclasses
 from typing import Any, Callable, ClassVar, Mapping, Sequence
 
-import mujoco
 import numpy as np
 from gymnasium import spaces
 
@@ -209,10 +208,7 @@ def check_start_poses(world) -> None:
     if len(setups) < 2:
         return
     m = world.model
-    d = mujoco.MjData(m)
-    d.qpos[:] = world.data.qpos
-    mujoco.mj_kinematics(m, d)
-    mujoco.mj_collision(m, d)
+    d = world.scratch_contacts()
     n = d.ncon
     if not n:
         return

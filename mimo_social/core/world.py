@@ -427,6 +427,16 @@ class World:
             q1 = d.xquat[b1] * np.array([1.0, -1.0, -1.0, -1.0])
             mujoco.mju_mulQuat(m.eq_data[eq, 6:10], q1, d.xquat[b2])
 
+    def scratch_contacts(self) -> mujoco.MjData:
+        """A scratch copy of the state at the world's current positions with its contacts found
+        (``mj_kinematics`` + ``mj_collision``: ``d.ncon``, ``d.contact``); the world's own data
+        is left as it is. The start checks read it (agents inside each other or in furniture)."""
+        d = mujoco.MjData(self.model)
+        d.qpos[:] = self.data.qpos
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_collision(self.model, d)
+        return d
+
     @property
     def initial_qpos(self) -> np.ndarray:
         return self._initial_qpos.copy()

@@ -8,7 +8,6 @@ typed: ``model``, ``data``, ``room``, ``geom_agent``, ``agent_setups``, ``names`
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from ..util.checks import ConfigError
@@ -52,10 +51,7 @@ def check_scene_clear(world) -> None:
     if world.room is None:
         return
     m = world.model
-    d = mujoco.MjData(m)
-    d.qpos[:] = world.data.qpos
-    mujoco.mj_kinematics(m, d)
-    mujoco.mj_collision(m, d)
+    d = world.scratch_contacts()
     n = d.ncon
     names = [m.geom(g).name for g in range(m.ngeom)]
     fixed = np.array([m.geom_bodyid[g] == 0 and names[g].startswith("playroom/")
