@@ -173,7 +173,7 @@ def env_setting_names() -> list[str]:
     settings (given to all), ``n_agents``, ``task_options`` and ``max_cycles``."""
     from ..core.config import AgentConfig
     from ..core.env import MimoParallelEnv
-    from ..envs._factory import make_parallel
+    from ..core.factory import make_parallel
 
     own = [p.name for fn in (MimoParallelEnv.__init__, make_parallel)
            for p in inspect.signature(fn).parameters.values()

@@ -2,9 +2,11 @@
 
 Every env of the package is one :class:`EnvEntry` of :data:`CATALOG`: its task name (what
 ``mimo-social train --task`` takes), its versioned PettingZoo module (``parallel_env``, ``env``
-and, for social tasks, ``scripted_env``) and its Gymnasium id. Registration, training, the
-benchmark, the package docstring, the docs and the tests read this list; a new task is its task
-file in :mod:`mimo_social.tasks`, its ``<task>_v0`` module here and one line below.
+and, for social tasks, ``scripted_env``), its Gymnasium id, and from the task's folder its
+scripted controller and a paradigm's measures. Registration, training, the baselines, the
+paradigms, the benchmark, the package docstring, the docs and the tests read this list; a new
+task is its folder ``mimo_social/tasks/<task>/``, its two-line ``<task>_v0`` shim here and one
+entry below.
 """
 
 from __future__ import annotations
@@ -13,11 +15,8 @@ from dataclasses import dataclass
 from types import ModuleType
 
 from ..core.gym_adapter import SingleAgentEnv
-from ..partners.controllers import (CatchController, ContingencyDetectorController,
-                                    GazeFollowController, HighFiveController,
-                                    ImitationController, MirrorController, ReachController,
-                                    ReceiveController, SelfBodyController, SocialTouchController,
-                                    StandupController, StillFaceInfantController)
+from ..tasks import (catch, contingency, free_play, handover, high_five, imitation,
+                     joint_attention, mirror, reach, selfbody, social_touch, standup, still_face)
 from . import (catch_v0, contingency_v0, free_play_v0, handover_v0, high_five_v0, imitation_v0,
                joint_attention_v0, mirror_v0, reach_v0, selfbody_v0, social_touch_v0,
                standup_v0, still_face_v0)
@@ -31,9 +30,10 @@ KINDS = ("sandbox", "one-agent", "social")
 
 @dataclass(frozen=True)
 class EnvEntry:
-    """One env: ``name`` (the task name), ``module`` (its ``<task>_v0`` module), ``gym_id`` (the
-    Gymnasium id: the env itself for one agent, the scripted form for a social task), ``kind``
-    (one of :data:`KINDS`), a one-line ``summary`` and the task's scripted ``controller``."""
+    """One env: ``name`` (the task name: its folder ``mimo_social/tasks/<name>/``), ``module``
+    (its ``<task>_v0`` module), ``gym_id`` (the Gymnasium id: the env itself for one agent, the
+    scripted form for a social task), ``kind`` (one of :data:`KINDS`), a one-line ``summary``,
+    the task's scripted ``controller`` and a paradigm's ``measures``."""
 
     name: str
     module: ModuleType
@@ -41,9 +41,13 @@ class EnvEntry:
     kind: str
     summary: str
     gym_defaults: tuple = ()   # keyword arguments the Gymnasium id passes by default
-    #: the scripted controller that solves the task (a Partner class made without arguments),
-    #: for the one-learner env; None where the task has none yet
+    #: the scripted controller that solves the task (a Partner class made without arguments,
+    #: from the task's ``controller.py``), for the one-learner env; None where the task has none
     controller: type | None = None
+    #: a paradigm's measures (its ``measures.py`` module: ``run(learner, episodes, seed,
+    #: env_kwargs)`` -> summary, ``rows(summaries)`` -> table lines, ``UNIT``); None for a task
+    #: whose success and return say it all
+    measures: ModuleType | None = None
 
     @property
     def module_name(self) -> str:
@@ -74,40 +78,43 @@ CATALOG: tuple[EnvEntry, ...] = (
              "infants (1-8) on the floor, optional props, no goal", (("n_agents", 1),)),
     EnvEntry("reach", reach_v0, "mimo_social/Reach-v0", "one-agent",
              "reach a ball in front of the body with the right hand",
-             controller=ReachController),
+             controller=reach.ReachController),
     EnvEntry("standup", standup_v0, "mimo_social/Standup-v0", "one-agent",
              "stand up from a crouch holding a crib rail",
-             controller=StandupController),
+             controller=standup.StandupController),
     EnvEntry("selfbody", selfbody_v0, "mimo_social/SelfBody-v0", "one-agent",
              "touch a named primitive of one's own body with the right hand",
-             controller=SelfBodyController),
+             controller=selfbody.SelfBodyController),
     EnvEntry("catch", catch_v0, "mimo_social/Catch-v0", "one-agent",
              "catch a falling ball and hold it",
-             controller=CatchController),
+             controller=catch.CatchController),
     EnvEntry("high_five", high_five_v0, "mimo_social/HighFive-v0", "social",
              "two infants meet with their right hands",
-             controller=HighFiveController),
+             controller=high_five.HighFiveController),
     EnvEntry("mirror", mirror_v0, "mimo_social/Mirror-v0", "social",
              "show the partner's facial expression, seen through the eyes",
-             controller=MirrorController),
+             controller=mirror.MirrorController),
     EnvEntry("joint_attention", joint_attention_v0, "mimo_social/JointAttention-v0", "social",
              "follow the partner's gaze to one of four toys",
-             controller=GazeFollowController),
+             controller=joint_attention.GazeFollowController),
     EnvEntry("social_touch", social_touch_v0, "mimo_social/SocialTouch-v0", "social",
              "touch a named part of the partner's body",
-             controller=SocialTouchController),
+             controller=social_touch.SocialTouchController),
     EnvEntry("handover", handover_v0, "mimo_social/Handover-v0", "social",
              "take a ball from the partner's hand",
-             controller=ReceiveController),
+             controller=handover.ReceiveController),
     EnvEntry("contingency", contingency_v0, "mimo_social/Contingency-v0", "social",
              "smile with a caregiver who answers live, replays a session or smiles on a timer",
-             controller=ContingencyDetectorController),
+             controller=contingency.ContingencyDetectorController,
+             measures=contingency.measures),
     EnvEntry("still_face", still_face_v0, "mimo_social/StillFace-v0", "social",
              "face-to-face play, the caregiver's still face, reunion: per-phase measures",
-             controller=StillFaceInfantController),
+             controller=still_face.StillFaceInfantController,
+             measures=still_face.measures),
     EnvEntry("imitation", imitation_v0, "mimo_social/Imitation-v0", "social",
              "reproduce the action a caregiver demonstrated, seen through the eyes",
-             controller=ImitationController),
+             controller=imitation.ImitationController,
+             measures=imitation.measures),
 )
 
 _BY_NAME = {e.name: e for e in CATALOG}

@@ -1,22 +1,4 @@
-"""`catch_v0`: the catch task as a one-agent PettingZoo env (see :mod:`.tasks.catch` for the table).
-
-``parallel_env(task_options={...}, physics={...}, max_steps=..., render_mode=..., **agent_settings)``
-returns a :class:`~mimo_social.core.env.MimoParallelEnv` with the one agent ``infant_0``;
-``env(...)`` the AEC version. The Gymnasium id is ``mimo_social/Catch-v0``.
-"""
-
-from ..tasks import catch as _task
-from ..tasks.catch import Catch
-from ._factory import make_aec, make_parallel
-
-__doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
-
-__all__ = ["parallel_env", "env", "Catch"]
-
-
-def parallel_env(**kwargs):
-    return make_parallel(Catch, **kwargs)
-
-
-def env(**kwargs):
-    return make_aec(Catch, **kwargs)
+# `catch_v0`: the catch task (mimo_social.tasks.catch) as a PettingZoo env, version 0; its
+# docstring is the task's table. A new version of the task is a new module beside this one.
+from ..tasks.catch import *  # noqa: F401,F403
+from ..tasks.catch import __all__, __doc__  # noqa: F401

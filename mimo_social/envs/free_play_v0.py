@@ -1,18 +1,4 @@
-"""`free_play_v0`: the free play task as a PettingZoo env (see :mod:`.tasks.free_play` for the table).
-
-``parallel_env(n_agents=..., task_options={...}, physics={...}, per_agent=[...], **agent_settings)``
-returns a :class:`~mimo_social.core.env.MimoParallelEnv`; ``env(...)`` the AEC version.
-"""
-
-from ..tasks.free_play import FreePlay
-from ._factory import make_aec, make_parallel
-
-__all__ = ["parallel_env", "env", "FreePlay"]
-
-
-def parallel_env(**kwargs):
-    return make_parallel(FreePlay, **kwargs)
-
-
-def env(**kwargs):
-    return make_aec(FreePlay, **kwargs)
+# `free_play_v0`: the free play task (mimo_social.tasks.free_play) as a PettingZoo env, version 0; its
+# docstring is the task's table. A new version of the task is a new module beside this one.
+from ..tasks.free_play import *  # noqa: F401,F403
+from ..tasks.free_play import __all__, __doc__  # noqa: F401

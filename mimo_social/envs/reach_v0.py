@@ -1,18 +1,4 @@
-"""`reach_v0`: the reach task as a PettingZoo env (see :mod:`.tasks.reach` for the table).
-
-``parallel_env(n_agents=..., task_options={...}, physics={...}, per_agent=[...], **agent_settings)``
-returns a :class:`~mimo_social.core.env.MimoParallelEnv`; ``env(...)`` the AEC version.
-"""
-
-from ..tasks.reach import Reach
-from ._factory import make_aec, make_parallel
-
-__all__ = ["parallel_env", "env", "Reach"]
-
-
-def parallel_env(**kwargs):
-    return make_parallel(Reach, **kwargs)
-
-
-def env(**kwargs):
-    return make_aec(Reach, **kwargs)
+# `reach_v0`: the reach task (mimo_social.tasks.reach) as a PettingZoo env, version 0; its
+# docstring is the task's table. A new version of the task is a new module beside this one.
+from ..tasks.reach import *  # noqa: F401,F403
+from ..tasks.reach import __all__, __doc__  # noqa: F401

@@ -1,22 +1,4 @@
-"""`selfbody_v0`: the selfbody task as a one-agent PettingZoo env (see :mod:`.tasks.selfbody` for the table).
-
-``parallel_env(task_options={...}, physics={...}, max_steps=..., render_mode=..., **agent_settings)``
-returns a :class:`~mimo_social.core.env.MimoParallelEnv` with the one agent ``infant_0``;
-``env(...)`` the AEC version. The Gymnasium id is ``mimo_social/SelfBody-v0``.
-"""
-
-from ..tasks import selfbody as _task
-from ..tasks.selfbody import SelfBody
-from ._factory import make_aec, make_parallel
-
-__doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
-
-__all__ = ["parallel_env", "env", "SelfBody"]
-
-
-def parallel_env(**kwargs):
-    return make_parallel(SelfBody, **kwargs)
-
-
-def env(**kwargs):
-    return make_aec(SelfBody, **kwargs)
+# `selfbody_v0`: the selfbody task (mimo_social.tasks.selfbody) as a PettingZoo env, version 0; its
+# docstring is the task's table. A new version of the task is a new module beside this one.
+from ..tasks.selfbody import *  # noqa: F401,F403
+from ..tasks.selfbody import __all__, __doc__  # noqa: F401

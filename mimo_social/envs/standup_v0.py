@@ -1,22 +1,4 @@
-"""`standup_v0`: the standup task as a one-agent PettingZoo env (see :mod:`.tasks.standup` for the table).
-
-``parallel_env(task_options={...}, physics={...}, max_steps=..., render_mode=..., **agent_settings)``
-returns a :class:`~mimo_social.core.env.MimoParallelEnv` with the one agent ``infant_0``;
-``env(...)`` the AEC version. The Gymnasium id is ``mimo_social/Standup-v0``.
-"""
-
-from ..tasks import standup as _task
-from ..tasks.standup import Standup
-from ._factory import make_aec, make_parallel
-
-__doc__ = (__doc__ or "") + "\nThe task:\n" + (_task.__doc__ or "")
-
-__all__ = ["parallel_env", "env", "Standup"]
-
-
-def parallel_env(**kwargs):
-    return make_parallel(Standup, **kwargs)
-
-
-def env(**kwargs):
-    return make_aec(Standup, **kwargs)
+# `standup_v0`: the standup task (mimo_social.tasks.standup) as a PettingZoo env, version 0; its
+# docstring is the task's table. A new version of the task is a new module beside this one.
+from ..tasks.standup import *  # noqa: F401,F403
+from ..tasks.standup import __all__, __doc__  # noqa: F401

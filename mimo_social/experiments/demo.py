@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ..envs._factory import make_parallel
+from ..core.factory import make_parallel
 from ..expressions.faces import EXPRESSIONS
 from ..recording.recorder import Recorder
 from ..scenery import SCENES

@@ -8,8 +8,8 @@ the next episode is:
 
 | phase | reset | success (``is_success`` in the infos) | scripted agents (:func:`phase_partners`) |
 |---|---|---|---|
-| ``"high_five"`` | the receiver's right arm hanging (shifted at random, as in the handover), the giver's arm where the world starts it, the ball on the floor beside the giver | both right hands feel the other agent on their skin and touch each other (as in :mod:`mimo_social.tasks.high_five`); the episode does not end | ``infant_0``: :class:`~mimo_social.partners.controllers.HighFiveController`; ``infant_1``: ``HandOffer(grip=False, release=None, palm="forward")`` |
-| ``"handover"`` | the handover's own: the ball in the giver's palm, its fingers closed on it | the handover's (the receiver's hand holds the ball, the giver's no longer touches it, for 0.3 s) | ``infant_0``: :class:`~mimo_social.partners.controllers.ReceiveController`; ``infant_1``: the handover's :func:`~mimo_social.tasks.handover.scripted_giver` |
+| ``"high_five"`` | the receiver's right arm hanging (shifted at random, as in the handover), the giver's arm where the world starts it, the ball on the floor beside the giver | both right hands feel the other agent on their skin and touch each other (as in :mod:`mimo_social.tasks.high_five`); the episode does not end | ``infant_0``: :class:`~mimo_social.tasks.high_five.HighFiveController`; ``infant_1``: ``HandOffer(grip=False, release=None, palm="forward")`` |
+| ``"handover"`` | the handover's own: the ball in the giver's palm, its fingers closed on it | the handover's (the receiver's hand holds the ball, the giver's no longer touches it, for 0.3 s) | ``infant_0``: :class:`~mimo_social.tasks.handover.ReceiveController`; ``infant_1``: the handover's :func:`~mimo_social.tasks.handover.scripted_giver` |
 
 Both phases keep running after success (the handover's ``end_on_success`` is off); a ball that
 falls ends the handover (as in the task). Rewards are the handover's in its phase, zero in the
@@ -23,10 +23,11 @@ import numpy as np
 from ..core.kinematics import hand_geoms
 from ..core.task import Plot
 from ..partners import HandOffer
-from ..partners.controllers import HighFiveController, ReceiveController
+from ..tasks.handover import ReceiveController
+from ..tasks.high_five import HighFiveController
 from ..tasks.common import ContactProbe, right_hand_parts
-from ..tasks.handover import GIVER, RECEIVER, Handover, scripted_giver
-from ..tasks.high_five import SkinSource
+from ..tasks.handover.task import GIVER, RECEIVER, Handover, scripted_giver
+from ..tasks.high_five.task import SkinSource
 from ..util.checks import check_choice
 
 __all__ = ["PHASES", "HighFiveThenHandover", "phase_partners"]

@@ -4,7 +4,6 @@
 from .base import Partner, Still, zero_action
 from .contingent import ContingentCaregiver
 from .cues import Cues, learner_cues
-from .demonstrator import Demonstrator
 from .expression import ExpressionShow
 from .gaze import GazeAtTarget
 from .hand_offer import HandOffer
@@ -13,4 +12,4 @@ from .wrapper import ScriptedPartners
 
 __all__ = ["Partner", "Still", "zero_action", "ScriptedPartners", "ExpressionShow",
            "GazeAtTarget", "HandOffer", "ContingentCaregiver", "Cues", "learner_cues",
-           "ReplayCaregiver", "load_stream", "save_stream", "Demonstrator"]
+           "ReplayCaregiver", "load_stream", "save_stream"]

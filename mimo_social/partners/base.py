@@ -20,7 +20,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..core.env import MimoParallelEnv
 
 __all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop",
-           "pd_gains", "motor_action", "follow_waypoints", "check_angles", "check_variants"]
+           "pd_gains", "motor_action", "torque_controls", "follow_waypoints", "check_angles",
+           "check_variants"]
 
 
 def zero_action(space: spaces.Space):
@@ -158,3 +159,20 @@ class Still(Partner):
 
     def act(self, env, agent, observation):
         return zero_action(env.action_space(agent))
+
+
+def torque_controls(act, q, tau) -> np.ndarray:
+    """The controls with which actuation model ``act`` exerts the joint torques ``tau`` (one per
+    motor) at joint angles ``q`` (rad), statically. Muscles: the agonist's activation on top of
+    the passive forces, from the isometric force-length curve (antagonist off), clipped to
+    [0, 1], in the ``2 n`` control layout (negative muscles, then positive ones); spring-damper
+    motors: ``tau / T_max`` in the pushing direction, clipped to [-1, 1]."""
+    tau = np.asarray(tau, float)
+    if act.name == "muscle":
+        n_full, p_full = act.isometric_torque(q, 1.0)
+        n_rest, p_rest = act.isometric_torque(q, 0.0)
+        need = tau - (n_rest + p_rest)
+        neg = np.clip(need / np.minimum(n_full - n_rest, -1e-9), 0.0, 1.0)
+        pos = np.clip(need / np.maximum(p_full - p_rest, 1e-9), 0.0, 1.0)
+        return np.concatenate([neg, pos])
+    return np.clip(np.where(tau >= 0, tau / act.torque_pos, tau / act.torque_neg), -1.0, 1.0)

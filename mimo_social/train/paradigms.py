@@ -1,20 +1,19 @@
 """The classic paradigms of infant social development run with a learner of one's choice.
 
 ``run_paradigm(task, learners, episodes, seed)`` runs ``episodes`` episodes of one paradigm
-(``still_face``, ``contingency``, ``imitation``: the scripted forms of their catalogue envs,
-``infant_0`` the learner, the caregiver scripted) with each learner and returns the paradigm's
-own summary per learner, computed by the task module's summary function (nothing is
-re-measured here):
+(the catalogue's tasks with measures of their own, :data:`PARADIGMS`: ``still_face``,
+``contingency``, ``imitation``; the scripted forms of their envs, ``infant_0`` the learner, the
+caregiver scripted) with each learner and returns the paradigm's own summary per learner,
+computed by the task's measures (``mimo_social/tasks/<task>/measures.py``, the catalogue entry's
+``measures``: its ``run`` and, for the table, ``rows``; nothing is re-measured here):
 
-* ``still_face``: :func:`mimo_social.tasks.still_face.still_face_summary` of each episode's last
-  info: per phase (interaction, still face, reunion) the share of the phase's steps with a smile,
-  with the gaze on the caregiver's face and with self-touch;
-* ``contingency``: :func:`mimo_social.tasks.contingency.condition_summary`: blocks of a live, a
-  replay (of that block's live episode) and a non-contingent episode; per condition the smile
-  rates, response and baseline rates, contingency index, gaze and shared smiling;
-* ``imitation``: :func:`mimo_social.tasks.imitation.summary` of
-  :func:`~mimo_social.tasks.imitation.run_episodes`: per demonstrated action the success rate,
-  the mean return and which act the learner answered with.
+* ``still_face``: per phase (interaction, still face, reunion) the share of the phase's steps
+  with a smile, with the gaze on the caregiver's face and with self-touch;
+* ``contingency``: blocks of a live, a replay (of that block's live episode) and a
+  non-contingent episode; per condition the smile rates, response and baseline rates,
+  contingency index, gaze and shared smiling;
+* ``imitation``: per demonstrated action the success rate, the mean return and which act the
+  learner answered with.
 
 A learner (:func:`make_learner`) is ``"scripted"`` (the catalogue's controller of the task: the
 scripted infant baseline), ``"random"`` (uniform samples of the learner's action space, seeded
@@ -34,17 +33,16 @@ import json
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-import numpy as np
 
-from ..envs.catalog import entry
+from ..envs.catalog import CATALOG, entry
 from ..partners.base import zero_action
 from .tasks import TrainInputError
 
 __all__ = ["PARADIGMS", "LEARNER_NAMES", "make_learner", "run_paradigm", "side_by_side",
            "check_learner"]
 
-#: the paradigms this runs (catalogue task names)
-PARADIGMS = ("still_face", "contingency", "imitation")
+#: the paradigms this runs: the catalogue's tasks that have measures of their own
+PARADIGMS = tuple(e.name for e in CATALOG if e.measures is not None)
 #: the built-in learners (besides a run folder)
 LEARNER_NAMES = ("scripted", "random", "zero")
 AGENT = "infant_0"
@@ -174,29 +172,6 @@ def _env_kwargs(task: str, specs: Sequence[str], env_kwargs) -> dict:
     return kws[0] if kws else {}
 
 
-def _still_face(learner, env, episodes: int, seed: int) -> dict:
-    from ..tasks.still_face import still_face_summary
-    finals, returns = [], []
-    for k in range(episodes):
-        obs, infos = env.reset(seed=seed + k)
-        learner.reset(env.unwrapped, AGENT, np.random.default_rng(seed + k))
-        last, total = infos.get(AGENT, {}), 0.0
-        while env.agents:
-            obs, rew, _, _, infos = env.step({AGENT: learner.act(env.unwrapped, AGENT,
-                                                                  obs[AGENT])})
-            last, total = infos.get(AGENT, last), total + float(rew.get(AGENT, 0.0))
-        finals.append(last)
-        returns.append(total)
-    out = still_face_summary(finals)
-    out["return"] = (float(np.mean(returns)), float(np.std(returns)))
-    return out
-
-
-def _imitation(learner, env, episodes: int, seed: int) -> dict:
-    from ..tasks.imitation import partner_policy, run_episodes, summary
-    return summary(run_episodes(env, partner_policy(learner, AGENT, seed=seed), episodes, seed))
-
-
 def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: int = 5,
                  seed: int = 0, env_kwargs: Mapping[str, Any] | None = None,
                  model: str = "final", deterministic: bool = True) -> dict:
@@ -219,24 +194,15 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
     for s in specs:
         check_learner(task, s)
     kw = _env_kwargs(task, specs, env_kwargs)
+    measures = entry(task).measures
     results = []
     for spec in specs:
-        if task == "contingency":
-            from ..tasks.contingency import condition_summary
-            probe = entry(task).scripted_env(**kw)
-            try:
-                learner = make_learner(task, spec, probe, model, deterministic)
-            finally:
-                probe.close()
-            summ = condition_summary(episodes, seed, controller=learner, env_kwargs=kw)
-        else:
-            env = entry(task).scripted_env(**kw)
-            try:
-                learner = make_learner(task, spec, env, model, deterministic)
-                run = _still_face if task == "still_face" else _imitation
-                summ = run(learner, env, episodes, seed)
-            finally:
-                env.close()
+        probe = entry(task).scripted_env(**kw)   # the learner's spaces
+        try:
+            learner = make_learner(task, spec, probe, model, deterministic)
+        finally:
+            probe.close()
+        summ = measures.run(learner, episodes, seed, kw)
         results.append({"learner": getattr(learner, "name", type(learner).__name__),
                         "spec": spec, "summary": summ})
     return {"task": task, "episodes": episodes, "seed": seed, "env_kwargs": kw,
@@ -244,54 +210,15 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
 
 
 # -- tables -----------------------------------------------------------------------------------
-def _ms(pair) -> str:
-    mean, sd = pair
-    return f"{mean:.2f} +- {sd:.2f}"
-
-
-def _rows_still_face(summaries) -> list[tuple[str, list[str]]]:
-    from ..tasks.still_face import MEASURES, PHASES
-    rows = [("success", [f"{100 * s['success']:.0f} %" for s in summaries]),
-            ("return", [f"{s['return'][0]:.1f} +- {s['return'][1]:.1f}" for s in summaries])]
-    for phase in PHASES:
-        for m in MEASURES:
-            rows.append((f"{phase}: {m}", [_ms(s["phases"][phase][m]) for s in summaries]))
-    return rows
-
-
-def _rows_contingency(summaries) -> list[tuple[str, list[str]]]:
-    from ..tasks.contingency import CONDITIONS, MEASURES
-    rows = []
-    for cond in CONDITIONS:
-        if not all(cond in s for s in summaries):
-            continue
-        for m in MEASURES:
-            rows.append((f"{cond}: {m}", [_ms(s[cond][m]) for s in summaries]))
-    return rows
-
-
-def _rows_imitation(summaries) -> list[tuple[str, list[str]]]:
-    keys = [k for k in summaries[0] if all(k in s for s in summaries)]
-    rows = []
-    for key in keys:
-        rows.append((f"{key}: success", [f"{100 * s[key]['success']:.0f} % of "
-                                         f"{s[key]['episodes']}" for s in summaries]))
-        rows.append((f"{key}: return", [f"{s[key]['return']:.2f}" for s in summaries]))
-        rows.append((f"{key}: responses",
-                     [", ".join(f"{n} {c}" for n, c in s[key]["responses"].items() if c)
-                      for s in summaries]))
-    return rows
-
-
 def side_by_side(result: Mapping[str, Any]) -> str:
     """:func:`run_paradigm`'s result as a markdown table: a row per measure (per phase,
     condition or demonstrated action), a column per learner (mean +- sd over episodes)."""
     task = result["task"]
     names = [r["learner"] for r in result["learners"]]
     summaries = [r["summary"] for r in result["learners"]]
-    rows = {"still_face": _rows_still_face, "contingency": _rows_contingency,
-            "imitation": _rows_imitation}[task](summaries)
-    unit = "blocks (live, replay, non-contingent)" if task == "contingency" else "episodes"
+    measures = entry(task).measures
+    rows = measures.rows(summaries)
+    unit = measures.UNIT
     lines = [f"{task}: {result['episodes']} {unit} per learner, seeds from {result['seed']}",
              "", "| measure | " + " | ".join(names) + " |",
              "|---" * (len(names) + 1) + "|"]

@@ -17,7 +17,7 @@ DOCS = Path(__file__).resolve().parents[2] / "docs" / "tasks.md"
 def test_docs_tasks_md_is_generated():
     assert DOCS.is_file() and DOCS.read_text() == task_docs.render(), (
         "docs/tasks.md differs from the task docstring tables: run `mimo-social docs` "
-        "(edit the tables in mimo_social/tasks/*.py, not docs/tasks.md)")
+        "(edit the tables in mimo_social/tasks/*/__init__.py, not docs/tasks.md)")
 
 
 @pytest.mark.parametrize("entry", CATALOG, ids=lambda e: e.name)
@@ -32,7 +32,7 @@ def test_every_table_has_the_required_rows(entry):
 
 def test_one_section_per_catalogue_entry_in_its_order():
     text = task_docs.render()
-    places = [text.index(f"Task `{e.name}`: `") for e in CATALOG]
+    places = [text.index(f"Task `{e.name}`: folder `mimo_social/tasks/{e.name}/`") for e in CATALOG]
     assert places == sorted(places)
     for e in CATALOG:
         assert f"`{e.module.__name__}`" in text and f"`{e.gym_id}`" in text
@@ -50,8 +50,8 @@ def test_overview_reads_the_task_classes():
 
 
 def test_parse_docstring():
-    doc = ("Thing (paper Sec. X): a title.\n\n| | |\n|---|---|\n| agents | 1 |\n"
-           "| reward (both) | a `|` b, :class:`~a.b.Partner` |\n\nA note\nover two lines.\n")
+    doc = ("Thing (paper Sec. X): a title.\n\nagents:\n    1\nreward (both):\n    a `|` b,\n"
+           "    :class:`~a.b.Partner`\n\nA note\nover two lines.\n")
     title, rows, notes = task_docs.parse_docstring(doc, "here")
     assert title == "Thing (paper Sec. X): a title."
     assert rows == (("agents", "1"), ("reward (both)", "a `|` b, :class:`~a.b.Partner`"))
@@ -59,7 +59,9 @@ def test_parse_docstring():
     assert task_docs._markdown(rows[1][1]) == "a `|` b, `Partner`"
     with pytest.raises(ValueError, match="no table"):
         task_docs.parse_docstring("Title only.", "here")
-    with pytest.raises(ValueError, match="no module docstring"):
+    with pytest.raises(ValueError, match="no table"):   # a key without an indented value
+        task_docs.parse_docstring("Title.\n\nagents:\nnot indented\n", "here")
+    with pytest.raises(ValueError, match="no docstring"):
         task_docs.parse_docstring(None, "here")
 
 

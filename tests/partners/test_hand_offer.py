@@ -9,8 +9,8 @@ from mimo_social.partners import zero_action
 from mimo_social.core.kinematics import hand_geoms
 from mimo_social.tasks.handover import OFFER_TARGET, scripted_giver
 from mimo_social.partners.hand_offer import HandOffer, offer_posture
-from mimo_social.partners.controllers.receive import ReceiveController, hand_frame, palm_posture
-from mimo_social.partners.controllers.reach import ReachController
+from mimo_social.tasks.handover.controller import ReceiveController, hand_frame, palm_posture
+from mimo_social.tasks.reach.controller import ReachController
 
 
 def _palm(env, i=1):

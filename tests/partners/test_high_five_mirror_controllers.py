@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import high_five_v0, mirror_v0
-from mimo_social.partners.controllers.high_five import ArmSweep, HighFiveController
-from mimo_social.partners.controllers.mirror import MirrorController
+from mimo_social.tasks.high_five.controller import ArmSweep, HighFiveController
+from mimo_social.tasks.mirror.controller import MirrorController
 
 
 def _state(env):

@@ -7,8 +7,8 @@ import pytest
 
 from mimo_social.envs import handover_v0
 from mimo_social.partners import zero_action
-from mimo_social.partners.controllers.reach import ReachController
-from mimo_social.partners.controllers.receive import (ARM, CupAndLeave, ReceiveController,
+from mimo_social.tasks.reach.controller import ReachController
+from mimo_social.tasks.handover.controller import (ARM, CupAndLeave, ReceiveController,
                                                       hand_frame, palm_posture)
 from mimo_social.tasks.handover import HandoverOptions, scripted_giver
 

@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import social_touch_v0
-from mimo_social.partners.controllers import touch
-from mimo_social.partners.controllers.touch import (
+from mimo_social.tasks.social_touch import controller as touch
+from mimo_social.tasks.social_touch.controller import (
     ArmSweep,
     NearestPartToucher,
     SocialTouchController,
 )
-from mimo_social.tasks import social_touch
+from mimo_social.tasks.social_touch import task as social_touch
 
 
 def _episode(policy, seed, **kwargs):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import sys
 import math
 import types
 import typing
@@ -24,7 +25,6 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 from mimo_social import partners as partners_pkg
 from mimo_social.core.config import AgentConfig, PhysicsConfig, parse_physics, resolve_agents
 from mimo_social.envs.catalog import CATALOG
-from mimo_social.partners import controllers as controllers_pkg
 from mimo_social.senses import SENSES
 from mimo_social.util.checks import ConfigError
 
@@ -275,7 +275,10 @@ def test_reset_seeds(entry, seed):
 # -- partners -------------------------------------------------------------------------------------
 def _partner_classes():
     out = {}
-    for mod in (partners_pkg, controllers_pkg):
+    # the reusable partners, and every task's scripted solution and other policies (what its
+    # package exports: e.g. imitation's demonstrator)
+    tasks = [sys.modules[e.controller.__module__.rsplit(".", 1)[0]] for e in CATALOG if e.controller]
+    for mod in (partners_pkg, *tasks):
         for name in getattr(mod, "__all__", ()):
             obj = getattr(mod, name)
             if inspect.isclass(obj) and callable(getattr(obj, "act", None)) \

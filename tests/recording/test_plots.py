@@ -11,7 +11,7 @@ import rerun.blueprint as rrb
 from mimo_social.core.task import Plot, Task
 from mimo_social.core.world import CLOTHES_PALETTE
 from mimo_social.envs import catalog, free_play_v0, high_five_v0
-from mimo_social.partners.controllers import HighFiveController
+from mimo_social.tasks.high_five import HighFiveController
 from mimo_social.recording import Recorder, read_batches
 from mimo_social.util.checks import ConfigError
 

@@ -6,7 +6,7 @@ import pytest
 
 from mimo_social.core.random_actions import random_action_block
 from mimo_social.envs import catch_v0
-from mimo_social.partners.controllers.catch import CatchController
+from mimo_social.tasks.catch.controller import CatchController
 from mimo_social.tasks import catch as catch_task
 
 A = "infant_0"

@@ -6,8 +6,9 @@ import pytest
 from mimo_social.envs import contingency_v0
 from mimo_social.expressions.faces import EXPRESSIONS
 from mimo_social.partners import Partner
-from mimo_social.partners.controllers.contingency import ContingencyDetectorController
-from mimo_social.tasks.contingency import CONDITIONS, condition_summary
+from mimo_social.tasks.contingency.controller import ContingencyDetectorController
+from mimo_social.tasks.contingency import CONDITIONS
+from mimo_social.tasks.contingency.measures import condition_summary
 from mimo_social.util.checks import ConfigError
 
 HAPPY = EXPRESSIONS.index("happy")
@@ -181,7 +182,7 @@ def test_success_and_reward_free():
 def hack_figures(episodes=20, seed=1000):
     """Live, seeds ``seed ..``: per policy (successes, return mean, return sd); the learner's
     eyes off (no policy here reads them)."""
-    from mimo_social.partners.controllers.mirror import MirrorController
+    from mimo_social.tasks.mirror.controller import MirrorController
     policies = {"always happy": Pulses(10, 10), "copies the caregiver": MirrorController(),
                 "1-step dip every 0.5 s": Pulses(50, 49),
                 "detector": ContingencyDetectorController()}

@@ -11,7 +11,7 @@ from mimo_social.core.kinematics import reach_sites
 from mimo_social.partners import Still
 from mimo_social.partners.base import zero_action
 from mimo_social.partners.hand_offer import HandOffer
-from mimo_social.partners.controllers.high_five import ArmSweep, HighFiveController
+from mimo_social.tasks.high_five.controller import ArmSweep, HighFiveController
 
 HAND = {"right_hand", "right_fingers"}
 CLOSE = 0.35  # m between the infants in tests that put the hands together by hand

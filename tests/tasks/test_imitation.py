@@ -4,9 +4,10 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import imitation_v0
-from mimo_social.partners.controllers.imitation import ImitationController
-from mimo_social.partners.demonstrator import ACTION_POSES, Demonstrator
-from mimo_social.tasks.imitation import ACTIONS, partner_policy, run_episodes, summary
+from mimo_social.tasks.imitation.controller import ImitationController
+from mimo_social.tasks.imitation.demonstrator import ACTION_POSES, Demonstrator
+from mimo_social.tasks.imitation import ACTIONS
+from mimo_social.tasks.imitation.measures import records, summary
 
 BLIND = {"vision": False}      # the learner's eyes off where the test needs no pictures
 
@@ -29,7 +30,7 @@ def seeds_by_action(env, first=0, n=40) -> dict:
 
 def episode(env, partner, seed):
     """The learner's last info and its return over one episode with a scripted policy."""
-    [rec] = run_episodes(env, partner_policy(partner), 1, seed=seed)
+    [rec] = records(env, partner, 1, seed=seed)
     return rec
 
 
@@ -99,18 +100,28 @@ def test_reward_is_highest_for_the_demonstrated_action():
             assert rec["is_success"] == (done == shown)
 
 
+class Acts:
+    """A policy for the learner from a function env -> action."""
+
+    def __init__(self, fn):
+        self.fn = fn
+
+    def act(self, env, agent, obs):
+        return self.fn(env)
+
+
 def test_random_and_zero_actions_fail():
     env = scripted()
-    zero = run_episodes(env, lambda o, e: np.zeros(16, np.float32), 4, seed=100)
+    zero = records(env, Acts(lambda e: np.zeros(16, np.float32)), 4, seed=100)
     assert all(r["response"] == -1 and r["return"] == 0.0 for r in zero)
     env.action_space("infant_0").seed(0)
-    rand = run_episodes(env, lambda o, e: e.action_space("infant_0").sample(), 8, seed=100)
+    rand = records(env, Acts(lambda e: e.action_space("infant_0").sample()), 8, seed=100)
     assert sum(r["is_success"] for r in rand) <= 2
 
 
 def test_reward_free_keeps_the_measures_and_summary_counts():
     env = scripted(reward_free=True)
-    recs = run_episodes(env, partner_policy(ImitationController()), 4, seed=0)
+    recs = records(env, ImitationController(), 4, seed=0)
     assert all(r["is_success"] and r["return"] == 0.0 for r in recs)
     s = summary(recs)
     assert s["all"]["episodes"] == 4 and s["all"]["success"] == 1.0

@@ -7,7 +7,7 @@ from gymnasium import spaces
 from mimo_social.core.gym_adapter import SingleAgentEnv
 from mimo_social.core.wrappers import FlattenParallel
 from mimo_social.envs import joint_attention_v0
-from mimo_social.partners.controllers.gaze_follow import GazeFollowController
+from mimo_social.tasks.joint_attention.controller import GazeFollowController
 from mimo_social.partners.gaze import GazeAtTarget
 from mimo_social.train.envs import make_sb3_single
 

@@ -11,7 +11,7 @@ from mimo_social.train.envs import make_sb3_single
 from mimo_social.expressions.faces import EXPRESSIONS
 from mimo_social.partners import Partner
 from mimo_social.partners.expression import ExpressionShow
-from mimo_social.partners.controllers.mirror import MirrorController
+from mimo_social.tasks.mirror.controller import MirrorController
 
 NO_MOTORS = np.zeros(0, np.float32)
 

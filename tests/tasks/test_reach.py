@@ -16,7 +16,7 @@ import pytest
 import mimo_social  # noqa: F401  (registers the ids)
 from mimo_social.core.kinematics import reach_sites
 from mimo_social.envs import reach_v0
-from mimo_social.partners.controllers.reach import ReachController
+from mimo_social.tasks.reach.controller import ReachController
 from mimo_social.tasks import reach as reach_task
 from mimo_social.tasks.reach import ReachOptions
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import selfbody_v0
-from mimo_social.partners.controllers.selfbody import SelfBodyController
+from mimo_social.tasks.selfbody.controller import SelfBodyController
 from mimo_social.tasks import selfbody as task
 
 A = "infant_0"

@@ -12,7 +12,7 @@ import pytest
 
 import mimo_social  # noqa: F401  (registers the ids)
 from mimo_social.envs import standup_v0
-from mimo_social.partners.controllers.standup import StandupController
+from mimo_social.tasks.standup.controller import StandupController
 from mimo_social.tasks import standup as task
 
 A = "infant_0"

@@ -8,9 +8,9 @@ from mimo_social.envs import still_face_v0
 from mimo_social.expressions.faces import EXPRESSIONS
 from mimo_social.partners import Partner, Still
 from mimo_social.partners.contingent import ContingentCaregiver
-from mimo_social.partners.controllers.still_face import StillFaceInfantController
-from mimo_social.tasks.still_face import (MEASURES, PHASES, format_still_face_summary,
-                                          still_face_summary)
+from mimo_social.tasks.still_face.controller import StillFaceInfantController
+from mimo_social.tasks.still_face import MEASURES, PHASES
+from mimo_social.tasks.still_face.measures import format_still_face_summary, still_face_summary
 
 HAPPY = EXPRESSIONS.index("happy")
 #: rad: the most any free joint of the caregiver may move from one step to the next, and in

@@ -1,0 +1,543 @@
+"""``SocialTouchController``: the scripted toucher of the social touch task (touch a named part of
+the partner with the palm, touching nothing else first), and two hack policies that game it.
+
+| | |
+|---|---|
+| reads | the target part (``env.task.target``: a body part name of the partner, e.g. ``"left_hand"``; or ``target=`` given to the controller) and the world's state at reset |
+| plan | once per reset, on scratch copies of the state: postures by damped least squares over the right arm's shoulder, elbow and wrist (:func:`hand_posture`, the fingers straight): the palm's face ``standoff`` (5 cm) off the target's nearest surface and facing it, then ``depth`` (1 cm) into it; every geom of the arm kept ``clearance`` (1.5 cm) from the partner's other parts (the forearm and upper arm from the target too) and from the toucher's own body; each plan of :data:`VARIANTS` (the arm first raised ``lift`` above the target or not, other stand-offs, IK from seeded random starts) is run with this controller's own PD law on a scratch copy of the world (``mj_step``, the motors' torques) and the first whose first contact with the partner is the palm side of the hand on the target within ``good_steps`` is kept (else the fastest that does; else the first) |
+| arm | PD control per joint toward the current waypoint, gains from each joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio ``damping`` 1), plus gravity / Coriolis and passive-spring compensation (``qfrc_bias``, ``qfrc_spring``); ``u = tau / T_max`` clipped to [-1, 1]; the waypoint advances when every joint is within ``tolerance`` (0.1 rad) or after ``hold_steps`` (60) |
+| fingers | held straight by the same PD |
+| state | ``target_part``, ``waypoints``, ``variant`` (the plan kept), ``planned_steps`` (steps to the touch on the scratch world; inf: no plan touched the target first) |
+
+Hack policies (they ignore the instruction; each scores less than the controller, see
+tests/partners/test_touch_controller.py): :class:`NearestPartToucher` touches, palm first, the
+listed target part nearest to its hand at reset, whatever the target; :class:`ArmSweep` swings
+the arm, elbow bent, in front of the partner from its side to the midline and down.
+
+It acts only through the agent's own motors (no ``qpos`` writes) and reads what it needs from the
+world and ``env.task`` (it imports no task).
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
+from ...core.kinematics import hand_geoms
+from ...util.checks import check_number
+from ...partners.base import (Partner, agent_index, check_variants, follow_waypoints, motor_action,
+                    pd_gains, require_motors)
+
+__all__ = [
+    "BACK_COS",
+    "SIDES",
+    "VARIANTS",
+    "ArmSweep",
+    "NearestPartToucher",
+    "SocialTouchController",
+    "first_touch",
+    "hand_posture",
+    "reach_posture",
+    "side_normal",
+    "surface_point",
+]
+
+ARM = RIGHT_SHOULDER_ELBOW + RIGHT_WRIST
+#: the hand touches with the finger pads: the palm's normal tipped this far towards the fingertips
+TILT_DEG = 45.0
+#: a hand contact whose normal (into the partner) has a component at or below this along the
+#: palm's normal is the back of the hand, which does not count (the social touch task's rule)
+BACK_COS = -0.5
+#: the last step in: the arm may come this close (m) to the target's neighbours
+TOUCH_CLEARANCE = 0.004
+#: the arm raised to the side, elbow bent (deg): a first waypoint that keeps the hand clear of
+#: the partner's knees on its way in
+RAISE_DEG = {"right_shoulder_abduction": 90.0, "right_elbow": -90.0}
+#: sides of the partner the hand may come in from (x: from the toucher to the partner, y: the
+#: toucher's left, z: up), as normals of the partner's surface
+SIDES = {"front": (-1.0, 0.0, 0.0), "above": (0.0, 0.0, 1.0), "front_above": (-1.0, 0.0, 1.0),
+         "outside_above": (0.0, -1.0, 1.0), "front_outside": (-1.0, -1.0, 0.0),
+         "front_outside_above": (-1.0, -1.0, 1.0)}
+#: the plans tried at reset, in order (keyword arguments of ``_plan``)
+VARIANTS = (({}, {"side": "front_above"}, {"side": "above"}, {"side": "front"},
+             {"side": "front_outside_above"}, {"side": "outside_above"},
+             {"side": "front_outside"}, {"lift": 0.10}, {"side": "above", "lift": 0.08},
+             {"side": "front_above", "lift": 0.08}, {"standoff": 0.03})
+            + tuple(dict(v, raise_arm=True) for v in (
+                {}, {"side": "front_outside"}, {"side": "outside_above"},
+                {"side": "front_outside_above"}, {"side": "above"}, {"side": "front_above"},
+                {"side": "front_outside", "lift": 0.08}))
+            + tuple(dict(v, tilt_deg=t) for t in (60.0, 30.0) for v in (
+                {}, {"side": "above"}, {"side": "front_above"}, {"side": "front"},
+                {"side": "front_outside"}))
+            + tuple({"seed": s} for s in range(1, 5))
+            + tuple({"side": "front_above", "seed": s} for s in range(5, 9)))
+
+
+def _subtree_geoms(m, a, root: int) -> np.ndarray:
+    inside = np.zeros(m.nbody, bool)
+    inside[root] = True
+    for b in sorted(a.body_ids.tolist()):   # MuJoCo numbers a parent before its children
+        if b != root and inside[m.body_parentid[b]]:
+            inside[b] = True
+    return a.geom_ids[inside[m.geom_bodyid[a.geom_ids]]]
+
+
+def _collide(m, g1: int, g2: int) -> bool:
+    b1, b2 = int(m.geom_bodyid[g1]), int(m.geom_bodyid[g2])
+    if m.body_parentid[b1] == b2 or m.body_parentid[b2] == b1:
+        return False
+    return bool((m.geom_contype[g1] & m.geom_conaffinity[g2])
+                or (m.geom_contype[g2] & m.geom_conaffinity[g1]))
+
+
+class _Geometry:
+    """Geom sets of one toucher / partner / part: the arm, the hand, the palm, the target and
+    the obstacles of each arm geom (pairs MuJoCo collides)."""
+
+    def __init__(self, world, i: int, j: int, part: str):
+        m = world.model
+        a, b = world.agents[i], world.agents[j]
+        try:
+            body = m.body(f"{b.name}/{part}").id
+        except KeyError:
+            raise ValueError(f"SocialTouchController: target {part!r} is no body part of "
+                             f"{b.name}") from None
+        inside = np.zeros(m.nbody, bool)
+        inside[body] = True
+        if part.endswith("_hand"):   # a hand includes its fingers (the task's rule)
+            for c in sorted(b.body_ids.tolist()):
+                if c != body and inside[m.body_parentid[c]]:
+                    inside[c] = True
+        self.target = np.flatnonzero(inside[m.geom_bodyid])
+        if not len(self.target):
+            raise ValueError(f"SocialTouchController: {b.name}'s part {part!r} has no geoms")
+        self.target_body = body
+        self.arm = _subtree_geoms(m, a, m.body(f"{a.name}/right_upper_arm").id)
+        self.hand = np.asarray(hand_geoms(world, i, 0), np.intp)
+        palm_body = int(m.site_bodyid[a.palm_sites[0]])
+        self.palm_body = palm_body
+        self.palm = np.flatnonzero(m.geom_bodyid == palm_body)
+        in_arm = np.isin(a.geom_ids, self.arm)
+        own = a.geom_ids[~in_arm]
+        others = np.concatenate([own, b.geom_ids])
+        is_target = np.isin(others, self.target)
+        self.obstacles = {}
+        for g in self.arm.tolist():
+            hand = g in set(self.hand.tolist())
+            self.obstacles[g] = np.array([o for o, t in zip(others.tolist(), is_target)
+                                          if _collide(m, g, o) and not (hand and t)], np.intp)
+
+
+def hand_posture(world, i: int, j: int, part: str, gap: float, start=None, iters: int = 300,
+                 clearance: float = 0.015, tilt_deg: float = TILT_DEG, direction=None,
+                 point=None, geometry: _Geometry | None = None) -> tuple[np.ndarray, float, float, np.ndarray]:
+    """Right-arm joint angles of agent ``i`` (its actuated joints, rad; the fingers straight)
+    that put its hand ``gap`` m from agent ``j``'s body part ``part`` (negative: into it), the
+    hand's touching direction (the palm's normal tipped ``tilt_deg`` towards the fingertips:
+    the finger pads) pointing at the part, every arm geom ``clearance`` from everything else (the
+    partner's other parts, the own body; the forearm and upper arm from the target too).
+    ``direction``: a fixed approach direction (world, unit) instead of the line between the
+    nearest points (moving in along the normal found at a stand-off); ``point`` (world): put
+    the centre of the fingertips there instead (``gap`` is then not used), the touching
+    direction along ``direction``.
+
+    Damped least squares on a scratch copy of the state (``start``: the first angles, default
+    the current ones). Returns the angles, the hand's signed distance to the part (m), the worst
+    clearance violation (m, 0 when every geom is clear) and the approach direction (unit).
+    """
+    m = world.model
+    a = world.agents[i]
+    geo = geometry if geometry is not None else _Geometry(world, i, j, part)
+    k = a.actuated_joint_idx
+    names = list(a.actuated_names)
+    arm = np.array([names.index(n) for n in ARM if n in names])
+    qadr, dadr = a.qpos_adr[k], a.dof_adr[k]
+    lo, hi = a.joint_range[k, 0], a.joint_range[k, 1]
+    d = mujoco.MjData(m)
+    d.qpos[:] = world.data.qpos
+    q = d.qpos[qadr].copy() if start is None else np.array(start, float)
+    fingers = np.setdiff1d(np.arange(len(names)), arm)
+    q[fingers] = np.clip(0.0, lo[fingers], hi[fingers])
+    d.qpos[qadr] = np.clip(q, lo, hi)
+    cols = dadr[arm]
+    fromto = np.zeros(6)
+    jac, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+    rb = m.geom_rbound
+    tip = int(a.fingertip_sites[0])
+    tilt = np.deg2rad(tilt_deg)
+    # in the hand's frame: the palm side is -y, the fingers point along +z
+    touch_dir = np.array([0.0, -np.cos(tilt), np.sin(tilt)])
+    dist = worst = np.inf
+    for _ in range(iters):
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        rows, errs = [], []
+        dist = np.inf
+        for h in geo.hand.tolist():
+            for t in geo.target.tolist():
+                s = float(mujoco.mj_geomDistance(m, d, h, t, 1.0, fromto))
+                if s < dist:
+                    dist, p_h, p_t, gt, gh = s, fromto[:3].copy(), fromto[3:].copy(), t, h
+        if direction is not None:
+            u = np.asarray(direction, float)
+        else:
+            u = p_t - p_h
+            if dist <= 1e-4 or np.linalg.norm(u) < 1e-6:
+                u = d.geom_xpos[gt] - p_h
+            u = u / max(np.linalg.norm(u), 1e-9)
+        if point is None:
+            mujoco.mj_jac(m, d, jac, None, p_h, int(m.geom_bodyid[gh]))
+            rows.append(jac[:, cols].copy())
+            errs.append(u * (dist - gap))
+        else:
+            mujoco.mj_jacSite(m, d, jac, None, tip)
+            rows.append(jac[:, cols].copy())
+            errs.append(np.asarray(point, float) - d.site_xpos[tip])
+        mujoco.mj_jacBody(m, d, None, jacr, geo.palm_body)
+        pointing = d.xmat[geo.palm_body].reshape(3, 3) @ touch_dir
+        rows.append(0.05 * jacr[:, cols])
+        errs.append(0.05 * np.cross(pointing, u))
+        worst = 0.0
+        for g, obs in geo.obstacles.items():
+            if not len(obs):
+                continue
+            near = obs[np.linalg.norm(d.geom_xpos[obs] - d.geom_xpos[g], axis=1)
+                       < rb[obs] + rb[g] + clearance + 0.02]
+            for o in near.tolist():
+                s = float(mujoco.mj_geomDistance(m, d, g, o, clearance + 0.02, fromto))
+                if s < clearance:
+                    p_g, p_o = fromto[:3].copy(), fromto[3:].copy()
+                    v = p_g - p_o
+                    if s <= 1e-4 or np.linalg.norm(v) < 1e-6:
+                        v = p_g - d.geom_xpos[o]
+                    v /= max(np.linalg.norm(v), 1e-9)
+                    mujoco.mj_jac(m, d, jac, None, p_g, int(m.geom_bodyid[g]))
+                    rows.append(jac[:, cols].copy())
+                    errs.append(v * (clearance - s))
+                    worst = max(worst, clearance - s)
+        e = np.concatenate(errs)
+        if np.linalg.norm(errs[0]) < 1e-3 and worst < 1e-3 and np.linalg.norm(errs[1]) < 2e-3:
+            break
+        J = np.vstack(rows)
+        step = J.T @ np.linalg.solve(J @ J.T + 1e-4 * np.eye(len(e)), e)
+        d.qpos[qadr[arm]] = np.clip(d.qpos[qadr[arm]] + np.clip(step, -0.1, 0.1),
+                                    lo[arm], hi[arm])
+    return d.qpos[qadr].copy(), float(dist), float(worst), u
+
+
+def first_touch(m, d, geo: _Geometry, arm_mask: np.ndarray, partner_mask: np.ndarray):
+    """``None`` while the arm touches nothing of the partner; else whether the first contact
+    includes the hand on the target, not with its back (contact normal within 120 deg of the
+    palm's normal)."""
+    n = d.ncon
+    if n == 0:
+        return None
+    c = d.contact
+    g1, g2 = c.geom1[:n], c.geom2[:n]
+    hit = ((arm_mask[g1] & partner_mask[g2]) | (arm_mask[g2] & partner_mask[g1])) \
+        & (c.dist[:n] <= 0.0)
+    if not hit.any():
+        return None
+    for k in np.flatnonzero(hit).tolist():
+        mine, other, sign = (g1[k], g2[k], 1.0) if arm_mask[g1[k]] else (g2[k], g1[k], -1.0)
+        if other in geo.target and mine in geo.hand:
+            palm = -d.xmat[m.geom_bodyid[mine]].reshape(3, 3)[:, 1]
+            if sign * float(c.frame[k, :3] @ palm) > BACK_COS:
+                return True
+    return False
+
+
+def side_normal(world, i: int, j: int, side: str) -> np.ndarray:
+    """The unit normal of a side (a key of :data:`SIDES`) of agent ``j``, seen from agent ``i``:
+    x from ``i`` to ``j`` (level), z up, y to ``i``'s left."""
+    d = world.data
+    ex = d.xpos[world.agents[j].body_ids[0]] - d.xpos[world.agents[i].body_ids[0]]
+    ex[2] = 0.0
+    ex /= max(np.linalg.norm(ex), 1e-9)
+    ez = np.array([0.0, 0.0, 1.0])
+    v = np.asarray(SIDES[side], float) @ np.vstack([ex, np.cross(ez, ex), ez])
+    return v / np.linalg.norm(v)
+
+
+def surface_point(world, geometry: _Geometry, n: np.ndarray):
+    """Where a ray coming in along ``-n`` through the target part's centre of mass first meets
+    the part (None: it misses)."""
+    m, d = world.model, world.data
+    pnt = d.xipos[geometry.target_body] + 0.3 * n
+    vec = -np.asarray(n, float)
+    best = np.inf
+    for g in geometry.target.tolist():
+        t = mujoco.mju_rayGeom(d.geom_xpos[g], d.geom_xmat[g], m.geom_size[g], pnt, vec,
+                               int(m.geom_type[g]))
+        if 0.0 <= t < best:
+            best = t
+    return None if not np.isfinite(best) else pnt + best * vec
+
+
+def reach_posture(world, i: int, j: int, part: str, depth: float = 0.005,
+                  clearance: float = 0.0) -> tuple[np.ndarray, float, float]:
+    """A right-arm posture of agent ``i`` with its hand (finger pads) ``depth`` into agent
+    ``j``'s ``part``, the arm ``clearance`` from everything else (0: touching nothing else): :func:`hand_posture` along the
+    line to the part's nearest point and in from each of :data:`SIDES`; the best (deepest with
+    the smallest violation). Returns the angles, the hand's signed distance to the part (m) and
+    the worst clearance violation (m). The task's reachability check."""
+    geo = _Geometry(world, i, j, part)
+    best = None
+    kw = {"clearance": clearance, "geometry": geo}
+    starts = [hand_posture(world, i, j, part, 0.05, geometry=geo)]
+    for side in SIDES:
+        n = side_normal(world, i, j, side)
+        s = surface_point(world, geo, n)
+        if s is not None:
+            starts.append(hand_posture(world, i, j, part, 0.0, direction=-n, geometry=geo,
+                                       point=s + 0.06 * n))
+    for q0, _, _, u in starts:
+        q, dist, worst, _ = hand_posture(world, i, j, part, -depth, start=q0, direction=u, **kw)
+        score = max(dist + depth, 0.0) + worst
+        if best is None or score < best[0]:
+            best = (score, q, dist, worst)
+    return best[1], best[2], best[3]
+
+
+class SocialTouchController(Partner):
+    """Touch the social touch task's target part of the partner with the palm, coming in along
+    the part's normal, clear of the partner's other parts (see the module table).
+
+    ``target``: a body part name of the partner, or ``None`` to read the task's target at each
+    reset (``env.task.target``); ``standoff`` (m): the palm's gap to the part before moving in;
+    ``depth`` (m): how far into the part the hand is aimed; ``tilt_deg``: the touching
+    direction, the palm's normal tipped this far towards the fingertips (the finger pads); ``lift`` (m): where variants raise
+    the palm above the part first; ``frequency`` (Hz) and ``damping`` (ratio): the PD loop;
+    ``tolerance`` (rad) and ``hold_steps``: when a waypoint gives way to the next; ``variants``:
+    the plans tried at reset (default :data:`VARIANTS`); ``good_steps``: the first plan that
+    touches the target first within this many steps on the scratch world is kept.
+    """
+
+    who = "SocialTouchController"
+
+    def __init__(self, target: str | None = None, standoff: float = 0.05, depth: float = 0.03,
+                 lift: float = 0.10, frequency: float = 3.0, damping: float = 1.0,
+                 tolerance: float = 0.1, hold_steps: int = 60, variants=None,
+                 good_steps: int = 250, tilt_deg: float = TILT_DEG):
+        if target is not None and (not isinstance(target, str) or not target):
+            raise ValueError(f"{self.who}: target={target!r}; allowed: None or a body part "
+                             "name of the partner")
+        self.target = target
+        self.standoff = check_number(self.who, "standoff", standoff, 0.0, 0.2)
+        self.depth = check_number(self.who, "depth", depth, 0.0, 0.05)
+        self.lift = check_number(self.who, "lift", lift, 0.0, 0.3)
+        self.frequency = check_number(self.who, "frequency", frequency, 0.1, 20.0)
+        self.damping = check_number(self.who, "damping", damping, 0.1, 5.0)
+        self.tolerance = check_number(self.who, "tolerance", tolerance, 0.01, 1.0)
+        self.hold_steps = int(check_number(self.who, "hold_steps", hold_steps, 1, 10000))
+        self.variants = check_variants(self.who, variants, self._plan, VARIANTS)
+        self.good_steps = int(check_number(self.who, "good_steps", good_steps, 1, 100000))
+        self.tilt_deg = check_number(self.who, "tilt_deg", tilt_deg, 0.0, 90.0)
+
+    def __repr__(self):
+        return f"{type(self).__name__}(target={self.target!r})"
+
+    # -- set-up shared with the hacks ------------------------------------------------------------
+    def _bind(self, env, agent):
+        w = env.world
+        m, d = w.model, w.data
+        i = agent_index(env, agent)
+        if len(env.possible_agents) != 2:
+            raise ValueError(f"{self.who}: needs a dyad (the toucher and the touched infant); "
+                             f"agents: {env.possible_agents}")
+        a = w.agents[i]
+        require_motors(self.who, agent, a, ARM,
+                       "it needs the right arm's motors (shoulder, elbow, wrist) in its action")
+        act = env.actuation[i]
+        if act.name == "muscle":
+            raise ValueError(f"{self.who}: {agent} is muscle-actuated; allowed actuation: "
+                             "'spring_damper' (the task's)")
+        self._i, self._j, self._a = i, 1 - i, a
+        k = a.actuated_joint_idx
+        self._qadr, self._dadr = a.qpos_adr[k], a.dof_adr[k]
+        self._lo, self._hi = a.joint_range[k, 0], a.joint_range[k, 1]
+        self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping)
+        self._act = act
+        self._tneg, self._tpos = act.torque_neg, act.torque_pos
+        self._arm_mask = np.zeros(m.ngeom, bool)
+        self._partner_mask = np.zeros(m.ngeom, bool)
+        self._partner_mask[w.agents[self._j].geom_ids] = True
+        tip = d.site_xpos[a.fingertip_sites[0]]
+        hand = hand_geoms(w, i, 0)
+        nearest = int(hand[np.argmin(np.linalg.norm(d.geom_xpos[hand] - tip, axis=1))])
+        round_ = m.geom_type[nearest] in (mujoco.mjtGeom.mjGEOM_SPHERE,
+                                          mujoco.mjtGeom.mjGEOM_CAPSULE,
+                                          mujoco.mjtGeom.mjGEOM_CYLINDER)
+        self._tip_radius = float(m.geom_size[nearest, 0]) if round_ else 0.01
+
+    def _part(self, env) -> str:
+        name = self.target if self.target is not None else getattr(env.task, "target", None)
+        if name is None:
+            raise ValueError(f"{self.who}: no target: give target= or use it on an env whose "
+                             "task names one (env.task.target)")
+        return str(name)
+
+    def reset(self, env, agent, rng):
+        super().reset(env, agent, rng)
+        self._bind(env, agent)
+        self.target_part = self._part(env)
+        w = env.world
+        self._geo = _Geometry(w, self._i, self._j, self.target_part)
+        self._arm_mask[:] = False
+        self._arm_mask[self._geo.arm] = True
+        best = None
+        for variant in self.variants:
+            plan = self._plan(w, **variant)
+            if not plan:
+                continue
+            steps = self._rollout(w, plan, env.max_steps, env.frame_skip)
+            if best is None or steps < best[0]:
+                best = (steps, plan, variant)
+            if steps <= self.good_steps:
+                break
+        if best is None:
+            raise ValueError(f"{self.who}: no plan for {self.target_part!r}")
+        self.planned_steps, self.waypoints, self.variant = best
+        self._wp, self._in_wp = 0, 0
+        self.target_angles = self.waypoints[0]
+
+    def _plan(self, w, lift: float | None = None, standoff: float | None = None,
+              seed: int | None = None, side: str | None = None,
+              raise_arm: bool = False, tilt_deg: float | None = None) -> list[np.ndarray]:
+        """Waypoints: (the hand ``lift`` above its stand-off,) the hand ``standoff`` off the
+        part facing it, then 40 % of that, then ``depth`` into it, moving in along one line.
+        ``tilt_deg``: another touching direction. ``raise_arm``: first the arm raised to the side (:data:`RAISE_DEG`). ``side`` (a key of :data:`SIDES`): come in along that side's normal to the point of the
+        part's surface hit by a ray from that side through its centre; else along the line
+        between the hand and the part's nearest point; the IK starts from the current posture
+        or from a seeded random one."""
+        standoff = self.standoff if standoff is None else standoff
+        start = None
+        if seed is not None:
+            start = np.random.default_rng(seed).uniform(self._lo, self._hi)
+        args = (w, self._i, self._j, self.target_part)
+        kw = {"geometry": self._geo,
+              "tilt_deg": self.tilt_deg if tilt_deg is None else tilt_deg}
+        if side is None:
+            pre, _, _, u = hand_posture(*args, standoff, start=start, **kw)
+            near, _, _, _ = hand_posture(*args, 0.4 * standoff, start=pre, direction=u,
+                                         clearance=TOUCH_CLEARANCE, **kw)
+            touch, _, _, _ = hand_posture(*args, -self.depth, start=near, direction=u,
+                                          clearance=TOUCH_CLEARANCE, **kw)
+            up = None
+            if lift:
+                up, _, _, _ = hand_posture(*args, lift, start=pre, **kw)
+        else:
+            n = side_normal(w, self._i, self._j, side)
+            surface = surface_point(w, self._geo, n)
+            if surface is None:
+                return []
+            u = -n
+            r = self._tip_radius
+
+            def at(gap, q0, clearance=0.015):
+                return hand_posture(*args, 0.0, start=q0, direction=u, clearance=clearance,
+                                    point=surface + n * (r + gap), **kw)[0]
+            pre = at(standoff, start)
+            near = at(0.4 * standoff, pre, TOUCH_CLEARANCE)
+            touch = at(-self.depth, near, TOUCH_CLEARANCE)
+            up = None
+            if lift:
+                up = hand_posture(*args, 0.0, start=pre, direction=u,
+                                  point=surface + n * (r + standoff) + [0.0, 0.0, lift], **kw)[0]
+        plan = ([up] if up is not None else []) + [pre, near, touch]
+        if raise_arm:
+            names = list(self._a.actuated_names)
+            q = w.data.qpos[self._qadr].copy()
+            for name, deg in RAISE_DEG.items():
+                if name in names:
+                    q[names.index(name)] = np.deg2rad(deg)
+            plan.insert(0, np.clip(q, self._lo, self._hi))
+        return plan
+
+    def _rollout(self, w, waypoints, max_steps: int, frame_skip: int) -> float:
+        """Control steps until the first contact with the partner, when it is the palm on the
+        target, running this plan on a scratch copy of the world (inf: never, or another part
+        first)."""
+        m = w.model
+        d = mujoco.MjData(m)
+        d.qpos[:], d.qvel[:], d.act[:], d.ctrl[:] = w.data.qpos, w.data.qvel, w.data.act, \
+            w.data.ctrl
+        mujoco.mj_forward(m, d)
+        state = [0, 0, waypoints[0]]
+        for step in range(1, max_steps + 1):
+            d.ctrl[self._act.actuator_ids] = self._act.torque(self._control(d, waypoints, state))
+            for _ in range(frame_skip):
+                mujoco.mj_step(m, d)
+            mujoco.mj_kinematics(m, d)
+            hit = first_touch(m, d, self._geo, self._arm_mask, self._partner_mask)
+            if hit is not None:
+                return float(step) if hit else float("inf")
+        return float("inf")
+
+    def _control(self, d, waypoints, state) -> np.ndarray:
+        """The controls of one step (PD + compensation toward the current waypoint); ``state``
+        [waypoint, steps in it, target angles] is advanced in place."""
+        return follow_waypoints(d, waypoints, state, self.hold_steps, self.tolerance, self._qadr,
+                                self._dadr, self._kp, self._kd, self._tneg, self._tpos)
+
+    def act(self, env, agent, observation):
+        state = [self._wp, self._in_wp, self.target_angles]
+        u = self._control(env.world.data, self.waypoints, state)
+        self._wp, self._in_wp, self.target_angles = state
+        return motor_action(env.action_space(agent), u)
+
+
+class NearestPartToucher(SocialTouchController):
+    """Hack policy: ignores the instruction and touches, palm first, the task's listed target
+    part (``env.task.targets``) whose centre is nearest its palm at reset."""
+
+    who = "NearestPartToucher"
+
+    def _part(self, env) -> str:
+        w = env.world
+        m, d = w.model, w.data
+        b = w.agents[self._j]
+        parts = list(getattr(env.task, "targets", ()) or [])
+        if not parts:
+            raise ValueError(f"{self.who}: the task lists no target parts (env.task.targets)")
+        palm = d.site_xpos[self._a.palm_sites[0]]
+        far = [np.linalg.norm(d.xipos[m.body(f"{b.name}/{p}").id] - palm) for p in parts]
+        return parts[int(np.argmin(far))]
+
+
+class ArmSweep(Partner):
+    """Hack policy: swings the right arm, elbow bent, forward and across in front of the
+    partner (shoulder horizontal from 0 to 90 deg at ``abduction_deg``), then lowers it: it
+    touches whatever part is in the way, the instruction unread. PD control as the controller's
+    (``frequency`` Hz)."""
+
+    #: (shoulder horizontal, shoulder abduction, elbow) in deg along the sweep
+    PATH = ((0.0, 80.0, -40.0), (45.0, 80.0, -40.0), (90.0, 80.0, -40.0), (90.0, 40.0, -20.0),
+            (90.0, 10.0, 0.0))
+
+    def __init__(self, frequency: float = 3.0, hold_steps: int = 60):
+        self.frequency = check_number("ArmSweep", "frequency", frequency, 0.1, 20.0)
+        self.hold_steps = int(check_number("ArmSweep", "hold_steps", hold_steps, 1, 10000))
+
+    def reset(self, env, agent, rng):
+        super().reset(env, agent, rng)
+        helper = SocialTouchController(frequency=self.frequency, hold_steps=self.hold_steps)
+        helper.who = "ArmSweep"
+        helper._bind(env, agent)
+        names = list(helper._a.actuated_names)
+        q0 = np.clip(np.zeros(len(names)), helper._lo, helper._hi)
+        waypoints = []
+        for h, ab, el in self.PATH:
+            q = q0.copy()
+            for n, deg in (("right_shoulder_horizontal", h), ("right_shoulder_abduction", ab),
+                           ("right_elbow", el)):
+                q[names.index(n)] = np.deg2rad(deg)
+            waypoints.append(np.clip(q, helper._lo, helper._hi))
+        helper.waypoints, helper.target_angles = waypoints, waypoints[0]
+        helper._wp = helper._in_wp = 0
+        self._helper = helper
+
+    def act(self, env, agent, observation):
+        return self._helper.act(env, agent, observation)
