@@ -14,6 +14,8 @@ catalogue's Gymnasium id; for a social task its learner, the partner scripted):
 * each trained run directory (``mimo-social train``): its final ``model.zip`` (or
   ``best_model.zip``), deterministic, on the flat observations it was trained on.
 
+Every episode runs in the core's episode loop (:func:`mimo_social.core.episodes.run_episode`).
+
 Per policy: success rate (``is_success`` of the last step's info; n/a where the task reports
 none), return mean and std, episode length, and steps to success: the first step whose info says
 ``is_success``, averaged over the successful episodes. :func:`markdown_table` writes the table.
@@ -29,9 +31,11 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ..core.episodes import run_episode
 from ..envs.catalog import entry
 from ..partners.base import zero_action
 from .envs import make_env
+from .rollouts import ModelPolicy
 from .tasks import TrainInputError, algo_class, check_task
 
 __all__ = ["baselines", "markdown_table", "write_json"]
@@ -46,10 +50,12 @@ class _Random:
         import copy
         self.space = copy.deepcopy(space)
 
-    def reset(self, base, seed: int) -> None:
-        self.space.seed(int(seed))
+    def reset(self, env, agent: str, rng: np.random.Generator) -> None:
+        # the space seeded with the episode's seed: ``rng`` is ``default_rng(seed)`` (see
+        # :func:`_episode`), whose seed sequence holds that seed as its entropy
+        self.space.seed(int(rng.bit_generator.seed_seq.entropy))
 
-    def act(self, obs):
+    def act(self, env, agent: str, obs):
         return self.space.sample()
 
 
@@ -59,10 +65,7 @@ class _Zero:
     def __init__(self, space):
         self.action = zero_action(space)
 
-    def reset(self, base, seed: int) -> None:
-        pass
-
-    def act(self, obs):
+    def act(self, env, agent: str, obs):
         return self.action
 
 
@@ -75,15 +78,14 @@ class _Scripted:
         self.controller = controller_cls()
         self.name = f"scripted ({type(self.controller).__name__})"
 
-    def reset(self, base, seed: int) -> None:
-        self.env, self.agent = base.parallel.unwrapped, base.agent
-        self.controller.reset(self.env, self.agent, np.random.default_rng(int(seed)))
+    def reset(self, env, agent: str, rng: np.random.Generator) -> None:
+        self.controller.reset(env, agent, rng)
 
-    def act(self, obs):
-        return self.controller.act(self.env, self.agent, obs)
+    def act(self, env, agent: str, obs):
+        return self.controller.act(env, agent, obs)
 
 
-class _Trained:
+class _Trained(ModelPolicy):
     """A trained run's policy, deterministic, on the flat observations of :func:`make_env`."""
 
     kind, wrapped = "trained", True
@@ -92,15 +94,9 @@ class _Trained:
         path = {"final": run / "model.zip", "best": run / "best_model.zip"}.get(model, Path(model))
         if not path.exists():
             raise FileNotFoundError(f"model {path} not found (model: final, best or a .zip path)")
-        self.model = algo_class(config["algo"]).load(str(path), device="cpu")
+        super().__init__(algo_class(config["algo"]).load(str(path), device="cpu"))
         self.name = f"{run.name} ({config['algo'].upper()})"
         self.run, self.path, self.algo = str(run), str(path), config["algo"]
-
-    def reset(self, base, seed: int) -> None:
-        pass
-
-    def act(self, obs):
-        return self.model.predict(obs, deterministic=True)[0]
 
 
 def _load_run(run: str | Path, task: str) -> dict:
@@ -136,20 +132,12 @@ def _env_kwargs(configs: Sequence[dict], runs: Sequence[str],
 
 
 def _episode(policy, env, base, seed: int) -> tuple[float, int, bool | None, int | None]:
-    """One episode: (return, length, success on the last step or None, first success step)."""
-    stepper = env if policy.wrapped else base
-    obs, info = stepper.reset(seed=seed)
-    policy.reset(base, seed)
-    total, length, first = 0.0, 0, None
-    while True:
-        obs, reward, terminated, truncated, info = stepper.step(policy.act(obs))
-        total += float(reward)
-        length += 1
-        if first is None and info.get("is_success"):
-            first = length
-        if terminated or truncated:
-            success = info.get("is_success")
-            return total, length, (None if success is None else bool(success)), first
+    """One episode of the core loop on the flat ``env`` (a trained policy) or on ``base``, the
+    SingleAgentEnv, the policy reset with ``default_rng(seed)``: (return, length, success on
+    the last step or None, first success step)."""
+    ep = run_episode(env if policy.wrapped else base, policy, seed, policy_rng=seed)
+    a = base.agent
+    return ep.returns[a], ep.length, ep.success(a), ep.first_success[a]
 
 
 def _summary(policy, episodes: list[tuple]) -> dict:

@@ -5,6 +5,9 @@
 ``evaluate_agents(policies, env, episodes, seed)``
     Every agent of a flat ParallelEnv acting with its own policy: per-agent returns and success
     rates (``is_success`` of the agent's info on its last step) and their means across agents.
+
+The episodes run in the core's episode loop (:mod:`mimo_social.core.episodes`), the models
+acting through :class:`ModelPolicy`.
 """
 
 from __future__ import annotations
@@ -14,26 +17,42 @@ from typing import Any, Mapping
 
 import numpy as np
 
-__all__ = ["run_gym_episode", "evaluate_policy", "run_episode", "evaluate_agents"]
+from ..core.episodes import run_episode as _run_episode
+
+__all__ = ["run_gym_episode", "evaluate_policy", "run_episode", "evaluate_agents", "ModelPolicy"]
+
+
+class ModelPolicy:
+    """A model with SB3's ``predict(obs, deterministic) -> (action, state)`` as a policy of the
+    core episode loop (:func:`mimo_social.core.episodes.run_episode`), acting on the observations
+    of the env stepped. ``actions``: a dict that gets each action, keyed by agent."""
+
+    def __init__(self, model, deterministic: bool = True, actions: dict | None = None):
+        self.model, self.deterministic, self.actions = model, deterministic, actions
+
+    def act(self, env, agent: str, obs):
+        action = self.model.predict(obs, deterministic=self.deterministic)[0]
+        if self.actions is not None:
+            self.actions[agent] = action
+        return action
+
+
+def _only(d: Mapping[str, Any]):
+    """The value of a one-entry dict (a Gymnasium env's numbers keyed by its agent)."""
+    return next(iter(d.values()))
 
 
 def run_gym_episode(model, env, seed: int | None, deterministic: bool = True, on_step=None):
     """One episode; returns (return, length, success or None)."""
-    obs, info = env.reset(seed=seed)
-    if on_step is not None:
-        on_step(None, None, info, reset=True)
-    total, length, success = 0.0, 0, None
-    while True:
-        action, _ = model.predict(obs, deterministic=deterministic)
-        obs, reward, terminated, truncated, info = env.step(action)
-        total += float(reward)
-        length += 1
-        if on_step is not None:
-            on_step(action, reward, info, reset=False)
-        if terminated or truncated:
-            if "is_success" in info:
-                success = bool(info["is_success"])
-            return total, length, success
+    actions: dict = {}
+    hooks = {}
+    if on_step is not None:   # the one agent's action, reward and info
+        hooks["on_reset"] = lambda _env, obs, infos: on_step(None, None, _only(infos), reset=True)
+        hooks["on_step"] = lambda _env, obs, rewards, terms, truncs, infos: on_step(
+            _only(actions), _only(rewards), _only(infos), reset=False)
+    ep = _run_episode(env, ModelPolicy(model, deterministic, actions), seed, **hooks)
+    agent = next(iter(ep.returns))
+    return ep.returns[agent], ep.length, ep.success(agent)
 
 
 def evaluate_policy(model, env, episodes: int, seed: int, deterministic: bool = True,
@@ -57,23 +76,21 @@ def run_episode(policies: Mapping[str, Any], env, seed: int | None, deterministi
                 on_step=None) -> dict[str, tuple[float, int, bool | None]]:
     """One episode of a (flat) ParallelEnv; each agent acts with ``policies[agent]``.
     Returns ``{agent: (return, length, success or None)}``."""
-    obs, infos = env.reset(seed=seed)
+    actions: dict = {}
+    hooks = {}
     if on_step is not None:
-        on_step(None, None, obs, reset=True)
-    out = {a: [0.0, 0, None] for a in env.possible_agents}
-    while env.agents:
-        actions = {a: policies[a].predict(obs[a], deterministic=deterministic)[0]
-                   for a in env.agents}
-        obs, rewards, terms, truncs, infos = env.step(actions)
-        for a, r in rewards.items():
-            out[a][0] += float(r)
-            out[a][1] += 1
-            if terms.get(a) or truncs.get(a):
-                s = infos.get(a, {}).get("is_success")
-                out[a][2] = None if s is None else bool(s)
-        if on_step is not None:
-            on_step(actions, rewards, obs, reset=False)
-    return {a: tuple(v) for a, v in out.items()}
+        hooks["on_reset"] = lambda _env, obs, infos: on_step(None, None, obs, reset=True)
+
+        def after_step(_env, obs, rewards, terms, truncs, infos):
+            acted = dict(actions)
+            actions.clear()
+            on_step(acted, rewards, obs, reset=False)
+        hooks["on_step"] = after_step
+    models = {a: ModelPolicy(policies[a], deterministic, actions)
+              for a in env.possible_agents if a in policies}
+    ep = _run_episode(env, models, seed, **hooks)
+    return {a: (ep.returns[a], ep.steps[a], ep.success(a) if ep.steps[a] else None)
+            for a in env.possible_agents}
 
 
 def evaluate_agents(policies: Mapping[str, Any], env, episodes: int, seed: int,
