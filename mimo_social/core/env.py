@@ -96,6 +96,7 @@ class MimoParallelEnv(ParallelEnv):
         self.agents = list(self.possible_agents)
         self._index = {name: i for i, name in enumerate(self.possible_agents)}
         self._bind()
+        self._bind_task()
         self._rng = np.random.default_rng()
         self._was_reset = False   # step() before the first reset() is an error, not a crash
         self._renderer = None
@@ -154,6 +155,29 @@ class MimoParallelEnv(ParallelEnv):
         self._motor_delays = [MotorDelay(k, act.n_controls) if (k := self._delays[i]["motor"])
                               else None for i, act in enumerate(self.actuation)]
 
+    def advance(self, n: int) -> str | None:
+        """``n`` physics steps with the controls in force, through the world's own step (the
+        actuation models' per-step updates included, the state checked after each step); the
+        reason string if the simulation went unstable (the world then restarted), else None.
+        :meth:`step` advances ``frame_skip`` of them; a task settling its start state (at reset)
+        advances as many as it needs."""
+        w = self.world
+        if not self._needs_substep:
+            return w.step(n)
+        m, d = w.model, w.data
+        acts = [act for act in self.actuation if act.needs_substep]
+
+        def substep():
+            for act in acts:
+                act.substep(m, d)
+        return w.step(n, substep)
+
+    def _bind_task(self):
+        """The task's index tables for this world (:meth:`Task.bind`): at construction, and at
+        a reset when the task object was bound to another env's world since."""
+        self.task.bind(self)
+        self.task.bound_world = self.world
+
     def delay_steps(self, agent) -> dict[str, int]:
         """The delays of ``agent`` (name) in control steps, channel -> k (``round(ms / (1000 *
         dt))``, halves up; 0: undelayed)."""
@@ -190,6 +214,8 @@ class MimoParallelEnv(ParallelEnv):
         self._expression[:] = 0
         for c in self.controls:
             c[:] = 0.0
+        if self.task.bound_world is not w:   # the task object was used by another env since
+            self._bind_task()
         self.task.reset(self, self._rng)
         mujoco.mj_forward(w.model, w.data)
         fill_sensor_history(w.model, w.data, w.delayed_sensors)   # delayed vestibular sensors
@@ -219,17 +245,7 @@ class MimoParallelEnv(ParallelEnv):
         self.task.before_physics(self)
         t2 = time.perf_counter()
         timing["task"] += t2 - t1
-        w = self.world
-        if self._needs_substep:
-            m, d = w.model, w.data
-            acts = self.actuation
-
-            def substep():
-                for act in acts:
-                    act.substep(m, d)
-            reason = w.step(self.frame_skip, substep)
-        else:
-            reason = w.step(self.frame_skip)
+        reason = self.advance(self.frame_skip)
         t3 = time.perf_counter()
         timing["physics"] += t3 - t2
         self.steps += 1

@@ -312,6 +312,16 @@ class Task:
     def props(self) -> list[Prop]:
         return []
 
+    #: the world this task's index tables were made for (set by the env with :meth:`bind`)
+    bound_world = None
+
+    def bind(self, env: EnvView) -> None:
+        """Resolve names to this world's integer index tables (bodies, geoms, qpos and dof
+        addresses, sensors, the shared sense systems a task reads). The env calls it once, after
+        its world and senses are built and before the first reset, and again only when this
+        task object is reset in another env (then :attr:`bound_world` is that env's world).
+        The base binds nothing."""
+
     def task_spaces(self, env: EnvView, i: int) -> dict[str, spaces.Space]:
         """Extra observation keys of this task for agent i."""
         return {}

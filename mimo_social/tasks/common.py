@@ -133,19 +133,16 @@ def hands_setting(settings: Mapping[str, Any]) -> str:
 
 # -- running -----------------------------------------------------------------------------------
 def settle(env, steps: int, gravity: bool = True) -> None:
-    """Run ``steps`` physics steps with the current controls (actuation models that need their
-    per-step update get it), optionally without gravity; ``data.time`` restarts at 0."""
+    """Run ``steps`` physics steps with the current controls through the env's own physics path
+    (:meth:`~mimo_social.core.env.MimoParallelEnv.advance`: actuation updates, the state checked
+    after every step), optionally without gravity; ``data.time`` restarts at 0."""
     w = env.world
     m, d = w.model, w.data
     saved = m.opt.gravity.copy()
     if not gravity:
         m.opt.gravity[:] = 0.0
-    subs = [a for a in env.actuation if a.needs_substep]
     try:
-        for _ in range(steps):
-            for act in subs:
-                act.substep(m, d)
-            mujoco.mj_step(m, d)
+        env.advance(steps)
     finally:
         m.opt.gravity[:] = saved
     d.time = 0.0

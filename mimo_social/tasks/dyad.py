@@ -30,6 +30,7 @@ Measuring an agent builds a one-agent world (about 30 ms), cached per body and p
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Callable, Mapping, Sequence
@@ -294,9 +295,13 @@ def task_plan(task, posture: str, distance: float,
     configs = tuple(getattr(task, "configs", ()) or ())
     if len(configs) != 2:
         return DyadPlan(float(distance), ({}, {}), True)
-    cached = task.__dict__.get("_dyad_plan")
+    cached = _PLANS.get(task)
     if cached is not None and cached[0] is task.configs:
         return cached[1]
     plan = plan_dyad(configs, posture, distance, frozen_of, look, meet, law)
-    task._dyad_plan = (task.configs, plan)
+    _PLANS[task] = (task.configs, plan)
     return plan
+
+
+#: each task object's last plan, with the configs it was made for (forgotten with the task)
+_PLANS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()

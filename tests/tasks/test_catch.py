@@ -7,7 +7,8 @@ import pytest
 from mimo_social.core.random_actions import random_action_block
 from mimo_social.envs import catch_v0
 from mimo_social.tasks.catch.controller import CatchController
-from mimo_social.tasks import catch as catch_task
+from mimo_social.tasks import catch as catch_package
+from mimo_social.tasks.catch import task as catch_task
 
 A = "infant_0"
 
@@ -63,7 +64,7 @@ def test_control_step_episode_length_and_reward_constants_are_the_tables():
         (100.0, -100.0, 1.0, 1.0)
     assert o.hold_time == 1.0 and o.pay_remaining and o.hold_start
     assert (o.drop_margin, o.max_distance) == (0.1, 0.5)
-    doc = catch_task.__doc__
+    doc = " ".join(catch_package.__doc__.split())   # the table's text, its lines joined
     for text in ("truncation at 800 steps", "`env.dt` 0.01 s", "`-100` (`failure_reward`)",
                  "`+100 + 1 x` the steps left", "`contact_reward` (1)", "`cost_weight` 1",
                  "for 1 s (100 steps)", "more than 10 cm below", "more than 0.5 m"):

@@ -17,17 +17,17 @@ import mimo_social  # noqa: F401  (registers the ids)
 from mimo_social.core.kinematics import reach_sites
 from mimo_social.envs import reach_v0
 from mimo_social.tasks.reach.controller import ReachController
+from mimo_social.envs.task_docs import parse_docstring
 from mimo_social.tasks import reach as reach_task
 from mimo_social.tasks.reach import ReachOptions
 
 A = "infant_0"
-TABLE = reach_task.__doc__
+TABLE = dict(parse_docstring(reach_task.__doc__, "reach")[1])
 
 
 def _row(name: str) -> str:
-    m = re.search(rf"^\| {name} \| (.*) \|$", TABLE, re.MULTILINE)
-    assert m, f"no row {name!r} in the reach table"
-    return m.group(1)
+    assert name in TABLE, f"no row {name!r} in the reach table"
+    return TABLE[name]
 
 
 def _shoulder(env) -> np.ndarray:

@@ -6,7 +6,9 @@ import pytest
 
 from mimo_social.envs import selfbody_v0
 from mimo_social.tasks.selfbody.controller import SelfBodyController
-from mimo_social.tasks import selfbody as task
+from mimo_social.envs.task_docs import parse_docstring
+from mimo_social.tasks import selfbody
+from mimo_social.tasks.selfbody import task
 
 A = "infant_0"
 
@@ -35,9 +37,11 @@ def test_constants_equal_the_table():
     assert env.max_steps == task.MAX_STEPS == 500
     o = env.task.options
     assert (o.success_reward, o.miss_reward, o.other_touch_cost) == (500.0, -1.0, 0.0)
-    for row in ("| physics | one physics step (5 ms)", "truncation at 500 steps", "`+500`",
-                "`-1`"):
-        assert row in task.__doc__
+    rows = dict(parse_docstring(selfbody.__doc__, "selfbody")[1])
+    assert rows["physics"].startswith("one physics step (5 ms)")
+    text = " ".join(selfbody.__doc__.split())
+    for row in ("truncation at 500 steps", "`+500`", "`-1`"):
+        assert row in text
     # the targets: the body's primitives (geoms), not the right arm's own nor the eyes
     assert len(env.task.targets) == 28 and "left_shin" in env.task.targets
     assert not any(t.startswith("right_") and ("arm" in t or "palm" in t or "finger" in t)

@@ -16,7 +16,7 @@ A = "infant_0"
 def test_one_agent_and_the_table(module):   # the API checks: tests/conformance
     env = module.parallel_env(max_steps=30)
     assert env.possible_agents == [A]
-    assert module.__doc__ and "| reward |" in module.__doc__  # the table travels with the env
+    assert module.__doc__ and "\nreward:\n" in module.__doc__  # the table travels with the env
     env.close()
 
 

@@ -7,7 +7,7 @@ import pytest
 from mimo_social.envs import social_touch_v0
 from mimo_social.partners import Still
 from mimo_social.tasks.social_touch.controller import hand_posture, reach_posture
-from mimo_social.tasks import social_touch
+from mimo_social.tasks.social_touch import task as social_touch
 
 MITTEN_TARGETS = ("upper_body", "lower_body", "left_upper_arm", "left_lower_arm", "left_hand",
                   "left_lower_leg")

@@ -91,7 +91,7 @@ def test_constants_equal_the_table():
     assert (o.cost_weight, o.head_reference, o.success_gain, o.success_hold) \
         == (0.01, 0.2, 0.20, 1.0)
     assert o.rail_height == 0.45
-    doc = task.__doc__
+    doc = " ".join(task.__doc__.split())   # the table's text, its lines joined
     for text in ("`frame_skip=2`", "control step 10 ms", "`z_head - 0.2 - 0.01 * sum(u_i^2)`",
                  "0.20 m above its settled start", "for the last 1 s", "a fixed 500 steps",
                  "0.45 m above the floor"):

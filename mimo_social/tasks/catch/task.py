@@ -115,7 +115,7 @@ class Catch(Task):
     def task_spaces(self, env, i):
         return {"ball_size": spaces.Box(0.0, 1.0, (1,), np.float32)}
 
-    def _bind(self, env):
+    def bind(self, env):
         w = env.world
         m = w.model
         a = w.agents[0]
@@ -174,8 +174,6 @@ class Catch(Task):
         env.world.place_prop("ball", position)
 
     def reset(self, env, rng):
-        if getattr(self, "_world", None) is not env.world:
-            self._bind(env)
         d = env.world.data
         o = self.options
         d.qpos[self._wrist_q] = self._wrist_start
@@ -189,7 +187,7 @@ class Catch(Task):
         noise = rng.uniform(-1.0, 1.0, 3) * np.asarray(o.position_noise)
         height = r + self._half_thickness + o.drop_height
         self.place_ball(env, palm + np.array([0.0, 0.0, height]) + noise)
-        self._held = 0
+        self._held_for = 0
         self._hold_steps = max(1, round(o.hold_time / env.dt))
         self._success = self._dropped = False
         self._n_touch = 0
@@ -217,12 +215,12 @@ class Catch(Task):
         d = w.data
         o = self.options
         self._n_touch, in_hand = self._touching(d)
-        self._held = self._held + 1 if in_hand else 0
+        self._held_for = self._held_for + 1 if in_hand else 0
         ball = d.xpos[self._ball_body]
         palm = d.site_xpos[self._palm]
         self._dropped = bool(ball[2] < palm[2] - o.drop_margin
                              or np.linalg.norm(ball - palm) > o.max_distance)
-        self._success = not self._dropped and self._held >= self._hold_steps
+        self._success = not self._dropped and self._held_for >= self._hold_steps
         if self._dropped:
             return np.array([o.failure_reward])
         if self._success:
@@ -250,7 +248,7 @@ class Catch(Task):
     def terminations(self, env):
         return (np.array([self._success or self._dropped]),
                 [{"is_success": self._success, "dropped": self._dropped,
-                  "parts_touching": self._n_touch, "held_steps": self._held,
+                  "parts_touching": self._n_touch, "held_steps": self._held_for,
                   "ball_radius": self._radius, "ball_mass": self._mass}])
 
 

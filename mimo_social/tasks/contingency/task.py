@@ -176,16 +176,16 @@ class Contingency(Task):
             out["posture"] = "kneeling" if body == "adult" else "standing"
         return out
 
-    def _held(self, i, config):
+    def held_joints(self, i, config):
         """Agent i's held joints (rad): all, standing knees a little bent, or its own posture's
         angles (the kneeling adult)."""
         angles = held_angles(config, "standing", {"right_knee": -5, "left_knee": -5})
         return held_posture(tables_of(config), keep=(), angles=angles)
 
     def setup(self, i, config):
-        plan = task_plan(self, "standing", self.options.distance, self._held, (0, 1))
+        plan = task_plan(self, "standing", self.options.distance, self.held_joints, (0, 1))
         pos, facing = face_to_face(i, plan.distance)
-        frozen = {**self._held(i, config), **plan.gaze[i]}
+        frozen = {**self.held_joints(i, config), **plan.gaze[i]}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=())
 

@@ -46,17 +46,17 @@ class FreePlay(Task):
             out.append(Plot("nearest_infant", "m", self._nearest))
         return out
 
-    def _head_height(self, env):
+    def bind(self, env):
+        """Index tables of this world (once per world: :meth:`Task.bind`)."""
         w = env.world
-        if getattr(self, "_plot_world", None) is not w:   # index tables, once per world
-            self._plot_world = w
-            self._heads = np.array([a.head_site for a in w.agents], np.intp)
-            self._roots = np.array([a.root_body for a in w.agents], np.intp)
-            self._self_pair = np.eye(len(w.agents), dtype=bool)
-        return w.data.site_xpos[self._heads, 2]
+        self._heads = np.array([a.head_site for a in w.agents], np.intp)
+        self._roots = np.array([a.root_body for a in w.agents], np.intp)
+        self._self_pair = np.eye(len(w.agents), dtype=bool)
+
+    def _head_height(self, env):
+        return env.world.data.site_xpos[self._heads, 2]
 
     def _nearest(self, env):
-        self._head_height(env)
         xy = env.world.data.xpos[self._roots, :2]
         diff = xy[:, None, :] - xy[None, :, :]
         gap = np.einsum("ijk,ijk->ij", diff, diff)

@@ -132,7 +132,7 @@ class Handover(Task):
                               "places infants standing, hip fixed)")
         # two 18-month-olds stand `distance` apart; other bodies at the distance scaled with
         # their reach, looking at each other's face (tasks/dyad.py)
-        plan = task_plan(self, "standing", self.options.distance, self._held,
+        plan = task_plan(self, "standing", self.options.distance, self.held_joints,
                          () if self.options.assisted_gaze else (0, 1), ADULT_OFFER)
         dist = plan.distance
         pos = (0.0, 0.0) if i == RECEIVER else (dist, 0.0)
@@ -140,12 +140,12 @@ class Handover(Task):
         tables = tables_of(config)
         arm = right_arm_joints(tables)
         gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
-        frozen = {**self._held(i, config), **plan.gaze[i]}
+        frozen = {**self.held_joints(i, config), **plan.gaze[i]}
         return AgentSetup(config, position=config.position or pos,
                           facing=config.facing or facing, frozen=frozen, base="fixed",
                           actuated=arm, gaze_joints=gaze)
 
-    def _held(self, i, config):
+    def held_joints(self, i, config):
         """Agent i's held joints (rad): all but the right arm (and head and eyes with
         ``assisted_gaze``); standing knees a little bent, or its own posture's angles (an adult
         leaning toward the infant)."""
@@ -160,7 +160,7 @@ class Handover(Task):
                      (0.95, 0.55, 0.15, 1.0))]
 
     # -- index tables (once per world) ---------------------------------------------------------
-    def _bind(self, env):
+    def bind(self, env):
         w = env.world
         m = w.model
         self._world = w
@@ -235,8 +235,6 @@ class Handover(Task):
         self._close_fingers(env, i)
 
     def reset(self, env, rng):
-        if getattr(self, "_world", None) is not env.world:
-            self._bind(env)
         w = env.world
         m, d = w.model, w.data
         o = self.options
@@ -250,7 +248,7 @@ class Handover(Task):
         # the giver: arm in the offer posture, the ball in its palm, fingers curled onto it
         self.put_ball_in_hand(env, GIVER, o.offer_target)
         self._settle(env)
-        self._held = 0
+        self._held_for = 0
         self._hold_steps = max(1, int(round(o.hold_time / env.dt)))
         self._success = self._dropped = False
         self._holder = "giver"
@@ -286,14 +284,10 @@ class Handover(Task):
         giver = env.possible_agents[GIVER]
         offer.reset(env, giver, np.random.default_rng(0))
         act = env.actuation[GIVER]
-        subs = [a for a in env.actuation if a.needs_substep]
         for _ in range(n):
             u = offer.act(env, giver, None)
             act.apply(m, d, np.asarray(u["motors"] if isinstance(u, dict) else u, float))
-            for _ in range(env.frame_skip):
-                for a in subs:
-                    a.substep(m, d)
-                mujoco.mj_step(m, d)
+            env.advance(env.frame_skip)
         act.reset(m, d)
         env.controls[GIVER][:] = 0.0
         d.time = 0.0
@@ -330,8 +324,8 @@ class Handover(Task):
         self._dropped = bool(ball[2] < o.drop_height)
         receiver_holds = self._parts >= o.min_parts and not giver_holds
         self._holder = "giver" if giver_holds else "receiver" if receiver_holds else "none"
-        self._held = self._held + 1 if receiver_holds and not self._dropped else 0
-        self._success = self._held >= self._hold_steps
+        self._held_for = self._held_for + 1 if receiver_holds and not self._dropped else 0
+        self._success = self._held_for >= self._hold_steps
         distance = self._palm_distance(d)
         r = o.shaping_scale * (self._distance - distance) if o.shaping else 0.0
         self._distance = distance
@@ -360,7 +354,7 @@ class Handover(Task):
     def terminations(self, env):
         done = self._dropped or (self._success and self.options.end_on_success)
         info = {"is_success": self._success, "holder": self._holder, "dropped": self._dropped,
-                "receiver_parts": self._parts, "held_steps": self._held,
+                "receiver_parts": self._parts, "held_steps": self._held_for,
                 "distance": self._distance}
         return np.array([done, done]), [dict(info), dict(info)]
 

@@ -111,7 +111,7 @@ class HighFive(Task):
     def agent_defaults(self, i, settings):
         return {"posture": "standing", "touch": hand_touch(hands_setting(settings))}
 
-    def _held(self, i, config):
+    def held_joints(self, i, config):
         """Agent i's held joints (rad): all but the right arm (and head and eyes with
         ``assisted_gaze``), standing knees a little bent, or its own posture's angles (an adult
         leaning toward the infant)."""
@@ -123,7 +123,7 @@ class HighFive(Task):
     def setup(self, i, config):
         # two 18-month-olds stand `distance` apart; other bodies at the distance scaled with
         # their reach, looking at each other's face (tasks/dyad.py)
-        plan = task_plan(self, "standing", self.options.distance, self._held,
+        plan = task_plan(self, "standing", self.options.distance, self.held_joints,
                          () if self.options.assisted_gaze else (0, 1))
         pos, facing = face_to_face(i, plan.distance)
         tables = tables_of(config)
@@ -131,11 +131,11 @@ class HighFive(Task):
                      "the high five (the right hands meeting)")
         arm = right_arm_joints(tables)
         gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
-        frozen = {**self._held(i, config), **plan.gaze[i]}
+        frozen = {**self.held_joints(i, config), **plan.gaze[i]}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=arm, gaze_joints=gaze)
 
-    def _bind(self, env):
+    def bind(self, env):
         w = env.world
         self._world = w
         self._gaze = [Gaze(w, i) for i in range(2)] if self.options.assisted_gaze else []
@@ -157,8 +157,6 @@ class HighFive(Task):
             self._arms.append((a.qpos_adr[k], a.dof_adr[k], rest[a.qpos_adr[k]].copy(), lo, hi))
 
     def reset(self, env, rng):
-        if getattr(self, "_world", None) is not env.world:
-            self._bind(env)
         m, d = env.world.model, env.world.data
         spread = self.options.start_spread
         for _ in range(START_TRIES):  # each arm in its own random posture, the hands touching nothing

@@ -160,7 +160,7 @@ class Imitation(Task):
             out.update(body="adult", posture="kneeling")
         return out
 
-    def _held(self, i, config):
+    def held_joints(self, i, config):
         """Agent i's held joints (rad): all but both arms; standing knees a little bent (an
         18-month-old), or its own posture's angles (a kneeling adult)."""
         tables = tables_of(config)
@@ -168,10 +168,10 @@ class Imitation(Task):
         return held_posture(tables, keep=both_arms_joints(tables), angles=angles)
 
     def setup(self, i, config):
-        plan = task_plan(self, "standing", self.options.distance, self._held, (0, 1), law="gap")
+        plan = task_plan(self, "standing", self.options.distance, self.held_joints, (0, 1), law="gap")
         self.pair_distance = plan.distance
         pos, facing = face_to_face(i, plan.distance)
-        frozen = {**self._held(i, config), **plan.gaze[i]}
+        frozen = {**self.held_joints(i, config), **plan.gaze[i]}
         if i == 0:
             frozen.update(self._learner_tilt(plan, frozen))
         arms = both_arms_joints(tables_of(config))
@@ -188,8 +188,8 @@ class Imitation(Task):
         configs = tuple(getattr(self, "configs", ()) or ())
         if len(configs) != 2:
             return {}
-        e0 = measure(configs[0], self._held(0, configs[0]))
-        e1 = measure(configs[1], self._held(1, configs[1]))
+        e0 = measure(configs[0], self.held_joints(0, configs[0]))
+        e1 = measure(configs[1], self.held_joints(1, configs[1]))
         far = plan.distance - e0.head[0]
 
         def elevation(x_own, z):     # a point x_own ahead of the partner's hip, at height z
@@ -249,14 +249,17 @@ class Imitation(Task):
         return not self.options.scripted_partner
 
     # -- running -------------------------------------------------------------------------------
+    def bind(self, env):
+        """Index tables of this world (once per world: :meth:`Task.bind`)."""
+        w = env.world
+        self._outcomes = Outcomes(w, getattr(self, "box_forward", None),
+                                  getattr(self, "arm", None))
+        q = self._outcomes.box_q[0]
+        self._box_start = w.data.qpos[q:q + 7].copy() if q >= 0 else None
+        self._dt = float(env.dt)
+
     def reset(self, env, rng):
         w = env.world
-        if not hasattr(self, "_outcomes"):
-            self._outcomes = Outcomes(w, getattr(self, "box_forward", None),
-                                      getattr(self, "arm", None))
-            q = self._outcomes.box_q[0]
-            self._box_start = w.data.qpos[q:q + 7].copy() if q >= 0 else None
-            self._dt = float(env.dt)
         self._allowed = np.zeros(len(ACTIONS), bool)
         self._allowed[self.action_ids] = True
         self._weights = np.array([1.0, 0.0 if self.options.scripted_partner else 1.0])

@@ -127,7 +127,7 @@ class JointAttention(Task):
         return {"posture": "sitting", "expressions": False, "vestibular": False,
                 "vision": False if scripted else {"width": EYE_SIZE, "height": EYE_SIZE}}
 
-    def _held(self, i, config):
+    def held_joints(self, i, config):
         """Agent i's held joints (rad): all but head and eyes, sitting, or in its own posture
         (an adult kneeling)."""
         angles = held_angles(config, "sitting", posture_joints("sitting", config.body))
@@ -137,10 +137,10 @@ class JointAttention(Task):
         # two sitting 18-month-olds are `distance` apart; other bodies (a kneeling adult) at
         # the distance scaled with their reach (tasks/dyad.py: 1.31 m for the kneeling adult,
         # where four toys still lie 25 degrees apart seen from both heads)
-        plan = task_plan(self, "sitting", self.options.distance, self._held, ())
+        plan = task_plan(self, "sitting", self.options.distance, self.held_joints, ())
         self.pair_distance = plan.distance
         pos, facing = face_to_face(i, plan.distance)
-        frozen = self._held(i, config)
+        frozen = self.held_joints(i, config)
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=GAZE_JOINTS)
 
@@ -166,18 +166,22 @@ class JointAttention(Task):
         return {"instruction": out}
 
     # -- running -------------------------------------------------------------------------------
+    def bind(self, env):
+        """Index tables of this world (once per world: :meth:`Task.bind`)."""
+        w = env.world
+        d = w.data
+        n = self.options.n_toys
+        self.toy_bodies = np.array([w.prop_bodies[f"toy_{k}"] for k in range(n)], np.intp)
+        self._toy_qpos = [w.prop_qpos[f"toy_{k}"] for k in range(n)]
+        self._rays = GazeRays(w, self.toy_bodies, TOY_SIZE, self.options.margin_deg)
+        self._heads = np.array([d.site_xpos[a.head_site] for a in w.agents])
+        self._weights = np.array([1.0, 0.0 if self.options.scripted_partner else 1.0])
+        self._head_dofs = np.concatenate([a.dof_adr[a.actuated_joint_idx] for a in w.agents])
+        self._dt = float(env.dt)
+
     def reset(self, env, rng):
         w = env.world
         d = w.data
-        if self.toy_bodies is None:
-            n = self.options.n_toys
-            self.toy_bodies = np.array([w.prop_bodies[f"toy_{k}"] for k in range(n)], np.intp)
-            self._toy_qpos = [w.prop_qpos[f"toy_{k}"] for k in range(n)]
-            self._rays = GazeRays(w, self.toy_bodies, TOY_SIZE, self.options.margin_deg)
-            self._heads = np.array([d.site_xpos[a.head_site] for a in w.agents])
-            self._weights = np.array([1.0, 0.0 if self.options.scripted_partner else 1.0])
-            self._head_dofs = np.concatenate([a.dof_adr[a.actuated_joint_idx] for a in w.agents])
-            self._dt = float(env.dt)
         for k, xy in enumerate(self._place_toys(rng)):
             q = self._toy_qpos[k]
             yaw = rng.uniform(-np.pi, np.pi)

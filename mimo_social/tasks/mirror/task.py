@@ -66,7 +66,7 @@ class Mirror(Task):
         return {"posture": "standing", "expressions": True, "vestibular": False,
                 "vision": False if scripted else {"width": EYE_SIZE, "height": EYE_SIZE}}
 
-    def _held(self, i, config):
+    def held_joints(self, i, config):
         """Agent i's held joints (rad): all (but head and eyes with ``assisted_gaze``), standing
         knees a little bent, or its own posture's angles."""
         gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
@@ -76,11 +76,11 @@ class Mirror(Task):
     def setup(self, i, config):
         # two 18-month-olds stand `distance` apart; other bodies (a kneeling adult) at the
         # distance scaled with their reach, looking at each other's face (tasks/dyad.py)
-        plan = task_plan(self, "standing", self.options.distance, self._held,
+        plan = task_plan(self, "standing", self.options.distance, self.held_joints,
                          () if self.options.assisted_gaze else (0, 1))
         pos, facing = face_to_face(i, plan.distance)
         gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
-        frozen = {**self._held(i, config), **plan.gaze[i]}
+        frozen = {**self.held_joints(i, config), **plan.gaze[i]}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=(), gaze_joints=gaze)
 

@@ -88,11 +88,13 @@ class Reach(Task):
         self._shoulder_body = int(m.jnt_bodyid[m.jnt_qposadr.tolist().index(
             a.qpos_adr[a.joint_names.index("right_shoulder_horizontal")])])
 
+    def bind(self, env):
+        """Index tables of this world (once per world: :meth:`Task.bind`)."""
+        self._prepare(env)
+
     def reset(self, env, rng):
         w = env.world
         m, d = w.model, w.data
-        if not hasattr(self, "_postures"):
-            self._prepare(env)
         d.qpos[self._arm_qpos] = self._postures[rng.integers(N_START_POSTURES)]
         mujoco.mj_kinematics(m, d)
         shoulder = d.xpos[self._shoulder_body].copy()

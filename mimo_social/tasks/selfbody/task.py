@@ -97,7 +97,7 @@ class SelfBody(Task):
     def task_spaces(self, env, i):
         return {"target": spaces.Box(0.0, 1.0, (len(self.targets),), np.float32)}
 
-    def _bind(self, env):
+    def bind(self, env):
         w = env.world
         m = w.model
         a = w.agents[0]
@@ -120,8 +120,6 @@ class SelfBody(Task):
         self._force = np.zeros(6)
 
     def reset(self, env, rng):
-        if getattr(self, "_world", None) is not env.world:
-            self._bind(env)
         d = env.world.data
         d.qpos[self._arm_qpos] = self._arm_start
         fixed = self.options.target

@@ -165,7 +165,7 @@ class SocialTouch(Task):
     def _actuated(self, i, tables):
         return right_arm_joints(tables) if i == TOUCHER else both_arms_joints(tables)
 
-    def _held(self, i, config):
+    def held_joints(self, i, config):
         """Agent i's held joints (rad): sitting cross-legged (or its own posture), the toucher
         leaning in with its head tilted back, the touched infant leaning back a little; all
         but the actuated arms and the eyes."""
@@ -183,7 +183,7 @@ class SocialTouch(Task):
         # two 18-month-olds sit `distance` apart; other bodies keep the floor between their
         # forward depths as two 18-month-olds have it; a partner of another body turns its head
         # to the toucher's face (tasks/dyad.py)
-        plan = task_plan(self, "sitting", self.options.distance, self._held, (TOUCHED,),
+        plan = task_plan(self, "sitting", self.options.distance, self.held_joints, (TOUCHED,),
                          law="gap")
         dist = plan.distance
         pos = (0.0, 0.0) if i == TOUCHER else (dist, 0.0)
@@ -198,7 +198,7 @@ class SocialTouch(Task):
             require_skin(self.name, "infant_1", config, self.targets,
                          "the touch it receives on every target part")
         head = {k: v for k, v in plan.gaze[i].items() if k in HEAD_GAZE_JOINTS}
-        frozen = {**self._held(i, config), **head}
+        frozen = {**self.held_joints(i, config), **head}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
                           frozen=frozen, base="fixed", actuated=actuated,
                           gaze_joints=EYE_GAZE_JOINTS)
@@ -208,7 +208,7 @@ class SocialTouch(Task):
             return {"target": spaces.Box(0.0, 1.0, (len(self.targets),), np.float32)}
         return {}
 
-    def _bind(self, env):
+    def bind(self, env):
         w = env.world
         m = w.model
         self._world = w
@@ -259,8 +259,6 @@ class SocialTouch(Task):
         self._geom_body = m.geom_bodyid.copy()
 
     def reset(self, env, rng):
-        if getattr(self, "_world", None) is not env.world:
-            self._bind(env)
         m, d = env.world.model, env.world.data
         d.qpos[self._arm_qpos] = self._arm_start
         fixed = self.options.target

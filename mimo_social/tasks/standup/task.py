@@ -161,16 +161,20 @@ class Standup(Task):
         return d.qpos.copy()
 
     # -- running --------------------------------------------------------------------------------
+    def bind(self, env):
+        """Index tables of this world (once per world: :meth:`Task.bind`)."""
+        w = env.world
+        m = w.model
+        a = w.agents[0]
+        self._start = self._start_pose(env)
+        self._rail = m.geom("crib_rail").id
+        self._act_qpos = a.qpos_adr[a.actuated_joint_idx]
+        self._head = a.head_site
+
     def reset(self, env, rng):
         w = env.world
         m, d = w.model, w.data
         a = w.agents[0]
-        if getattr(self, "_start_world", None) is not w:
-            self._start_world = w
-            self._start = self._start_pose(env)
-            self._rail = m.geom("crib_rail").id
-            self._act_qpos = a.qpos_adr[a.actuated_joint_idx]
-            self._head = a.head_site
         self._model_settings(env)
         d.qpos[:] = self._start
         d.qvel[:] = 0.0

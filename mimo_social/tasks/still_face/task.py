@@ -131,17 +131,17 @@ class StillFace(Task):
             return GAZE_JOINTS + (LEARNER_ARM_JOINTS if self.options.arms_free else ())
         return GAZE_JOINTS + CAREGIVER_ARM_JOINTS
 
-    def _held(self, i, config):
+    def held_joints(self, i, config):
         """Agent i's held joints (rad): all but its free ones, sitting (or its own posture)."""
         angles = held_angles(config, "sitting", posture_joints("sitting", config.body))
         return held_posture(tables_of(config), keep=self._free(i, config), angles=angles)
 
     def setup(self, i, config):
-        plan = task_plan(self, "sitting", self.options.distance, self._held, ())
+        plan = task_plan(self, "sitting", self.options.distance, self.held_joints, ())
         pos, facing = face_to_face(i, plan.distance)
         free = self._free(i, config)
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
-                          frozen=self._held(i, config), base="fixed", actuated=free)
+                          frozen=self.held_joints(i, config), base="fixed", actuated=free)
 
     # -- phases ---------------------------------------------------------------------------------
     def phase_steps(self, dt: float) -> tuple[int, int, int]:
@@ -158,26 +158,30 @@ class StillFace(Task):
         return PHASES[self.phase]
 
     # -- running ----------------------------------------------------------------------------------
+    def bind(self, env):
+        """Index tables of this world (once per world: :meth:`Task.bind`)."""
+        w = env.world
+        m = w.model
+        self._bounds = tuple(np.cumsum(self.phase_steps(env.dt))[:2].tolist())
+        self._head_dofs = np.concatenate([
+            a.dof_adr[[k for k in a.actuated_joint_idx if a.joint_names[k] in GAZE_JOINTS]]
+            for a in w.agents])
+        c = w.agents[1]
+        k = c.actuated_joint_idx
+        self._care_qpos, self._care_dof = c.qpos_adr[k], c.dof_adr[k]
+        hands, masks = self_touch_geoms(w, 0)
+        self._hand_mask = np.zeros((2, m.ngeom), bool)
+        for s in range(2):
+            self._hand_mask[s, hands[s]] = True
+        self._touch_mask = np.stack(masks)
+        self._n_inter = sum(1 for t in range(env.max_steps) if self.phase_at(t) != 1)
+        self._need = max(1, math.ceil(self.options.success_fraction * self._n_inter - 1e-9))
+        scripted = self.options.scripted_partner
+        self._weights = np.array([1.0, 0.0 if scripted else 1.0])
+
     def reset(self, env, rng):
         w = env.world
         m, d = w.model, w.data
-        if self._bounds is None:
-            self._bounds = tuple(np.cumsum(self.phase_steps(env.dt))[:2].tolist())
-            self._head_dofs = np.concatenate([
-                a.dof_adr[[k for k in a.actuated_joint_idx if a.joint_names[k] in GAZE_JOINTS]]
-                for a in w.agents])
-            c = w.agents[1]
-            k = c.actuated_joint_idx
-            self._care_qpos, self._care_dof = c.qpos_adr[k], c.dof_adr[k]
-            hands, masks = self_touch_geoms(w, 0)
-            self._hand_mask = np.zeros((2, m.ngeom), bool)
-            for s in range(2):
-                self._hand_mask[s, hands[s]] = True
-            self._touch_mask = np.stack(masks)
-            self._n_inter = sum(1 for t in range(env.max_steps) if self.phase_at(t) != 1)
-            self._need = max(1, math.ceil(self.options.success_fraction * self._n_inter - 1e-9))
-            scripted = self.options.scripted_partner
-            self._weights = np.array([1.0, 0.0 if scripted else 1.0])
         del m
         self.phase = 0
         self._held_q = None
