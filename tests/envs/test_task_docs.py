@@ -86,3 +86,10 @@ def test_each_task_section_lists_the_plots_its_replay_shows():
         names = [p.name for p in d.task_cls(d.task_cls.default_n_agents, None).plots()]
         assert all(f"`{n}`" in row for n in names), (d.entry.name, row)
     assert "`hand_distance` (m), one line" in page and "`gaze_error` (deg), per agent" in page
+
+
+@pytest.mark.parametrize("entry", CATALOG, ids=lambda e: e.name)
+def test_the_table_is_wrapped_within_100_columns(entry):
+    package = task_docs.task_package(entry)
+    long = [line for line in package.__doc__.splitlines() if len(line) > 100]
+    assert not long, f"{package.__name__}: table lines over 100 columns: {long}"

@@ -1,0 +1,146 @@
+"""Contingency: smiling with a caregiver who answers live, replays a session or smiles on a timer.
+
+agents:
+    2: `infant_0` (the learner, an 18-month-old) and `infant_1` (the caregiver: by default the adult
+    body, kneeling; an infant partner is allowed with `per_agent=[{}, {"body": "infant"}]`).
+    `scripted_env` drives the caregiver (`ContingencyCaregiver`, below); `parallel_env` makes it a
+    second learner (condition "live" only)
+body:
+    the learner stands (as in `mirror_v0`), hip fixed in the world, every joint held; head and eyes
+    held looking at the caregiver's face (`tasks/dyad.py` aims them for the pair's bodies), so the
+    caregiver's face is in the middle of both eye images without any aiming; the caregiver kneels
+    (its own posture's legs), every joint held, head and eyes on the learner's face. Nothing moves
+    but the faces: the paradigm is about expressions
+scene:
+    the pair face to face, `distance` (0.3 m) apart for two 18-month-olds; the kneeling adult is
+    placed by the measured reach of its arm (0.37 m, `tasks/dyad.py`), as in `mirror_v0`: its face
+    spans about a third of each of the learner's 64x64 eye images (about 20 pixels across on a
+    rendered frame)
+conditions:
+    option `condition`, or `env.unwrapped.task.set_condition(name)` from the next reset on.
+    **live**: the scripted caregiver answers each of the learner's smiles (its face turning "happy")
+    with probability `response_probability` (0.8) by a smile `response_delay_s` (0.5 s) later, held
+    `response_duration_s` (1 s; a new answer restarts it), else a neutral face
+    (`ContingentCaregiver`, mode "interactive", cue: the expression only). **replay**: the
+    caregiver's action stream (its faces, step by step) of an earlier live episode is played back
+    regardless of the learner (`ReplayCaregiver`): by default the last live episode of this env (run
+    one first), or the `stream` given to `scripted_env` (a stream dict, e.g.
+    `mimo_social.partners.replay.load_stream(path)` of one saved with `save_stream(path,
+    env.partners["infant_1"].recorded)`); Murray and Trevarthen's double video: the same caregiver
+    behaviour, out of sync with the infant. **non_contingent**: the caregiver smiles, each smile
+    held `response_duration_s`, at the rate it answered in this env's last live episode (before any
+    live episode: `timer_rate_hz`, 0.5 per second), started on a random timer independent of the
+    learner (mode "non_contingent"; a Poisson process from the partner's seeded generator). In
+    replay and non-contingent nothing the learner does changes the caregiver (tested). Two learners:
+    "live" only (the caregiver is the other learner's policy; replay and non-contingent need the
+    script: a ConfigError)
+reset:
+    both faces neutral; nothing random in the task (the scripted caregiver draws its responses and
+    timer from the env's seed)
+action:
+    `Dict(motors=Box(0,), expression=Discrete(7))`: the learner's face is its action (no motor is
+    free)
+observation:
+    `eye_left`, `eye_right` (64x64x3 RGB: the caregiver's face reaches the learner only through its
+    eyes), `proprioception` (0 floats: no free joint); never the caregiver's expression, mode or
+    stream
+reward:
+    +1 on a step of shared smiling: the learner and the caregiver both show "happy" while the
+    learner's gaze is on the caregiver's face (`partners/cues.py`, `learner_cues`), else 0; with
+    `reward_free` (False) 0 on every step, every measure still in the infos (for curiosity,
+    empowerment or contingency-detection signals of one's own). Two learners: each is rewarded when
+    both smile and its own gaze is on the other's face. A learner that smiles at random (1/7 of the
+    steps) shares at most 1/7 of the steps; the zero action (neutral) none
+success:
+    per episode: `is_success` becomes True on the step at which the shared-smile steps reach
+    `success_fraction` (0.2) of the episode's `max_steps` (2000: 400 steps); the last step's value
+    is the episode's verdict. Meant for the live condition, where the learner's smiles bring the
+    caregiver's: a smile held on (one answer of 1 s) or a copy of the caregiver's face (which never
+    smiles first) fails; a face drawn at random each step is happy on 1/7 of the steps (13.8 %
+    shared, measured), far from 20 %. In replay and non-contingent it depends on the caregiver's own
+    timing and is reported, not a goal
+termination:
+    none; truncation at 2000 steps (20 s: a contingency needs several smiles and answers to show;
+    Murray and Trevarthen's live and replay sessions lasted 30-60 s)
+infos:
+    `condition` (0 live, 1 replay, 2 non_contingent), `smiling` (the learner, this step),
+    `caregiver_smiling`, `gaze_on_face` (the learner's), `shared` (a shared-smile step),
+    `shared_steps`, `learner_smiles` and `caregiver_smiles` (smile onsets so far: the face turning
+    "happy"), `learner_smile_rate` and `caregiver_smile_rate` (onsets per second so far),
+    `smiling_fraction` (of the steps so far), `gaze_fraction`, `shared_fraction`, `response_rate`
+    (the share of the learner's smiles, among those whose window has passed or been answered,
+    followed by a caregiver smile onset within `window_s` (1.5 s)), `baseline_rate` (the share of
+    control windows, `window_s` blocks of the episode holding no learner smile and not within
+    `window_s` after one, in which the caregiver begins to smile), `contingency_index`
+    (`response_rate - baseline_rate`: Watson's conditional-probability difference: about the
+    response probability in live, lower in replay and non-contingent, where the caregiver's smiles
+    follow the learner's only by chance), `is_success`
+options:
+    `condition` ("live", "replay", "non_contingent"), `distance` (0.3 m, 0.22 to 2.0),
+    `response_delay_s` (0.5 s, 0 to 5), `response_probability` (0.8, 0 to 1), `response_duration_s`
+    (1.0 s, 0.01 to 10), `timer_rate_hz` (0.5, 0 to 10: the non-contingent rate before any live
+    episode), `window_s` (1.5 s, 0.05 to 10: the contingency index's window; keep it above the
+    delay), `success_fraction` (0.2, 0.01 to 1), `reward_free` (False), `scripted_partner` (False;
+    set by `scripted_env`)
+privileged cues:
+    none: the caregiver's face reaches the learner only through its eyes; the reward and the
+    measures read both faces and the gaze from the world (no observation)
+baselines:
+    live, 20 episodes of 2000 steps, seeds 1000-1019, the learner's eyes rendered (`mimo-social
+    baselines contingency --episodes 20 --seed 1000`): random face each step 0 / 20 successes,
+    return 276.8 +- 13.2; zero action (neutral) 0 / 20, 0 +- 0; scripted
+    `ContingencyDetectorController` 19 / 20, 665 +- 117, success secured at step 1122 on average.
+    Hacks and an upper bound, same seeds (`python tests/tasks/test_contingency.py`; eyes off, no
+    policy reads them): always happy 0 / 20, 90.0 +- 30.0 (one answer); copying the caregiver's face
+    (`MirrorController`) 0 / 20, 0 +- 0 (the caregiver never smiles first); smiling with a one-step
+    neutral dip every 0.5 s (each dip a new smile, answered before the last answer ends) 20 / 20,
+    1851.3 +- 59.1: the reward's optimum uses the contingency, and the detector, which also tests
+    it, reaches a third of it. No trained learner yet
+summary:
+    `measures.condition_summary(episodes, seed, controller)` runs blocks of live, replay (of that
+    block's live episode) and non-contingent episodes and returns each measure's mean and sd per
+    condition (`format_summary` prints it); the scripted `ContingencyDetectorController`, 10 blocks,
+    seeds 1000-1009 (`condition_summary(episodes=10, seed=1000)`), mean +- sd live / replay /
+    non-contingent: share of the steps smiling 0.576 +- 0.073 / 0.381 +- 0.136 / 0.364 +- 0.158;
+    smile onsets per second 0.42 / 0.40 / 0.38; response rate 0.851 +- 0.124 / 0.438 +- 0.210 /
+    0.369 +- 0.215; baseline rate 0.000 / 0.392 / 0.135; contingency index 0.851 +- 0.124 / 0.046 +-
+    0.554 / 0.234 +- 0.381; shared smiling 0.344 / 0.173 / 0.152 of the steps; success 9 / 5 / 3 of
+    10; caregiver smile onsets per second 0.35 / 0.35 (the same stream) / 0.24. The pattern Murray
+    and Trevarthen report (fewer positive expressions when the same mother is replayed) shows in the
+    share of the steps smiling, not in the smile onsets (the detector keeps bidding briefly)
+sources:
+    not in the MIMo paper: a paradigm of this package after Watson (1972, 1979: infants detect the
+    contingency of events on their own behaviour, measured as conditional probabilities; the smile
+    as the response to a contingent stimulus), Watson and Ramey (1972: contingent mobiles raise the
+    infant's response rate), Murray and Trevarthen (1985: double video, 6-12-week-olds with their
+    mothers live versus a replay of the same mother, which brought gaze avoidance and fewer positive
+    expressions), Nadel et al. (1999, live-replay-live), Bigelow and Rochat (2006: 2-month-olds
+    smile less to a partner whose contingency for smiles differs from their mother's). Response
+    delay 0.5 s: a prompt answer, within the 1-s resolution at which face-to-face interaction is
+    coded (Beebe et al. 2016), and well below the delays of a few seconds that keep young infants
+    from learning a contingency (Millar 1972)
+version history:
+    v0, issue 19: first version, with `still_face_v0`, `imitation_v0` and the contingent and replay
+    caregivers
+
+The learner's action and the caregiver's face of the same step are compared; a scripted caregiver
+reads the learner's face before the learner's action of a step applies, so its answers come one
+control step (10 ms) after `response_delay_s`.
+
+``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns a
+:class:`~mimo_social.core.env.MimoParallelEnv` with two learners (the caregiver ``infant_1`` an
+adult learner by default; condition "live" only); ``env(...)`` the AEC version;
+``scripted_env(partner=None, stream=None, **kwargs)`` a one-learner env (``infant_0`` learns) whose
+caregiver ``infant_1`` is driven by :class:`~mimo_social.tasks.contingency.ContingencyCaregiver`
+(live, replay of the last live episode or of ``stream``, non-contingent, as the task's condition
+says), or by ``partner``.
+"""
+
+from .task import (CONDITIONS, MEASURES, ContingencyOptions, Contingency, ContingencyCaregiver,
+                   ContingencyMeasures, parallel_env, env, scripted_env)
+from . import measures
+from .controller import ContingencyDetectorController
+
+__all__ = ["measures", "CONDITIONS", "MEASURES", "ContingencyOptions", "Contingency",
+           "ContingencyCaregiver", "ContingencyMeasures", "parallel_env", "env", "scripted_env",
+           "ContingencyDetectorController"]

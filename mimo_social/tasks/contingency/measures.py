@@ -1,0 +1,107 @@
+"""The contingency paradigm's measures: blocks of a live, a replay (of that block's live
+episode) and a non-contingent episode; per condition the learner's smile rate, the share of the
+steps smiling, gaze on the caregiver's face, response and baseline rates, the contingency index
+and shared smiling (mean and sd over blocks), from each episode's last learner info.
+
+:func:`run` is what ``mimo-social paradigm contingency`` calls for each learner (the catalogue
+entry's ``measures``); :func:`rows` its lines in the side-by-side table.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from ...core.episodes import run_episodes
+from ...util.checks import ConfigError, check_choice
+from .controller import ContingencyDetectorController
+from .task import CONDITIONS, MEASURES, scripted_env
+
+__all__ = ["UNIT", "AGENT", "summarize", "condition_summary", "format_summary", "run", "rows"]
+
+#: what one of :func:`run`'s ``episodes`` is: a block of one episode per condition
+UNIT = "blocks (live, replay, non-contingent)"
+#: the learner: the infant; the caregiver is scripted
+AGENT = "infant_0"
+
+
+def summarize(finals: Sequence[Mapping[str, Any]]) -> dict[str, dict[str, tuple[float, float]]]:
+    """Per condition, each :data:`MEASURES` entry's mean and sd over episodes, from each
+    episode's last-step info (its ``condition`` code says the condition)."""
+    out: dict[str, dict[str, tuple[float, float]]] = {}
+    for code, cond in enumerate(CONDITIONS):
+        rows = [f for f in finals if int(f["condition"]) == code]
+        if not rows:
+            continue
+        out[cond] = {m: (float(np.mean([float(r[m]) for r in rows])),
+                         float(np.std([float(r[m]) for r in rows]))) for m in MEASURES}
+        out[cond]["episodes"] = (float(len(rows)), 0.0)
+    return out
+
+
+def condition_summary(episodes: int = 5, seed: int = 0, controller: Any = None,
+                      conditions: Sequence[str] = CONDITIONS,
+                      env_kwargs: Mapping[str, Any] | None = None) -> dict:
+    """Blocks of one episode per condition (``conditions``, in that order; "replay" needs a
+    "live" before it in a block and replays it), ``episodes`` blocks, the env (the scripted
+    form, :func:`~mimo_social.tasks.contingency.task.scripted_env`) reset with seed
+    ``seed + block``; the learner is ``controller`` (a policy for ``infant_0``: ``act(env,
+    agent, obs)`` and optionally ``reset(env, agent, rng)``; by default
+    :class:`~mimo_social.tasks.contingency.controller.ContingencyDetectorController`), reset
+    with a generator seeded ``[seed + block, k]`` for the block's k-th condition, so that it
+    does not repeat its live actions in the replay. Returns :func:`summarize` of the
+    episodes."""
+    conditions = tuple(conditions)
+    for c in conditions:
+        check_choice("contingency", "conditions", c, CONDITIONS)
+    if "replay" in conditions and ("live" not in conditions
+                                   or conditions.index("live") > conditions.index("replay")):
+        raise ConfigError("contingency: conditions list 'replay' without a 'live' before it; "
+                          "allowed: e.g. ('live', 'replay', 'non_contingent')")
+    learner = ContingencyDetectorController() if controller is None else controller
+    env = scripted_env(**dict(env_kwargs or {}))
+    task = env.unwrapped.task
+    finals = []
+    try:
+        for block in range(int(episodes)):
+            for k, cond in enumerate(conditions):
+                task.set_condition(cond)
+                [episode] = run_episodes(env, {AGENT: learner}, 1, seed + block,
+                                         policy_seeds=[[seed + block, k]])
+                finals.append(episode.last_infos[AGENT])
+    finally:
+        env.close()
+    return summarize(finals)
+
+
+def run(learner, episodes: int, seed: int, env_kwargs: Mapping[str, Any] | None = None) -> dict:
+    """``learner`` in ``episodes`` blocks of live, replay and non-contingent episodes
+    (:func:`condition_summary`)."""
+    return condition_summary(episodes, seed, controller=learner, env_kwargs=env_kwargs)
+
+
+def format_summary(table: Mapping[str, Mapping[str, tuple[float, float]]]) -> str:
+    """A markdown table: one row per measure, one column per condition (mean +- sd)."""
+    conds = list(table)
+    lines = ["| measure | " + " | ".join(conds) + " |", "|---" * (len(conds) + 1) + "|"]
+    for m in ("episodes", *MEASURES):
+        cells = []
+        for c in conds:
+            mean, sd = table[c][m]
+            cells.append(f"{mean:.0f}" if m == "episodes" else f"{mean:.3f} +- {sd:.3f}")
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def rows(summaries: Sequence[Mapping]) -> list[tuple[str, list[str]]]:
+    """The table's lines for :func:`run`'s summaries, a cell per learner: per condition each
+    measure (mean +- sd over blocks)."""
+    out = []
+    for cond in CONDITIONS:
+        if not all(cond in s for s in summaries):
+            continue
+        for m in MEASURES:
+            out.append((f"{cond}: {m}", [f"{s[cond][m][0]:.2f} +- {s[cond][m][1]:.2f}"
+                                         for s in summaries]))
+    return out

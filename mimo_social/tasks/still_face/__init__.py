@@ -1,0 +1,138 @@
+"""Still face: face-to-face play, then the caregiver's still, unresponsive face, then reunion.
+
+agents:
+    2: `infant_0` (the learner infant) and `infant_1` (the caregiver: by default the adult body
+    kneeling, `body="adult"`, `posture="kneeling"`; an infant partner is allowed, e.g.
+    `per_agent=[{}, {"body": "infant", "posture": "sitting"}]`); scripted (`scripted_env`: by
+    default a `ContingentCaregiver`, `partners/contingent.py`) or a second learner
+body:
+    the learner sits (the infant seat of the paradigm), hip fixed in the world, every joint held
+    except head and eyes (9 motors) and, with `arms_free` (on), both shoulders and elbows (8
+    motors): it can look at or away from the caregiver and bring its hands to its own body
+    (self-directed behaviour); without `arms_free` no self-touch is possible. The caregiver holds
+    its posture (legs, trunk) and moves its head and eyes and its right arm (shoulder, elbow, wrist:
+    7 motors; its fingers held), as `ContingentCaregiver` needs (its gaze response and its pat).
+    Both have faces (expressions on). With `head_support` (on) the task cancels gravity on both
+    agents' head and eye joints (neck tone: a zero action does not let the head drop)
+scene:
+    the pair face to face; two sitting 18-month-olds `distance` (0.6 m) apart, their feet just short
+    of each other (at 0.45 m the scripted infant's hands caught on the partner's toes on their way
+    to its chest); other bodies placed by measured reach (`tasks/dyad.py`): the kneeling adult's hip
+    1.01 m from the infant's, at arm's length, its eyes (1.13 m high) 1.0 m from the sitting
+    infant's (0.42 m high), 45 degrees above them; its head (0.18 m across) spans 10 degrees, 11
+    pixels of a 64x64 eye (60 degree field; `per_agent=[{"vision": {"width": 128, "height": 128}},
+    {}]` doubles it). Closer, the adult's face would be nearly overhead (the "gap" law of
+    `tasks/dyad.py`: 0.61 m, 67 degrees up)
+phases:
+    `phases_s` = (interaction, still face, reunion) seconds, default (5, 5, 5): phase k lasts
+    `round(phases_s[k] / dt)` control steps (dt 0.01 s: 500 each); `max_steps` defaults to their sum
+    at the default dt (1500; steps past the last phase stay in reunion). Laboratory phases last 1-2
+    min (Mesman et al. 2009); seconds here keep episodes short enough to train. Interaction and
+    reunion: the caregiver acts; the scripted form sets a caregiver with `set_mode` to
+    `"interactive"`. Still face: the scripted form sets it to `"still"`, and the task holds the
+    caregiver still whoever drives it (a script or a second learner, whose actions are then
+    ignored): its face shown neutral, its free joints written back to the angles they had when the
+    phase began and their velocities zeroed every control step, its controls replaced by ones that
+    hold (spring-damper: none, gravity and springs cancelled by applied forces; positional: the held
+    angles plus the gravity torque over the servo stiffness). Measured: no free joint of the
+    caregiver moves more than 1e-3 rad in the still phase (tests/tasks/test_still_face.py,
+    spring-damper and positional, random caregiver actions)
+reset:
+    heads and eyes at rest: the learner's line of sight passes 51 degrees below the caregiver's face
+    (it sees the caregiver's trunk and thighs, the face above its view), so a still learner does not
+    look at the face; both faces neutral; arms at their sitting rest. Nothing in the task is random
+    (the scripted caregiver draws whether it answers each cue; with its defaults, `probability` 1,
+    it always does)
+action:
+    learner: `Dict(motors=Box(-1, 1, (17,)), expression=Discrete(7))` (9 head and eye motors, then
+    the 8 arm motors; 9 without `arms_free`); caregiver (two learners): its 16 motors and expression
+observation:
+    `eye_left`, `eye_right` (64x64x3 RGB: the only way the caregiver's face and movements reach the
+    learner), `proprioception` (102 floats: its own free joints); a scripted caregiver has no eyes;
+    never the phase, nor the caregiver's expression or mode
+measures:
+    per learner step, from `learner_cues` (`partners/cues.py`, the same cues the contingent
+    caregiver answers): `smiling` (its face is "happy": positive expression), `gaze_on_face` (its
+    line of sight passes within 10 degrees of the caregiver's face centre), and `self_touch`
+    (self-directed behaviour: a contact between a hand of the learner and its own head, trunk or
+    other arm and hand; a hand on its legs or hip does not count, nor a touch by or of the
+    caregiver); per phase, so far this episode, the fraction of that phase's steps with each:
+    `smile_<phase>`, `gaze_<phase>`, `self_touch_<phase>` (phases `interaction`, `still`,
+    `reunion`), and `phase` (0, 1, 2: the step's phase, names in `PHASES`).
+    `measures.still_face_summary(infos)` gives their mean and spread over episodes from each
+    episode's last info; `format_still_face_summary` prints it
+reward:
+    a social reward, +1 on a step of mutual engagement: the learner looks at the caregiver's face
+    while both smile (the learner's and the caregiver's face "happy"), else 0. The still phase pays
+    nothing (the caregiver's face is held neutral). The default caregiver smiles back 0.5 s after
+    each onset of the learner's smile, for 1 s: a smile held without renewal is answered once, so
+    engagement needs renewed bids, as in a real exchange. Two learners both get it (cooperative);
+    with `scripted_partner` only `infant_0`. `reward_free` (off): every reward 0, the measures
+    unchanged (for a learning signal of one's own: curiosity, contingency detection)
+success:
+    per episode: the engaged steps reach `success_fraction` (0.5) of the episode's interaction and
+    reunion steps (within `max_steps`: 1000 by default); `is_success` turns True on the step from
+    which the episode can no longer fail, the last step's value is the verdict. Success measures
+    engagement in the interactive phases; the still phase is where the measures show the still-face
+    effect, not a test
+termination:
+    none; truncation at `max_steps`
+infos:
+    `phase`, `smiling`, `gaze_on_face`, `self_touch`, `engaged`, `engaged_steps`,
+    `interactive_steps` (interaction and reunion steps so far), `smile_<phase>`, `gaze_<phase>`,
+    `self_touch_<phase>`, `is_success` (the learner's measures; the caregiver's infos are the same).
+    The caregiver's `expression` info is its action's, also while the task shows its face neutral
+options:
+    `phases_s` ((5, 5, 5) s, each 0.05-600), `distance` (0.6 m, 0.3-1.5: two sitting 18-month-olds'
+    hip distance), `arms_free` (True), `head_support` (True), `success_fraction` (0.5, 0.05-1),
+    `reward_free` (False), `scripted_partner` (False)
+privileged cues:
+    none: the caregiver's face, head and arm reach the learner only through its eyes; the phase and
+    the caregiver's mode are never observed. The reward and the measures read both faces, the gaze
+    line and the contacts from the world (they are no observation)
+baselines:
+    scripted form, default settings, 20 episodes of 15 s (seeds 1000-1019): scripted
+    `StillFaceInfantController` 20 / 20, return 888.0 +- 0.0 (every episode alike: nothing is random
+    with the default caregiver), success secured at step 1109 (in reunion); its measures per phase
+    (fraction of the phase's steps, mean over episodes; smile / gaze at the face / self-touch):
+    interaction 0.99 / 0.96 / 0.00, still 0.00 / 0.01 / 0.94, reunion 0.99 / 0.93 / 0.01, the
+    still-face pattern (the gaze fractions miss the 0.3 s head turns). Random 0 / 20, 16.7 +- 8.9;
+    zero action 0 / 20, 0.0 +- 0.0, every measure 0 (`mimo-social baselines still_face --episodes 20
+    --seed 1000`). The test file's own baselines and hacks, with every measure (`python
+    tests/tasks/test_still_face.py 20`): uniform random 0 / 20, 13.9 +- 8.5, smile 0.14-0.15, gaze
+    0.09-0.14, self-touch 0.02-0.03 in every phase; "stare" (smiles and looks, never renews its
+    smile: answered once a phase) 0 / 20, 200.0; "look" (looks, never smiles) 0 / 20, 0.0; looks
+    with a random face every step 0 / 20, 128.9 +- 15.2; smiles (renewed every second) without
+    turning its head 0 / 20, 0.0. `test_baselines_scripted_succeeds_random_zero_and_hacks_fail`
+    (slow) checks these on 5 episodes
+sources:
+    Tronick, Als, Adamson, Wise & Brazelton (1978), The infant's response to entrapment between
+    contradictory messages in face-to-face interaction, J. Am. Acad. Child Psychiatry 17: 1-13 (the
+    paradigm: interaction, still face, reunion; infants sober, look away and comfort themselves when
+    the mother's face is still); Mesman, van IJzendoorn & Bakermans-Kranenburg (2009), The many
+    faces of the Still-Face Paradigm, Developmental Review 29: 120-162 (review and meta-analysis of
+    the measures: positive affect and gaze at the parent drop in the still face and partly recover
+    in reunion)
+version history:
+    v0, issue 19: first version, with the contingent caregiver (`partners/contingent.py`), the
+    learner's cues (`partners/cues.py`) and the scripted infant `StillFaceInfantController`
+
+``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns a
+:class:`~mimo_social.core.env.MimoParallelEnv` with two learners (the infant ``infant_0`` and the
+caregiver ``infant_1``, by default the kneeling adult; the task holds the caregiver still in the
+still phase, whatever its actions); ``env(...)`` the AEC version; ``scripted_env(partner=None,
+**kwargs)`` a one-learner env (``infant_0`` learns) whose caregiver ``infant_1`` is driven by a
+scripted :class:`~mimo_social.partners.Partner`, by default
+:class:`~mimo_social.partners.contingent.ContingentCaregiver`: before every step the wrapper sets a
+partner that has ``set_mode`` to ``"still"`` in the still phase and to ``"interactive"`` in the
+others (the task option ``scripted_partner`` is set: the caregiver has no eyes and no reward).
+"""
+
+from .task import (PHASES, MEASURES, LEARNER_ARM_JOINTS, StillFace, StillFaceOptions,
+                   self_touch_geoms, parallel_env, env, scripted_env, PhasedPartners)
+from . import measures
+from .controller import StillFaceInfantController
+
+__all__ = ["measures", "PHASES", "MEASURES", "LEARNER_ARM_JOINTS", "StillFace", "StillFaceOptions",
+           "self_touch_geoms", "parallel_env", "env", "scripted_env", "PhasedPartners",
+           "StillFaceInfantController"]

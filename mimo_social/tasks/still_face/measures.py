@@ -1,0 +1,87 @@
+"""The still-face paradigm's measures over episodes: per phase (interaction, still face,
+reunion) the share of the phase's steps with a smile, with the gaze on the caregiver's face and
+with self-touch, from each episode's last learner info.
+
+:func:`run` is what ``mimo-social paradigm still_face`` calls for each learner (the catalogue
+entry's ``measures``); :func:`rows` its lines in the side-by-side table.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Iterable, Mapping, Sequence
+
+import numpy as np
+
+from ...core.episodes import run_episodes
+from .task import MEASURES, PHASES, scripted_env
+
+__all__ = ["UNIT", "AGENT", "still_face_summary", "format_still_face_summary", "run", "rows"]
+
+#: what one of :func:`run`'s ``episodes`` is
+UNIT = "episodes"
+#: the learner: the infant; the caregiver is scripted
+AGENT = "infant_0"
+
+
+def still_face_summary(infos: Iterable[Mapping]) -> dict:
+    """Per phase and measure, the mean and standard deviation over episodes of the fraction of
+    the phase's steps with it, from each episode's last learner info (``infos``: one mapping per
+    episode with the ``<measure>_<phase>`` keys of the task's infos). Returns ``{"episodes": n,
+    "success": share of episodes with is_success, "phases": {phase: {measure: (mean, sd)}}}``;
+    a ValueError names a missing key."""
+    rows = [dict(x) for x in infos]
+    if not rows:
+        raise ValueError("still_face_summary: no episodes; allowed: one info mapping per episode")
+    out = {}
+    for phase in PHASES:
+        out[phase] = {}
+        for key in MEASURES:
+            name = f"{key}_{phase}"
+            missing = [k for k, r in enumerate(rows) if name not in r]
+            if missing:
+                raise ValueError(f"still_face_summary: episode {missing[0]} has no {name!r}; "
+                                 "allowed: the last info of a still_face_v0 episode")
+            v = np.array([float(r[name]) for r in rows])
+            out[phase][key] = (float(v.mean()), float(v.std()))
+    success = float(np.mean([bool(r.get("is_success", False)) for r in rows]))
+    return {"episodes": len(rows), "success": success, "phases": out}
+
+
+def format_still_face_summary(summary: Mapping) -> str:
+    """:func:`still_face_summary` as a text table (phase rows, measure columns)."""
+    lines = [f"episodes {summary['episodes']}, success {100 * summary['success']:.0f} %",
+             f"{'phase':<12}" + "".join(f"{k:>18}" for k in MEASURES)]
+    for phase, row in summary["phases"].items():
+        lines.append(f"{phase:<12}" + "".join(f"{m:>11.2f} +-{s:>4.2f}" for m, s in row.values()))
+    return "\n".join(lines)
+
+
+def run(learner, episodes: int, seed: int, env_kwargs: Mapping[str, Any] | None = None) -> dict:
+    """``learner`` (a policy for ``infant_0``: ``act(env, agent, obs)``, optional ``reset``) in
+    ``episodes`` episodes of the scripted still face (seeds ``seed``, ``seed + 1``, ...):
+    :func:`still_face_summary` of the last infos, plus ``return``: (mean, sd) over episodes."""
+    env = scripted_env(**dict(env_kwargs or {}))
+    try:
+        done = run_episodes(env, {AGENT: learner}, episodes, seed)
+    finally:
+        env.close()
+    out = still_face_summary([e.last_infos[AGENT] for e in done])
+    returns = [e.returns[AGENT] for e in done]
+    out["return"] = (float(np.mean(returns)), float(np.std(returns)))
+    return out
+
+
+def _ms(pair) -> str:
+    mean, sd = pair
+    return f"{mean:.2f} +- {sd:.2f}"
+
+
+def rows(summaries: Sequence[Mapping]) -> list[tuple[str, list[str]]]:
+    """The table's lines for :func:`run`'s summaries, a cell per learner: success, return, and
+    per phase each measure (mean +- sd over episodes)."""
+    out = [("success", [f"{100 * s['success']:.0f} %" for s in summaries]),
+           ("return", [f"{s['return'][0]:.1f} +- {s['return'][1]:.1f}" for s in summaries])]
+    for phase in PHASES:
+        for m in MEASURES:
+            out.append((f"{phase}: {m}", [_ms(s["phases"][phase][m]) for s in summaries]))
+    return out
