@@ -43,7 +43,7 @@ infos:
 privileged cues:
     `target`: the named primitive as a one-hot code (the instruction; no sense carries it)
 scripted controller:
-    `partners.controllers.selfbody.SelfBodyController`: plans waypoints by IK at reset (arm raised,
+    `tasks.selfbody.controller.SelfBodyController`: plans waypoints by IK at reset (arm raised,
     palm above the target, hand near it, hand 1 cm inside it; or backwards from touching postures
     found from seeded random starts), runs each plan on a scratch copy of the world with its own PD
     law and keeps the first that touches, then PD + gravity compensation through the motors: 20 of
