@@ -30,7 +30,9 @@ import json
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
+from ..core.env import TIMING_KEYS
 from ..envs.catalog import CATALOG, entry
+from ..senses import SENSES
 
 __all__ = [
     "COMPONENTS", "ENV_COMPONENTS", "CHUNK", "WARMUP_STEPS", "EPISODE_STEPS",
@@ -38,12 +40,13 @@ __all__ = [
     "DEFAULT_CONFIGS", "check_names", "mimo_reference",
 ]
 
-#: What a configuration's total is split into (they sum to the total).
-COMPONENTS = ("physics", "actuation", "touch", "vision", "proprioception", "vestibular",
-              "recording", "task", "other")
-#: The components the env times itself (``env.timing``).
-ENV_COMPONENTS = ("actuation", "physics", "proprioception", "vestibular", "touch", "vision",
-                  "task")
+#: What a configuration's total is split into (they sum to the total): physics, actuation, each
+#: sense of the registry (:data:`mimo_social.senses.SENSES`, in its order), recording, task and
+#: the rest.
+COMPONENTS = ("physics", "actuation", *SENSES, "recording", "task", "other")
+#: The components the env times itself (``env.timing``, :data:`mimo_social.core.env.TIMING_KEYS`)
+#: but its own remainder (``other``: this benchmark's ``other`` is all that is not timed).
+ENV_COMPONENTS = tuple(key for key in TIMING_KEYS if key != "other")
 
 #: Steps per timed chunk; the progress bar is updated between chunks, outside the timer.
 CHUNK = 100

@@ -1,7 +1,7 @@
 """What the developing body costs: build time per age (and for the adult), and the cost per step
 of sensorimotor delays and of the acuity filter, each measured against the same env without it.
 
-``mimo-social bench-development`` runs it (:mod:`mimo_social.cli.bench_development`); the numbers
+``mimo-social bench development`` runs it (:mod:`mimo_social.cli.bench_development`); the numbers
 go to BENCHMARKS.md. Variants that are compared run in turns of 100 steps under the same smooth
 random actions (:func:`mimo_social.bench.vision_cost.bench_env`), so a change of the machine's
 speed touches them alike; each figure is the mean over every step.
@@ -17,6 +17,7 @@ import numpy as np
 from ..body.tables import load_body
 from ..core.config import PhysicsConfig
 from ..envs import free_play_v0
+from ..senses import SENSES
 from .vision_cost import bench_env
 
 __all__ = ["BUILD_BODIES", "ALL_DELAYS_MS", "build_times", "delay_cost",
@@ -35,7 +36,7 @@ BUILD_BODIES = (
 #: Every sense delayed by 100 ms (10 control steps at the default 10 ms control step). The motor
 #: command is left undelayed: a motor delay changes the trajectory, so its steps would compare
 #: different physics, not the cost of the buffers.
-ALL_DELAYS_MS = {"proprioception": 100.0, "vestibular": 100.0, "touch": 100.0, "vision": 100.0}
+ALL_DELAYS_MS = dict.fromkeys(SENSES, 100.0)
 
 
 def build_times(hands: Sequence[str] = ("mitten", "five_fingers"), repeats: int = 3) -> list[dict]:

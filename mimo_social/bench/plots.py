@@ -57,7 +57,8 @@ def _draw_panel(ax, title, bars, scaling=False):
     bottom = np.zeros(len(bars))
     for comp in COMPONENTS:
         h = np.array([r["components"].get(comp, 0.0) for r, _ in bars])
-        ax.bar(x, h, 0.65, bottom=bottom, label=comp, color=COLOURS[comp])
+        ax.bar(x, h, 0.65, bottom=bottom, label=comp,
+               color=COLOURS.get(comp))        # a sense with no colour here: the next default
         bottom += h
     for xi, (r, _) in zip(x, bars):
         label = f"{r['real_s_per_sim_s']:.3f}"

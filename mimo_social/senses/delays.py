@@ -29,10 +29,13 @@ from importlib import resources
 
 import numpy as np
 
+from . import SENSES
+
 __all__ = ["CHANNELS", "delay_table", "developmental_delays"]
 
-#: the delayed channels: each sense and the motor command (the order of ``AgentConfig.delays``)
-CHANNELS = ("proprioception", "vestibular", "touch", "vision", "motor")
+#: the delayed channels: each sense of the registry (:data:`mimo_social.senses.SENSES`, in its
+#: order) and the motor command (the order of ``AgentConfig.delays``)
+CHANNELS = (*SENSES, "motor")
 
 
 @lru_cache(maxsize=None)
