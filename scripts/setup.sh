@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PY=${PYTHON:-python3}
-# chromium: the headless-browser check of a replay (mimo-social check-viewer, driven by playwright)
+# chromium: the headless-browser check of a replay (scripts/check_viewer.py, driven by playwright)
 DEBS="libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 libosmesa6 libglu1-mesa chromium"
 
 missing=""

@@ -1,4 +1,5 @@
-"""The benchmark: real seconds per simulated second, split by component (``mimo-social bench``).
+"""The benchmark: real seconds per simulated second, split by component (``mimo-social bench
+sim``).
 
 :mod:`.configs` (what runs: :data:`CONFIGS`, one per catalogue env among them; targets and the
 original MIMo's figures), :mod:`.runner` (the timed runs, :func:`run_benchmarks`),

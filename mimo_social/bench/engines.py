@@ -4,7 +4,7 @@ workers, on the same tasks with the same policy, and the scaling efficiency from
 :func:`run` measures every (task, engine, workers) configuration in turn with the measuring
 function given for each engine (``measure[engine](task, workers, seconds) -> dict`` with at least
 ``steps_per_s``; :mod:`mimo_social.train.throughput` has those of SB3 and RLlib, which the
-``bench-engines`` command passes in: this layer does not import the training layer), then
+``bench engines`` command passes in: this layer does not import the training layer), then
 :func:`efficiencies` gives, per task and engine, ``steps/s with n / (n x steps/s with 1)``.
 :func:`markdown` / :func:`plot` write the table and the figure; the results dict is plain JSON.
 """

@@ -1,7 +1,7 @@
 """What recording costs: the share of the env's step time spent recording with
 :class:`~mimo_social.recording.Recorder`, and the file's size per simulated minute.
 
-``mimo-social bench-recording`` runs it (:mod:`mimo_social.cli.bench_recording`); the numbers go
+``mimo-social bench recording`` runs it (:mod:`mimo_social.cli.bench_recording`); the numbers go
 to BENCHMARKS.md and the recorder's docstring.
 """
 

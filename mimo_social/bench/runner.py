@@ -382,7 +382,8 @@ def run_benchmarks(names: Sequence[str] | str | None = None,
         try:
             CONFIGS["agents_1"].make_env().close()
         except Exception as e:  # noqa: BLE001 - the configurations will say what fails
-            print(f"mimo-social bench: the throw-away build failed: {error_text(e)}", file=sys.stderr)
+            print(f"mimo-social bench sim: the throw-away build failed: {error_text(e)}",
+                  file=sys.stderr)
         first_build = time.perf_counter() - t
 
         runners = []
@@ -397,7 +398,8 @@ def run_benchmarks(names: Sequence[str] | str | None = None,
                 except Exception as e:  # noqa: BLE001 - noted, the other configurations run
                     skipped.append({"name": name, "stage": "build", "reason": error_text(e)})
                     bar.update(sim_seconds)
-                    print(f"mimo-social bench: skipping {name}: {error_text(e)}", file=sys.stderr)
+                    print(f"mimo-social bench sim: skipping {name}: {error_text(e)}",
+                          file=sys.stderr)
             while not all(r.done for r in runners):
                 for r in list(runners):
                     if r.done:

@@ -1,4 +1,4 @@
-"""Soak: long runs that look for what grows (``mimo-social soak``).
+"""Soak: long runs that look for what grows (``mimo-social bench soak``).
 
 Two phases in one process, each driven by smooth random actions
 (:func:`mimo_social.core.random_actions.random_action_block`) and reset with a new seed at the
@@ -290,6 +290,6 @@ def plot(result: dict, path: str | Path) -> None:
                 ax.set_xlabel(f"steps ({r['steps_per_s']:.0f} steps/s, "
                               f"{r['recordings']} recordings)" if phase != "touch"
                               else f"steps ({r['steps_per_s']:.0f} steps/s)", fontsize=8)
-    fig.suptitle("mimo-social soak: growth after a warm-up of "
+    fig.suptitle("mimo-social bench soak: growth after a warm-up of "
                  f"{warm:.0%} of each phase's steps", fontsize=10)
     fig.savefig(str(path), dpi=110)

@@ -1,7 +1,7 @@
 """What the eyes cost: milliseconds per eye image for each step of the renderer's design
 (:data:`BENCH_VARIANTS`), and real seconds per simulated second of whole env steps with vision.
 
-``mimo-social bench-vision`` runs it once per OpenGL backend, each in its own process
+``mimo-social bench vision`` runs it once per OpenGL backend, each in its own process
 (:mod:`mimo_social.cli.bench_vision`); the numbers go to BENCHMARKS.md.
 """
 

@@ -1,7 +1,9 @@
 """The ``mimo-social`` command: one module per subcommand.
 
 Each subcommand module provides ``add_parser(subparsers)``, which adds its parser and sets the
-parser's ``func`` to the function that runs it.
+parser's ``func`` to the function that runs it. ``bench`` is a group: ``mimo-social bench
+MEASUREMENT``, one module per measurement (:mod:`.bench`, which also keeps the old names of the
+measuring commands for one release).
 """
 
 from __future__ import annotations
@@ -11,20 +13,12 @@ import errno
 import os
 import sys
 
-from . import train
-from . import bench, bench_vision, calibrate, compliance, demo, figure, replay
-from . import docs
-from . import bench_recording
-from . import baselines
-from . import soak
-from . import bench_engines
-from . import bench_development
-from . import paradigm
-from . import check_viewer
+from . import baselines, bench, calibrate, compliance, demo, docs, figure, paradigm, replay, train
 
-SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, bench_vision, figure, docs,
-               bench_recording, baselines, soak, bench_engines, bench_development, paradigm,
-               check_viewer)
+#: the modules of the top-level commands (the measurements are under ``bench``:
+#: :data:`.bench.MEASUREMENTS`)
+SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, figure, docs, baselines,
+               paradigm)
 
 
 class UsageError(SystemExit):
@@ -67,6 +61,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     """Run ``mimo-social ARGS``; its exit code. Errors are one line on stderr (see the epilog)."""
     parser = build_parser()
+    argv = bench.old_form(sys.argv[1:] if argv is None else list(argv))   # note on an old name
     args = parser.parse_args(argv)   # a bad argument: argparse's usage error, exit code 2
     try:
         return int(args.func(args) or 0)
@@ -74,7 +69,8 @@ def main(argv=None) -> int:
         if args.debug or os.environ.get("MIMO_SOCIAL_DEBUG", "") not in ("", "0"):
             raise
         code, message = _error(e)
-        name = " ".join(filter(None, (args.command, getattr(args, "parameter", None))))
+        name = " ".join(filter(None, (args.command, getattr(args, "measurement", None),
+                                      getattr(args, "parameter", None))))
         print(f"mimo-social {name}: error: {message}", file=sys.stderr)
         return code
 

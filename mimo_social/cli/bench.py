@@ -1,111 +1,82 @@
-"""``mimo-social bench``: measure real seconds per simulated second, by component (the
-library: :mod:`mimo_social.bench`).
+"""``mimo-social bench MEASUREMENT``: the measuring commands, one module each.
 
-    mimo-social bench --json bench.json --update-benchmarks-md
+    mimo-social bench sim          real s per simulated s by component     (cli/bench_sim.py)
+    mimo-social bench vision       eye images per OpenGL backend           (cli/bench_vision.py)
+    mimo-social bench recording    the Rerun recording's cost and size     (cli/bench_recording.py)
+    mimo-social bench development  build time per age, delays, acuity      (cli/bench_development.py)
+    mimo-social bench engines      SB3 vs RLlib training throughput        (cli/bench_engines.py)
+    mimo-social bench soak         growth of memory, threads, open files   (cli/bench_soak.py)
+
+Each module has ``NAME``, ``HELP``, ``add_parser(subparsers, name, **kw)`` and ``run(args)``.
+
+**Old names, for one release**: the top-level commands ``bench-vision``, ``bench-recording``,
+``bench-development``, ``bench-engines`` and ``soak`` (:data:`OLD_NAMES`), and ``mimo-social
+bench --option ...`` without a measurement (the simulation benchmark's old form), still run as
+before; :func:`old_form` prints one line on stderr naming the new command. They go in the next
+release.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import os
+import functools
 import sys
-from pathlib import Path
 
-from .. import bench
-from ._args import input_file, output_file, positive_float, seed, write_file
+from . import bench_development, bench_engines, bench_recording, bench_sim, bench_soak
+from . import bench_vision
 
-__all__ = ["add_parser", "run"]
+__all__ = ["MEASUREMENTS", "OLD_NAMES", "add_parser", "old_form"]
+
+#: measurement -> its module, in the order of the help
+MEASUREMENTS = {module.NAME: module for module in (bench_sim, bench_vision, bench_recording,
+                                                   bench_development, bench_engines, bench_soak)}
+#: old top-level command -> its measurement (kept for one release, not listed in the help)
+OLD_NAMES = {"bench-vision": "vision", "bench-recording": "recording",
+             "bench-development": "development", "bench-engines": "engines", "soak": "soak"}
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Add ``bench`` with a parser per measurement, and the old names (unlisted)."""
     parser = subparsers.add_parser(
-        "bench", help="measure real seconds per simulated second, by component",
-        description="Measure real seconds per simulated second (and env build time) for each "
-                    "configuration, split by component. Default set: "
-                    + ", ".join(bench.DEFAULT_CONFIGS) + "; also: "
-                    + ", ".join(n for n in bench.CONFIGS if n not in bench.DEFAULT_CONFIGS) + ".")
-    parser.add_argument("--json", default="bench.json", metavar="FILE", type=output_file,
-                        help="where to write the results (default: bench.json)")
-    parser.add_argument("--sim-seconds", type=positive_float, default=bench.DEFAULT_SIM_SECONDS,
-                        metavar="S",
-                        help=f"simulated seconds per configuration (default: "
-                             f"{bench.DEFAULT_SIM_SECONDS:g}, one episode of the grid)")
-    parser.add_argument("--only", default=None, metavar="NAME,...",
-                        help="comma-separated configurations to run (default: the default set; "
-                             "'all': every configuration)")
-    parser.add_argument("--markdown", default=None, metavar="FILE", type=output_file,
-                        help="write a Markdown report there (default: none)")
-    parser.add_argument("--update-benchmarks-md", action="store_true",
-                        help="write BENCHMARKS.md (and docs/benchmarks.png unless --plot is given)")
-    parser.add_argument("--plot", default=None, metavar="FILE.png", type=output_file,
-                        help="write stacked bar charts of the components there (and a second "
-                             "one, tasks and scaling, beside it as <stem>_tasks_scaling.png)")
-    parser.add_argument("--seed", type=seed, default=0, help="seed of the random actions")
-    parser.add_argument("--no-recording", action="store_true",
-                        help="do not record the runs (the recording component is then 0)")
-    parser.add_argument("--from-json", default=None, metavar="FILE", type=input_file,
-                        help="measure nothing: re-render --markdown/--plot from an earlier --json "
-                             "output (its recorded command is kept)")
-    parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
-    parser.add_argument("--no-cold-start", action="store_true",
-                        help="skip the fresh-process build measurements")
-    parser.set_defaults(func=run)
+        "bench", help="measure: " + ", ".join(MEASUREMENTS) + " (mimo-social bench MEASUREMENT)",
+        description="Measure the package's speed and costs. Each measurement is its own command "
+                    "with its own options: mimo-social bench MEASUREMENT --help.",
+        epilog="The old names bench-vision, bench-recording, bench-development, bench-engines "
+               "and soak, and 'mimo-social bench --option ...' for 'bench sim', still run in "
+               "this release, with a one-line note; they go in the next release.")
+    sub = parser.add_subparsers(dest="measurement", metavar="MEASUREMENT", title="measurements")
+    for name, module in MEASUREMENTS.items():
+        module.add_parser(sub, name, help=module.HELP)
+    parser.set_defaults(func=functools.partial(_missing, parser))
+    for old, new in OLD_NAMES.items():
+        MEASUREMENTS[new].add_parser(
+            subparsers, old, epilog=f"The old name of 'mimo-social bench {new}': it goes in "
+                                    "the next release.")
     return parser
 
 
-def _command(args, markdown, plot) -> str:
-    parts = ["mimo-social bench", f"--json {args.json}", f"--sim-seconds {args.sim_seconds:g}"]
-    if args.only:
-        parts.append(f"--only {args.only}")
-    if args.seed:
-        parts.append(f"--seed {args.seed}")
-    if getattr(args, "no_recording", False):
-        parts.append("--no-recording")
-    if args.no_cold_start:
-        parts.append("--no-cold-start")
-    if markdown:
-        parts.append(f"--markdown {markdown}")
-    if plot:
-        parts.append(f"--plot {plot}")
-    return " ".join(parts)
+def _missing(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+    """``mimo-social bench`` alone: a usage error that lists the measurements."""
+    parser.error("give a measurement: " + ", ".join(MEASUREMENTS)
+                 + "; e.g. mimo-social bench sim (see mimo-social bench --help)")
 
 
-def run(args) -> int:
-    try:
-        names = bench.check_names(args.only)
-    except ValueError as e:
-        print(f"mimo-social bench: error: {e}", file=sys.stderr)
-        return 2
-    markdown, plot = args.markdown, args.plot
-    if args.update_benchmarks_md:
-        markdown = markdown or "BENCHMARKS.md"
-        plot = plot or "docs/benchmarks.png"
-    if args.from_json:
-        report = json.loads(Path(args.from_json).read_text())
-    else:
-        report = bench.run_benchmarks(names, args.sim_seconds, seed=args.seed,
-                                progress=not args.no_progress,
-                                measure_cold_start=not args.no_cold_start,
-                                record=not getattr(args, "no_recording", False))
-        report["settings"]["command"] = _command(args, markdown, plot)
-        write_file(args.json, json.dumps(report, indent=2) + "\n")
-    plots = bench.plot_report(report, plot) if plot else []
-    if markdown:
-        md = Path(markdown)
-        rel = [os.path.relpath(Path(p).resolve(), md.resolve().parent) for p in plots]
-        write_file(md, bench.markdown_report(report, report["settings"].get("command"), rel)
-                   + "\n")
-    print(bench.markdown_table(report))
-    for s in report.get("skipped") or []:
-        print(f"skipped: {s['name']}: {s['reason']}")
-    for c in bench.target_checks(report):
-        print(f"target: {c['target']}: {c['measured']} -> {'met' if c['met'] else 'NOT met'}")
-    for v in bench.jacobian_verdict(report):
-        print(f"jacobian, {v['n_agents']} agent(s): {v['winner']} "
-              f"(dense faster by {v['dense_faster_by'] * 100:+.1f} % of physics in the median "
-              f"chunk, in {v['dense_faster_in'] * 100:.0f} % of chunks; unstable "
-              f"episodes dense {v['dense_unstable']}, sparse {v['sparse_unstable']})")
-    written = [str(p) for p in (None if args.from_json else args.json, markdown, *plots) if p]
-    print("wrote " + ", ".join(written))
-    return 0
+def old_form(argv: list[str]) -> list[str]:
+    """``argv`` (the arguments after ``mimo-social``) as the parser reads them, with a one-line
+    note on stderr when it uses an old name: an old command runs as before (its parser is
+    kept); ``bench`` followed by an option is ``bench sim``."""
+    at = next((i for i, a in enumerate(argv) if not a.startswith("-")), None)
+    if at is None:
+        return argv
+    word, rest = argv[at], argv[at + 1:]
+    if word in OLD_NAMES:
+        _note(f"'{word}' is now 'bench {OLD_NAMES[word]}'; the old name goes in the next release")
+    elif word == "bench" and rest and rest[0].startswith("-") and rest[0] not in ("-h", "--help"):
+        _note("'bench' without a measurement is now 'bench sim'; the old form goes in the next "
+              "release")
+        return [*argv[:at + 1], bench_sim.NAME, *rest]
+    return argv
+
+
+def _note(text: str) -> None:
+    print(f"mimo-social: {text}", file=sys.stderr)

@@ -1,8 +1,8 @@
-"""``mimo-social bench-development``: build time per age and for the adult, and the cost per step
+"""``mimo-social bench development``: build time per age and for the adult, and the cost per step
 of sensorimotor delays and of the acuity filter (:mod:`mimo_social.bench.development`).
 
-    mimo-social bench-development                      # the figures of BENCHMARKS.md
-    mimo-social bench-development --sim-seconds 1 --repeats 1 --json out.json
+    mimo-social bench development                      # the figures of BENCHMARKS.md
+    mimo-social bench development --sim-seconds 1 --repeats 1 --json out.json
 """
 
 from __future__ import annotations
@@ -13,12 +13,18 @@ import json
 from ..bench import development
 from ._args import output_file, positive_float, positive_int, write_file
 
-__all__ = ["add_parser", "run"]
+__all__ = ["NAME", "HELP", "add_parser", "run"]
+
+#: its name under ``mimo-social bench`` and its line in the list of measurements
+NAME = "development"
+HELP = "cost of developing bodies: build time per age, delays, acuity"
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
+    """Add the parser as ``name`` (``kw``: more of argparse's ``add_parser`` settings, e.g.
+    ``help``; none: not listed)."""
     parser = subparsers.add_parser(
-        "bench-development", help="cost of developing bodies: build time per age, delays, acuity",
+        name, **kw,
         description="Build time per age and for the adult; ms per step with and without "
                     "sensorimotor delays and the acuity filter, measured in turns of 100 steps.")
     parser.add_argument("--sim-seconds", type=positive_float, default=15.0,

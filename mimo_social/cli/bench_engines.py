@@ -1,6 +1,6 @@
-"""``mimo-social bench-engines``: SB3 and RLlib training throughput side by side.
+"""``mimo-social bench engines``: SB3 and RLlib training throughput side by side.
 
-``mimo-social bench-engines --tasks high_five,mirror --workers 1,2 --seconds 30 --out DIR``
+``mimo-social bench engines --tasks high_five,mirror --workers 1,2 --seconds 30 --out DIR``
     PPO with one shared policy (64x64 MLP) on each task, with SB3 (``workers`` spawned worker
     processes) and with RLlib (``workers`` env runners), ``--seconds`` of training each after a
     warm-up iteration; prints env steps per second and the scaling efficiency from 1 to n workers
@@ -27,7 +27,11 @@ from ..train import MULTI_TASKS
 from ..train.throughput import ENGINES, rllib_throughput, sb3_throughput, time_to_success
 from ._args import comma_choices, output_dir, positive_float, positive_int, seed, write_file
 
-__all__ = ["add_parser", "run"]
+__all__ = ["NAME", "HELP", "add_parser", "run"]
+
+#: its name under ``mimo-social bench`` and its line in the list of measurements
+NAME = "engines"
+HELP = "SB3 vs RLlib: env steps/s while training, 1 and 2 workers"
 
 
 def _ints(text: str) -> list[int]:
@@ -40,9 +44,11 @@ def _ints(text: str) -> list[int]:
     return values
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
+    """Add the parser as ``name`` (``kw``: more of argparse's ``add_parser`` settings, e.g.
+    ``help``; none: not listed)."""
     p = subparsers.add_parser(
-        "bench-engines", help="SB3 vs RLlib: env steps/s while training, 1 and 2 workers",
+        name, **kw,
         description="PPO training throughput (env steps per second) of SB3 (worker processes) "
         "and RLlib (env runners) side by side on the same tasks with the same policy, and the "
         "scaling efficiency from 1 worker to n.")
@@ -119,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
                 "epochs": args.epochs, "seed": args.seed,
                 "learner torch threads": args.torch_threads,
                 "one world per worker": "SB3 spawned worker processes, RLlib env runners"}
-    command = (f"mimo-social bench-engines --tasks {args.tasks} --engines {args.engines} "
+    command = (f"mimo-social bench engines --tasks {args.tasks} --engines {args.engines} "
                f"--workers {','.join(map(str, args.workers))} --seconds {args.seconds:g} "
                f"--rollout {args.rollout} --minibatch {args.minibatch} --epochs {args.epochs} "
                f"--hidden {','.join(map(str, args.hidden))} --seed {args.seed} "

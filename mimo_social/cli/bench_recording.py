@@ -1,4 +1,4 @@
-"""``mimo-social bench-recording``: what recording with the Rerun recorder costs (share of the env
+"""``mimo-social bench recording``: what recording with the Rerun recorder costs (share of the env
 step time) and how big the file grows (MB per simulated minute), for the configurations of
 :data:`mimo_social.bench.recording_cost.BENCH_CONFIGS`; ``--eyes``: the plain step, recording
 without eyes and with eyes side by side in one run
@@ -12,12 +12,18 @@ import sys
 from ..bench import recording_cost
 from ._args import comma_choices, output_dir, positive_float
 
-__all__ = ["add_parser", "run"]
+__all__ = ["NAME", "HELP", "add_parser", "run"]
+
+#: its name under ``mimo-social bench`` and its line in the list of measurements
+NAME = "recording"
+HELP = "what recording costs: share of the env step and MB per simulated minute"
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
+    """Add the parser as ``name`` (``kw``: more of argparse's ``add_parser`` settings, e.g.
+    ``help``; none: not listed)."""
     parser = subparsers.add_parser(
-        "bench-recording", help="recording benchmark: cost per env step and MB per sim. minute",
+        name, **kw,
         description="Cost (share of the env step time) and size (MB per simulated minute) of "
                     "recording with the Recorder, for 2 infants without images, with touch and "
                     "with 2 x 64x64 eyes each. --eyes: the plain step beside recording without and "
@@ -42,8 +48,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     if args.eyes and args.only:
-        print("bench-recording: --only picks configurations of the size and cost table; --eyes "
-              "runs its own comparison; allowed: one of them", file=sys.stderr)
+        print(f"mimo-social bench {NAME}: error: --only picks configurations of the size and "
+              "cost table; --eyes runs its own comparison; allowed: one of them", file=sys.stderr)
         return 2
     if args.eyes:
         results = recording_cost.bench_eye_cost(args.sim_seconds or 40.0, folder=args.folder)

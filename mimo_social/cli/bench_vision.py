@@ -1,4 +1,4 @@
-"""``mimo-social bench-vision``: what the eyes cost, per OpenGL backend, each in its own process.
+"""``mimo-social bench vision``: what the eyes cost, per OpenGL backend, each in its own process.
 
 Prints milliseconds per eye image for each variant of
 :data:`mimo_social.bench.vision_cost.BENCH_VARIANTS` and real seconds per simulated second of
@@ -15,12 +15,18 @@ from ._args import comma_choices, output_file, positive_float, positive_int, wri
 
 BACKENDS = ["egl", "osmesa", "glfw"]
 
-__all__ = ["add_parser", "run"]
+__all__ = ["NAME", "HELP", "add_parser", "run"]
+
+#: its name under ``mimo-social bench`` and its line in the list of measurements
+NAME = "vision"
+HELP = "ms per eye image by variant, and env steps with vision, per OpenGL backend"
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
+    """Add the parser as ``name`` (``kw``: more of argparse's ``add_parser`` settings, e.g.
+    ``help``; none: not listed)."""
     parser = subparsers.add_parser(
-        "bench-vision", help="vision benchmark: ms per eye image by variant, env steps",
+        name, **kw,
         description="Vision benchmark: ms per eye image by variant, and real s per simulated s "
                     "of whole env steps; each backend in its own process.")
     parser.add_argument("--backends", default="egl,osmesa",

@@ -17,7 +17,7 @@ Rate: by default eye images are logged at :data:`EYE_LOG_HZ` (25 per simulated s
 4th step at the default 100 Hz control): a replay is watched at about video rate, and every
 frame of two agents' four 64x64 eyes at 100 Hz costs about a fifth of the step's CPU time
 (10 % on the stepping thread, 12 % on the encoder's), at 25 Hz a tenth (7.6-8 % and 3 %, of
-which the recording without eyes takes 6.7-7 %; ``mimo-social bench-recording --eyes`` on a
+which the recording without eyes takes 6.7-7 %; ``mimo-social bench recording --eyes`` on a
 2-core VM busy with other work). ``Recorder(eye_every_k_steps=1)`` logs every rendered frame.
 """
 

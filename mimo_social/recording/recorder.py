@@ -65,8 +65,8 @@ crash keeps every row up to :attr:`Recorder.flushed_step`, losing at most two in
 cost is mostly per chunk (entity and flush): the interval sets the price. Measured on a 2-core VM
 busy with other work, stepping thread's CPU time against the plain step's: 2 infants without
 images 7-16 % (the busier the machine, the more), ~16 MB per simulated minute (touch adds ~18,
-eyes at 25 Hz ~5: ``mimo-social bench-recording``); with touch and 2 x 64x64 eyes each
-(``mimo-social bench-recording --eyes``, medians of interleaved runs) 7 % without eyes, 8 %
+eyes at 25 Hz ~5: ``mimo-social bench recording``); with touch and 2 x 64x64 eyes each
+(``mimo-social bench recording --eyes``, medians of interleaved runs) 7 % without eyes, 8 %
 with eyes at 25 Hz (the default; +3 % on the encoder thread), 10 % with every frame
 (``eye_every_k_steps=1``; +12 % on the encoder thread). ``every_k_steps=2`` halves poses and
 skin. Call :meth:`Recorder.close` (or use ``with``): it sends the rest, writes the footer, ends

@@ -25,7 +25,7 @@ def encode_png(image: np.ndarray, level: int = 1) -> bytes:
     """An (h, w, 3) or (h, w) uint8 image as PNG bytes (lossless; no imaging library needed).
 
     Every row uses PNG's "up" filter (the difference to the row above): with zlib level 1 it
-    keeps rendered eye images small and fast to encode (``mimo-social bench-recording``).
+    keeps rendered eye images small and fast to encode (``mimo-social bench recording``).
     """
     img = np.asarray(image)
     if img.dtype != np.uint8 or img.ndim not in (2, 3) or (img.ndim == 3 and img.shape[2] != 3):

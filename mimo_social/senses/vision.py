@@ -26,7 +26,7 @@ of all agents are tiles of one offscreen buffer of one GL context per process (s
 the process that steps the env and is dropped when the env is pickled, so vector envs in worker
 processes work with the ``spawn`` / ``forkserver`` start methods (not ``fork`` after rendering).
 
-What it costs: ``mimo-social bench-vision`` (each variant of
+What it costs: ``mimo-social bench vision`` (each variant of
 :data:`mimo_social.bench.vision_cost.BENCH_VARIANTS` against the one before) and BENCHMARKS.md.
 
 Helpers: :func:`vision_system` (the system of an env), :func:`eye_images` (an agent's current

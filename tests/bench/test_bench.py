@@ -1,13 +1,12 @@
-"""Smoke tests of the benchmark (`mimo-social bench`): structure, names, totals, components."""
+"""Smoke tests of the benchmark (`mimo-social bench sim`): structure, names, totals, components."""
 
-import argparse
 import json
 
 import numpy as np
 import pytest
 
 from mimo_social import bench
-from mimo_social.cli import bench as bench_cli
+from mimo_social.cli import build_parser
 from mimo_social.core import random_actions
 
 TOP_KEYS = {"machine", "settings", "cold_start", "results"}
@@ -55,7 +54,7 @@ def test_run_benchmarks_structure(report):
 
 
 def test_markdown_and_targets(report):
-    md = bench.markdown_report(report, "mimo-social bench --sim-seconds 0.5", "docs/b.png")
+    md = bench.markdown_report(report, "mimo-social bench sim --sim-seconds 0.5", "docs/b.png")
     assert "| `agents_1` | 1 |" in md and "| `physics_only` | 1 |" in md
     assert report["machine"]["cpu"] in md and "![" in md
     checks = bench.target_checks(report)
@@ -80,10 +79,9 @@ def test_unknown_name_is_rejected():
 
 
 def test_cli_writes_json_markdown_and_plot(tmp_path, capsys):
-    parser = argparse.ArgumentParser(prog="mimo-social")
-    bench_cli.add_parser(parser.add_subparsers(dest="command", required=True))
+    parser = build_parser()
     out, md, png = tmp_path / "b.json", tmp_path / "B.md", tmp_path / "docs" / "b.png"
-    args = parser.parse_args(["bench", "--json", str(out), "--sim-seconds", "0.3",
+    args = parser.parse_args(["bench", "sim", "--json", str(out), "--sim-seconds", "0.3",
                               "--only", "physics_only,reach", "--markdown", str(md),
                               "--plot", str(png), "--no-progress", "--no-cold-start"])
     assert args.func(args) == 0
@@ -95,8 +93,9 @@ def test_cli_writes_json_markdown_and_plot(tmp_path, capsys):
     assert "physics_only" in capsys.readouterr().out
     # re-rendering from the JSON measures nothing and keeps the recorded command
     md2 = tmp_path / "again.md"
-    args = parser.parse_args(["bench", "--from-json", str(out), "--markdown", str(md2)])
+    args = parser.parse_args(["bench", "sim", "--from-json", str(out), "--markdown", str(md2)])
     assert args.func(args) == 0
+    assert "mimo-social bench sim --json" in md2.read_text()
     assert "--only physics_only,reach" in md2.read_text()
 
 
@@ -202,7 +201,7 @@ def test_report_tables_plots_and_noise_check(small, tmp_path):
     # a copy of v64 named agents_1 stands in for the real one (the same configuration)
     one = dict(report["results"][0], name="agents_1", group="scaling")
     report["results"].insert(1, one)
-    md = bench.markdown_report(report, "mimo-social bench", ["docs/a.png", "docs/b.png"])
+    md = bench.markdown_report(report, "mimo-social bench sim", ["docs/a.png", "docs/b.png"])
     assert "## Infants in one world" in md and "| 2 |" in md
     assert "`agents_1` and `v64`" in md or "`v64` and `agents_1`" in md
     assert "](docs/a.png)" in md and "](docs/b.png)" in md

@@ -1,4 +1,4 @@
-"""``mimo-social bench-development`` with tiny numbers: every body builds and is timed, every
+"""``mimo-social bench development`` with tiny numbers: every body builds and is timed, every
 compared env steps, and the table names each figure against its base."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from mimo_social.bench import development
 
 def test_bench_development_times_every_body_and_variant(tmp_path, capsys):
     out = tmp_path / "dev.json"
-    code = cli.main(["bench-development", "--sim-seconds", "0.06", "--repeats", "1",
+    code = cli.main(["bench", "development", "--sim-seconds", "0.06", "--repeats", "1",
                      "--json", str(out)])
     assert code == 0
     results = json.loads(out.read_text())

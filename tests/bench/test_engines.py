@@ -37,12 +37,12 @@ def test_efficiency_table_and_figure(tmp_path):
 def test_command_measures_sb3(tmp_path):
     from mimo_social.cli import main
     out = tmp_path / "bench"
-    code = main(["bench-engines", "--engines", "sb3", "--tasks", "high_five", "--workers", "1",
-                 "--seconds", "0.5", "--rollout", "64", "--minibatch", "64", "--epochs", "1",
-                 "--out", str(out)])
+    code = main(["bench", "engines", "--engines", "sb3", "--tasks", "high_five", "--workers",
+                 "1", "--seconds", "0.5", "--rollout", "64", "--minibatch", "64", "--epochs",
+                 "1", "--out", str(out)])
     assert code == 0
     res = json.loads((out / "engines.json").read_text())
     (row,) = res["rows"]
     assert row["engine"] == "sb3" and row["workers"] == 1 and row["env_steps"] >= 64
     assert row["steps_per_s"] > 0
-    assert (out / "engines.png").exists() and "bench-engines" in (out / "engines.md").read_text()
+    assert (out / "engines.png").exists() and "bench engines" in (out / "engines.md").read_text()

@@ -1,4 +1,4 @@
-"""``mimo-social soak`` with tiny numbers: it writes the samples (CSV), the figures (JSON), the
+"""``mimo-social bench soak`` with tiny numbers: it writes the samples (CSV), the figures (JSON), the
 plot (PNG) and prints the growth per 100k steps; what it samples and fits is right."""
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ def ran(tmp_path_factory):
     from contextlib import redirect_stdout
     buf = io.StringIO()
     with redirect_stdout(buf):
-        code = cli.main(["soak", *ARGS, "--out", str(out)])
+        code = cli.main(["bench", "soak", *ARGS, "--out", str(out)])
     return out, code, buf.getvalue()
 
 
@@ -48,7 +48,7 @@ def test_soak_writes_csv_json_png_and_prints_the_growth(ran):
     # every episode of 50 steps is its own recording, the next opened at once
     assert [int(r["recordings"]) for r in vision][::5] == [1, 2, 3, 4, 5]
     figures = json.loads((out / "soak.json").read_text())
-    assert figures["command"].startswith("mimo-social soak --steps 600 --vision-steps 200")
+    assert figures["command"].startswith("mimo-social bench soak --steps 600 --vision-steps 200")
     assert figures["settings"]["seed"] == 3
     for phase, n in (("touch", 600), ("vision+recording", 200)):
         f = figures["phases"][phase]
@@ -109,20 +109,21 @@ def test_process_sample_sees_a_new_thread_and_an_open_file(tmp_path):
                                  ["--vision-size", "4"], ["--episode-steps", "1e20"]])
 def test_bad_arguments_are_usage_errors(bad, capsys):
     with pytest.raises(SystemExit) as e:
-        cli.main(["soak", *bad])
+        cli.main(["bench", "soak", *bad])
     assert e.value.code == 2
     assert bad[0] in capsys.readouterr().err
 
 
 def test_nothing_to_run_says_so(capsys):
-    assert cli.main(["soak", "--steps", "0", "--vision-steps", "0", "--no-progress"]) == 2
+    assert cli.main(["bench", "soak", "--steps", "0", "--vision-steps", "0",
+                     "--no-progress"]) == 2
     assert "nothing to run" in capsys.readouterr().err
 
 
 def test_an_output_folder_that_cannot_be_made_is_refused_before_the_run(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("x")
-    assert cli.main(["soak", "--steps", "10", "--vision-steps", "0", "--no-progress",
+    assert cli.main(["bench", "soak", "--steps", "10", "--vision-steps", "0", "--no-progress",
                      "--out", str(blocker / "sub")]) == 1
     err = capsys.readouterr().err
     assert "--out" in err and "sub" in err

@@ -63,24 +63,29 @@ BAD = [
     (["baselines", "reach", "--env-kwargs", '{"bogus": 1}'], "--env-kwargs"),
     (["baselines", "reach", "--markdown", "{file}/x.md"], "--markdown"),
     (["baselines", "reach", "--model", "worst"], "--model"),
-    (["bench", "--sim-seconds", "inf"], "--sim-seconds"),
-    (["bench", "--sim-seconds", "0"], "--sim-seconds"),
-    (["bench", "--seed", "-1"], "--seed"),
-    (["bench", "--json", "{file}/b.json"], "--json"),
-    (["bench", "--from-json", "{dir}/nothing.json"], "--from-json"),
-    (["bench", "--plot", "{dir}"], "--plot"),
-    (["bench-recording", "--sim-seconds", "0"], "--sim-seconds"),
-    (["bench-recording", "--only", "7"], "--only"),
-    (["bench-recording", "--only", "0,0"], "--only"),
-    (["bench-recording", "--folder", "{file}"], "--folder"),
-    (["bench-vision", "--backends", "vulkan"], "--backends"),
-    (["bench-vision", "--rounds", "0"], "--rounds"),
-    (["bench-vision", "--sim-seconds", "nan"], "--sim-seconds"),
-    (["bench-vision", "--json", "{file}/x.json"], "--json"),
-    (["bench-development", "--sim-seconds", "0"], "--sim-seconds"),
-    (["bench-development", "--sim-seconds", "nan"], "--sim-seconds"),
-    (["bench-development", "--repeats", "x"], "--repeats"),
-    (["bench-development", "--json", "{file}/x.json"], "--json"),
+    (["bench", "sim", "--sim-seconds", "inf"], "--sim-seconds"),
+    (["bench", "sim", "--sim-seconds", "0"], "--sim-seconds"),
+    (["bench", "sim", "--seed", "-1"], "--seed"),
+    (["bench", "sim", "--json", "{file}/b.json"], "--json"),
+    (["bench", "sim", "--from-json", "{dir}/nothing.json"], "--from-json"),
+    (["bench", "sim", "--plot", "{dir}"], "--plot"),
+    (["bench", "recording", "--sim-seconds", "0"], "--sim-seconds"),
+    (["bench", "recording", "--only", "7"], "--only"),
+    (["bench", "recording", "--only", "0,0"], "--only"),
+    (["bench", "recording", "--folder", "{file}"], "--folder"),
+    (["bench", "vision", "--backends", "vulkan"], "--backends"),
+    (["bench", "vision", "--rounds", "0"], "--rounds"),
+    (["bench", "vision", "--sim-seconds", "nan"], "--sim-seconds"),
+    (["bench", "vision", "--json", "{file}/x.json"], "--json"),
+    (["bench", "development", "--sim-seconds", "0"], "--sim-seconds"),
+    (["bench", "development", "--sim-seconds", "nan"], "--sim-seconds"),
+    (["bench", "development", "--repeats", "x"], "--repeats"),
+    (["bench", "development", "--json", "{file}/x.json"], "--json"),
+    (["bench", "engines", "--workers", "0", "--out", "{dir}/e"], "--workers"),
+    (["bench", "engines", "--tasks", "moon", "--out", "{dir}/e"], "--tasks"),
+    (["bench", "engines", "--out", "{file}"], "--out"),
+    (["bench", "soak", "--steps", "-1"], "--steps"),
+    (["bench", "soak", "--vision-size", "4"], "--vision-size"),
     (["calibrate", "fmax", "--iterations", "-1"], "--iterations"),
     (["calibrate", "fmax", "--steps", "3"], "--steps"),
     (["calibrate", "vmax", "--episodes", "0"], "--episodes"),
@@ -119,7 +124,8 @@ def _fill(argv, places):
 def test_a_bad_argument_is_a_one_line_usage_error_naming_the_option(argv, option, places,
                                                                     capsys, monkeypatch):
     ran = []
-    for module in cli.SUBCOMMANDS:   # nothing may run: the parser refuses first
+    commands = (*cli.SUBCOMMANDS, *cli.bench.MEASUREMENTS.values())
+    for module in commands:   # nothing may run: the parser refuses first
         monkeypatch.setattr(module, "run", lambda *a, **k: ran.append(a), raising=False)
     with pytest.raises(SystemExit) as exc:
         cli.main(_fill(argv, places))
@@ -127,7 +133,8 @@ def test_a_bad_argument_is_a_one_line_usage_error_naming_the_option(argv, option
     err = capsys.readouterr().err
     assert "Traceback" not in err
     last = err.strip().splitlines()[-1]
-    assert last.startswith(f"mimo-social {argv[0]}") and "error: argument" in last
+    command = " ".join(argv[:2] if argv[0] == "bench" else argv[:1])
+    assert last.startswith(f"mimo-social {command}") and "error: argument" in last
     assert option in last
     assert not ran
 

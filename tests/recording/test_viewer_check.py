@@ -1,29 +1,38 @@
-"""The real-browser check of a replay (issue 20): Rerun's web viewer in headless Chromium shows
-the bodies of a play-room recording in its 3D view, and does not pass a recording without
-bodies.
+"""The real-browser check of a replay (issue 20), a developer's check that lives beside the
+package in ``scripts/`` (``python3 scripts/check_viewer.py FILE.rrd``, issue 27): Rerun's web
+viewer in headless Chromium shows the bodies of a play-room recording in its 3D view, and does
+not pass a recording without bodies.
 
-The browser tests are skipped (with the reason) where Chromium, Playwright or ``rerun`` is
-missing; the pixel and colour tests run everywhere. The default browser tests take about
-1.5 min here (software WebGL, two shared cores); the demo's recording, and the play room
-without its agents (the scene alone has furniture of the clothes' hues), are the slow variants.
+The browser tests are slow (``-m slow``: minutes of software WebGL) and skipped (with the
+reason) where Chromium, Playwright or ``rerun`` is missing; the pixel, colour and argument tests
+run by default and everywhere.
 """
 
 from __future__ import annotations
 
 import colorsys
 import re
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 import rerun as rr
 
-from mimo_social.cli import main
 from mimo_social.core.world import CLOTHES_PALETTE
 from mimo_social.envs import high_five_v0
 from mimo_social.recording.recorder import Recorder
-from mimo_social.recording.viewer_check import (SEPARATOR_RGB, ViewerCheckError, browser_missing,
-                                                check_viewer, colour_pixels, find_3d_view,
-                                                recording_colours, time_bar, without_agents)
+
+SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
+sys.path.insert(0, str(SCRIPTS))       # the check is a script's module, not the package's
+
+import check_viewer as script  # noqa: E402
+from viewer_check import (SEPARATOR_RGB, ViewerCheckError, browser_missing,  # noqa: E402
+                          check_viewer, colour_pixels, find_3d_view, recording_colours,
+                          time_bar, without_agents)
+
+main = script.main
 
 MISSING = browser_missing()
 needs_browser = pytest.mark.skipif(MISSING is not None, reason=f"viewer check: {MISSING}")
@@ -134,24 +143,53 @@ def test_a_recording_without_bodies_has_nothing_to_look_for(tmp_path):
         check_viewer(path, progress=None)
 
 
-def test_cli_refuses_a_bad_size_and_a_missing_file(tmp_path, capsys):
+def test_the_script_refuses_a_bad_size_and_a_missing_file(tmp_path, capsys):
     with pytest.raises(SystemExit) as e:
-        main(["check-viewer", str(tmp_path / "none.rrd")])
-    assert e.value.code == 2 and "no such file" in capsys.readouterr().err
+        main([str(tmp_path / "none.rrd")])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and "no such file" in err
+    assert err.strip().splitlines()[-1].startswith("scripts/check_viewer.py: error: argument")
     path = _no_bodies(tmp_path / "floor.rrd")
     for bad, why in (("1920", "WIDTHxHEIGHT"), ("axb", "WIDTHxHEIGHT"),
                      ("10x10", "width 640 to 7680")):
         with pytest.raises(SystemExit) as e:
-            main(["check-viewer", str(path), "--size", bad])
+            main([str(path), "--size", bad])
         assert e.value.code == 2 and why in capsys.readouterr().err
+
+
+def test_the_script_runs_from_the_command_line_and_says_why_it_fails(tmp_path):
+    """Run as the README says (its own folder on the path); a recording without bodies is one
+    line, exit code 1, before any browser starts."""
+    path = _no_bodies(tmp_path / "floor.rrd")
+    done = subprocess.run([sys.executable, str(SCRIPTS / "check_viewer.py"), str(path)],
+                          capture_output=True, text=True)
+    assert done.returncode == 1, done.stderr
+    assert "Traceback" not in done.stderr
+    assert done.stderr.strip() == (f"scripts/check_viewer.py: FAILED: {path}: no agent body "
+                                   "with a saturated clothes colour under /world/<agent>/: "
+                                   "nothing to look for")
+
+
+def test_the_check_left_the_package(capsys):
+    import importlib
+
+    from mimo_social import cli
+
+    with pytest.raises(SystemExit) as e:
+        cli.main(["check-viewer", "x.rrd"])
+    assert e.value.code == 2 and "invalid choice: 'check-viewer'" in capsys.readouterr().err
+    for gone in ("mimo_social.recording.viewer_check", "mimo_social.recording.web_viewer"):
+        with pytest.raises(ModuleNotFoundError):
+            importlib.import_module(gone)
 
 
 # ------------------------------------------------------------------------------ in the browser
 
+@pytest.mark.slow
 @needs_browser
 def test_the_web_viewer_shows_both_bodies_in_its_3d_view(recording, tmp_path, capsys):
     shot = tmp_path / "shot.png"
-    code = main(["check-viewer", str(recording), "--screenshot", str(shot), "--timeout", "150",
+    code = main([str(recording), "--screenshot", str(shot), "--timeout", "150",
                  "--size", "1280x720"])              # half the pixels of 1920x1080: faster
     out = capsys.readouterr().out
     assert code == 0, out
@@ -165,6 +203,7 @@ def test_the_web_viewer_shows_both_bodies_in_its_3d_view(recording, tmp_path, ca
     assert Image.open(shot).size == (1280, 720)
 
 
+@pytest.mark.slow
 @needs_browser
 def test_a_recording_without_bodies_fails_the_check(tmp_path):
     path = _no_bodies(tmp_path / "floor.rrd")

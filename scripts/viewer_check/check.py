@@ -1,4 +1,5 @@
-"""A real-browser check of a recording: Rerun's web viewer in headless Chromium shows the bodies.
+"""A real-browser check of a recording: Rerun's web viewer in headless Chromium shows the bodies
+(a developer's check, outside the package: ``python3 scripts/check_viewer.py FILE.rrd``).
 
 :func:`check_viewer` serves the ``.rrd`` over HTTP (with an ``Access-Control-Allow-Origin``
 header: the viewer's page comes from another port), starts ``rerun --web-viewer`` on a free port
@@ -35,7 +36,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..util.checks import ConfigError, check_int, check_number
+from mimo_social.util.checks import ConfigError, check_int, check_number
+
 from .web_viewer import (Browser, FileServer, ViewerCheckError, WebViewer, browser_missing,
                          chromium_path, without_agents)
 

@@ -1,11 +1,14 @@
-"""``mimo-social check-viewer FILE.rrd``: open a recording in Rerun's web viewer in headless
-Chromium, take a screenshot and check that the 3D view shows the bodies.
+#!/usr/bin/env python3
+"""Open a recording in Rerun's web viewer in headless Chromium, take a screenshot and check that
+the 3D view shows the bodies (a developer's check; docs/viewer_check.md).
 
-See :mod:`mimo_social.recording.viewer_check` for what is served, started and looked for. Needs
-Chromium (``chromium`` on the ``PATH`` or ``$MIMO_SOCIAL_CHROMIUM``), the Python package
+    python3 scripts/check_viewer.py recordings/demo.rrd --screenshot docs/demo_viewer.png
+
+See :mod:`viewer_check.check` (beside this script) for what is served, started and looked for.
+Needs Chromium (``chromium`` on the ``PATH`` or ``$MIMO_SOCIAL_CHROMIUM``), the Python package
 ``playwright`` (no browser download: the system Chromium is driven) and ``rerun`` (rerun-sdk).
 Exit code 0 when the bodies show, 1 when they do not (the message says which colours were
-missing and where the screenshot is), 2 for a bad argument.
+missing and where the screenshot is) or a tool is missing, 2 for a bad argument.
 """
 
 from __future__ import annotations
@@ -14,10 +17,10 @@ import argparse
 import math
 import sys
 
-from ..recording.viewer_check import ViewerCheckError, check_viewer
-from ._args import input_file, output_file
+from mimo_social.cli._args import input_file, output_file
+from viewer_check import ViewerCheckError, check_viewer
 
-__all__ = ["add_parser", "run"]
+PROG = "scripts/check_viewer.py"
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -47,10 +50,9 @@ def _number(lo: float, hi: float | None, allowed: str):
     return parse
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
-    parser = subparsers.add_parser(
-        "check-viewer", help="open a recording in Rerun's web viewer in headless Chromium; "
-                             "screenshot it and check that the 3D view shows the bodies",
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=PROG,
         description="Serve FILE.rrd over HTTP, start `rerun --web-viewer`, open it in headless "
                     "Chromium (software WebGL), wait for the recording to load, save a "
                     "screenshot and check that the 3D view shows every agent's clothes colour, "
@@ -77,17 +79,29 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--no-baseline", action="store_true",
                         help="skip the second page (the recording without the agents): count "
                              "every pixel of the clothes' hues, the scene's included (faster)")
-    parser.set_defaults(func=run)
     return parser
 
 
-def run(args: argparse.Namespace) -> int:
+def main(argv=None) -> int:
+    """Run the check with ``argv`` (default: the command line); the exit code. A bad argument
+    is argparse's usage error (exit code 2); a failure is one line on stderr."""
+    args = build_parser().parse_args(argv)
     try:
         result = check_viewer(args.file, screenshot=args.screenshot, timeout=args.timeout,
                               size=args.size, at=args.at, wait=args.wait,
                               baseline=not args.no_baseline)
     except ViewerCheckError as e:
-        print(f"mimo-social check-viewer: FAILED: {e}", file=sys.stderr)
+        print(f"{PROG}: FAILED: {e}", file=sys.stderr)
+        return 1
+    except ValueError as e:                  # a bad setting (ConfigError)
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:                     # a screenshot that cannot be written, ...
+        print(f"{PROG}: error: {e}", file=sys.stderr)
         return 1
     print(result.format())
     return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

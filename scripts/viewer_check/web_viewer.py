@@ -1,4 +1,4 @@
-"""The processes of the viewer check (:mod:`mimo_social.recording.viewer_check`): the
+"""The processes of the viewer check (:mod:`viewer_check.check`): the
 recording's folder over HTTP with a CORS header, ``rerun --web-viewer`` on free ports, headless
 Chromium driven by Playwright, and ``rerun rrd filter`` for a copy without the agents."""
 
@@ -26,7 +26,6 @@ _CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chro
 
 class ViewerCheckError(RuntimeError):
     """The viewer did not show what it should (or could not be started)."""
-
 
 
 def chromium_path() -> str | None:

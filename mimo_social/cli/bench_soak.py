@@ -1,9 +1,9 @@
-"""``mimo-social soak``: long runs of free play (touch; vision + recording) that sample resident
-memory, OS threads and open file descriptors, and report their growth per 100k steps (the
-library: :mod:`mimo_social.bench.soak`).
+"""``mimo-social bench soak``: long runs of free play (touch; vision + recording) that sample
+resident memory, OS threads and open file descriptors, and report their growth per 100k steps
+(the library: :mod:`mimo_social.bench.soak`).
 
-    mimo-social soak --out soak                    # 1e6 touch steps, 1e5 vision + recording
-    mimo-social soak --steps 20000 --vision-steps 5000 --out /tmp/soak
+    mimo-social bench soak --out soak              # 1e6 touch steps, 1e5 vision + recording
+    mimo-social bench soak --steps 20000 --vision-steps 5000 --out /tmp/soak
 """
 
 from __future__ import annotations
@@ -15,7 +15,11 @@ from pathlib import Path
 from ..bench import soak as soak_lib
 from ._args import non_negative_int
 
-__all__ = ["add_parser", "run"]
+__all__ = ["NAME", "HELP", "add_parser", "run"]
+
+#: its name under ``mimo-social bench`` and its line in the list of measurements
+NAME = "soak"
+HELP = "long free-play runs: growth of memory, threads and open files"
 
 
 def _count(text: str) -> int:
@@ -55,9 +59,11 @@ def _fraction(text: str) -> float:
     return value
 
 
-def add_parser(subparsers) -> argparse.ArgumentParser:
+def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
+    """Add the parser as ``name`` (``kw``: more of argparse's ``add_parser`` settings, e.g.
+    ``help``; none: not listed)."""
     parser = subparsers.add_parser(
-        "soak", help="long free-play runs: growth of memory, threads and open files",
+        name, **kw,
         description="Run free play with touch (--steps) and then with 2 eyes and every episode "
                     "recorded to its own .rrd file (--vision-steps), with smooth random "
                     "actions; sample resident memory (MB), OS threads and open file "
@@ -90,8 +96,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _command(args) -> str:
-    parts = ["mimo-social soak", f"--steps {args.steps}", f"--vision-steps {args.vision_steps}",
-             f"--out {args.out}", f"--seed {args.seed}"]
+    parts = ["mimo-social bench soak", f"--steps {args.steps}",
+             f"--vision-steps {args.vision_steps}", f"--out {args.out}", f"--seed {args.seed}"]
     for flag, value, default in (("--sample-every", args.sample_every, 10_000),
                                  ("--episode-steps", args.episode_steps, 1000),
                                  ("--vision-size", args.vision_size, 64),
@@ -105,13 +111,13 @@ def _command(args) -> str:
 
 def run(args: argparse.Namespace) -> int:
     if args.steps + args.vision_steps == 0:
-        print("mimo-social soak: --steps 0 and --vision-steps 0: nothing to run",
+        print(f"mimo-social bench {NAME}: error: --steps 0 and --vision-steps 0: nothing to run",
               file=sys.stderr)
         return 2
     try:                                   # a folder that cannot be made: say so before the run
         Path(args.out).mkdir(parents=True, exist_ok=True)
     except OSError as e:
-        print(f"mimo-social soak: --out {args.out}: {e}", file=sys.stderr)
+        print(f"mimo-social bench {NAME}: error: --out {args.out}: {e}", file=sys.stderr)
         return 1
     try:
         result = soak_lib.soak(args.steps, args.vision_steps, seed=args.seed,
@@ -122,7 +128,7 @@ def run(args: argparse.Namespace) -> int:
                                progress=not args.no_progress)
         paths = soak_lib.write_outputs(result, args.out, _command(args))
     except OSError as e:
-        print(f"mimo-social soak: cannot write the outputs: {e}", file=sys.stderr)
+        print(f"mimo-social bench {NAME}: error: cannot write the outputs: {e}", file=sys.stderr)
         return 1
     print(soak_lib.format_summary(result))
     print("wrote " + ", ".join(str(p) for p in paths.values()))
