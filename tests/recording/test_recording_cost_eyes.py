@@ -1,4 +1,4 @@
-"""What recording with eyes costs: the eye-cost benchmark (`mimo-social bench-recording --eyes`)
+"""What recording with eyes costs: the eye-cost benchmark (`mimo-social bench recording --eyes`)
 runs the plain step and recordings without and with eyes in turns; with eyes (2 infants, 64x64
 eyes, touch on) the stepping thread pays at most 10 % of the step."""
 
@@ -59,12 +59,12 @@ def test_bench_recording_eyes_command_prints_the_table(tmp_path, capsys, monkeyp
     monkeypatch.setattr(recording_cost, "bench_eye_cost",
                         lambda s, folder=None: real(rounds=1, flush_every_s=0.05, config=small,
                                                     folder=folder))
-    assert cli.main(["bench-recording", "--eyes", "--folder", str(tmp_path)]) == 0
+    assert cli.main(["bench", "recording", "--eyes", "--folder", str(tmp_path)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("| run | ms/step (wall) |")
     assert [x.split(" | ")[0] for x in lines[2:]] == [f"| {k}" for k in EYE_COST_VARIANTS]
 
 
 def test_bench_recording_eyes_with_only_is_refused(capsys):
-    assert cli.main(["bench-recording", "--eyes", "--only", "0"]) == 2
+    assert cli.main(["bench", "recording", "--eyes", "--only", "0"]) == 2
     assert "--only" in capsys.readouterr().err

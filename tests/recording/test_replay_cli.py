@@ -200,12 +200,12 @@ def test_command_line_end_to_end(high_five_file):
 def test_bench_recording_subcommand_measures_chosen_configurations(tmp_path, capsys):
     from mimo_social.cli import bench_recording
 
-    assert bench_recording in cli.SUBCOMMANDS
-    assert cli.main(["bench-recording", "--sim-seconds", "0.2", "--only", "0",
+    assert bench_recording in cli.bench.MEASUREMENTS.values()
+    assert cli.main(["bench", "recording", "--sim-seconds", "0.2", "--only", "0",
                      "--folder", str(tmp_path)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 3 and lines[0].startswith("| configuration |")
     assert lines[2].startswith("| 2 infants, no images |")
     assert (tmp_path / "bench_0.rrd").stat().st_size > 0
     with pytest.raises(SystemExit, match="--only"):
-        cli.main(["bench-recording", "--only", "first"])
+        cli.main(["bench", "recording", "--only", "first"])

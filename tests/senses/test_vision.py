@@ -351,7 +351,7 @@ def test_bench_vision_command_and_report():
     from mimo_social.bench import vision_cost
     from mimo_social.cli import build_parser
 
-    args = build_parser().parse_args(["bench-vision", "--backends", "egl", "--rounds", "2"])
+    args = build_parser().parse_args(["bench", "vision", "--backends", "egl", "--rounds", "2"])
     assert (args.backends, args.rounds, args.sim_seconds, args.worker) == ("egl", 2, 5.0, False)
     res = {"egl": {"images": [{"agents": 1, "size": 64, "variant": "final", "ms_per_image": 0.2},
                               {"variant": "readback_rgb_mjr_readPixels", "ms_per_2x256x256": 1.0}],

@@ -27,7 +27,7 @@ privileged cues:
     none
 baselines:
     no reward, so no learning baseline; its speed (the scene of the benchmarks) is measured by
-    `mimo-social bench` (BENCHMARKS.md)
+    `mimo-social bench sim` (BENCHMARKS.md)
 sources:
     not in the MIMo paper as a task: the sandbox of this package
 version history:
