@@ -1,8 +1,9 @@
 """Initial postures as data: joint angles (degrees) and the root's tilt.
 
-Arms hang 12 degrees abducted so the hands clear the hips. Joints not named keep their spring reference angle (the relaxed pose). ``pitch_deg`` tilts the
-whole body about its own left-right axis before it is placed on the floor (lying on the back is a
-pitch of -90 degrees: the face looks up). The world lowers every posture onto the floor.
+Arms hang 12 degrees abducted so the hands clear the hips. Joints not named keep their spring
+reference angle (the relaxed pose). ``pitch_deg`` tilts the whole body about its own left-right axis
+before it is placed on the floor (lying on the back is a pitch of -90 degrees: the face looks up).
+The world lowers every posture onto the floor.
 
 :data:`POSTURES` holds every body's postures; :data:`BODY_POSTURES` what one body (the adult)
 does otherwise, merged over them by :func:`posture_joints` and :func:`posture_pitch` (read a

@@ -28,7 +28,8 @@ from ..util.checks import (ConfigError, check_bool, check_choice, check_int, che
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig", "AgentConfig",
     "PhysicsConfig", "ConfigError", "resolve_agents", "parse_physics", "ACTUATION_MODELS",
-    "POSTURES", "BODIES", "AGE_RANGE", "DELAY_CHANNELS", "DELAY_LIMIT_MS", "env_settings", "RENDER_SIZE_RANGE", "MAX_STEPS_LIMIT",
+    "POSTURES", "BODIES", "AGE_RANGE", "DELAY_CHANNELS", "DELAY_LIMIT_MS", "env_settings",
+    "RENDER_SIZE_RANGE", "MAX_STEPS_LIMIT",
 ]
 
 ACTUATION_MODELS = ("spring_damper", "muscle", "positional")

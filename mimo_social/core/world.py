@@ -179,7 +179,7 @@ class World:
         spec = mujoco.MjSpec()
         spec.modelname = "mimo_social"
         spec.compiler.degree = False
-        self._set_options(spec, physics)
+        self.set_physics_options(spec, physics)
         self.faces = FaceTextures()
         self.faces.add_to(spec)
         self.room = None
@@ -243,7 +243,9 @@ class World:
         self.hold_welds()
 
     @staticmethod
-    def _set_options(spec, physics: PhysicsConfig):
+    def set_physics_options(spec, physics: PhysicsConfig):
+        """Write ``physics`` (timestep, gravity, solver settings) and the offscreen buffer's
+        size into a model spec's options (also for scenes built outside a World)."""
         opt = spec.option
         opt.timestep = physics.timestep
         opt.gravity = physics.gravity

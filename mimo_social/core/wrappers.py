@@ -44,15 +44,15 @@ from pettingzoo import ParallelEnv
 
 from ..util.checks import number_array
 
-__all__ = ["ParallelWrapper", "FlattenParallel", "NumericInfos", "INFO_KINDS", "FlatActionWrapper", "FlatObservationWrapper",
-           "ExpressionActionWrapper", "is_expression_only", "flat_action_space",
-           "flat_observation_space"]
+__all__ = ["ParallelWrapper", "FlattenParallel", "NumericInfos", "INFO_KINDS", "FlatActionWrapper",
+           "FlatObservationWrapper", "ExpressionActionWrapper", "is_expression_only",
+           "flat_action_space", "flat_observation_space", "ObsFlattener", "ActionDecoder"]
 
 LOGIT_LOW, LOGIT_HIGH = -1.0, 1.0
 
 
 # -- observations -------------------------------------------------------------------------------
-class _ObsFlattener:
+class ObsFlattener:
     """Turns one agent's observation (a ``Dict``, a ``Box`` or another space) into a float32 vector.
 
     Images (``uint8`` Boxes, e.g. the eyes) are scaled to [0, 1]: learners' networks expect
@@ -99,7 +99,7 @@ class FlatObservationWrapper(gym.ObservationWrapper):
 
     def __init__(self, env: gym.Env):
         super().__init__(env)
-        self._flatten = _ObsFlattener(env.observation_space)
+        self._flatten = ObsFlattener(env.observation_space)
         self.observation_space = self._flatten.space
 
     def observation(self, observation):
@@ -108,11 +108,11 @@ class FlatObservationWrapper(gym.ObservationWrapper):
 
 def flat_observation_space(space: spaces.Space) -> spaces.Box:
     """The float32 ``Box`` that :class:`FlattenParallel` gives for an observation space."""
-    return _ObsFlattener(space).space
+    return ObsFlattener(space).space
 
 
 # -- actions ------------------------------------------------------------------------------------
-class _ActionDecoder:
+class ActionDecoder:
     """Maps a flat float32 action onto an agent's action space of this package.
 
     Supported: a ``Box`` (returned reshaped), or ``Dict({"motors": Box, "expression": Discrete})``
@@ -194,7 +194,7 @@ def _numbers(action, who: str, field: str, allowed: str) -> np.ndarray:
 def flat_action_space(space: spaces.Space) -> spaces.Space:
     """The float32 ``Box`` (``Discrete`` for a face-only agent) that :class:`FlattenParallel`
     accepts for an action space."""
-    return _ActionDecoder(space).space
+    return ActionDecoder(space).space
 
 
 # -- the PettingZoo wrapper ---------------------------------------------------------------------
@@ -258,8 +258,8 @@ class FlattenParallel(ParallelWrapper):
     def __init__(self, env: ParallelEnv):
         super().__init__(env)
         self.possible_agents = list(env.possible_agents)
-        self._obs = {a: _ObsFlattener(env.observation_space(a)) for a in self.possible_agents}
-        self._act = {a: _ActionDecoder(env.action_space(a)) for a in self.possible_agents}
+        self._obs = {a: ObsFlattener(env.observation_space(a)) for a in self.possible_agents}
+        self._act = {a: ActionDecoder(env.action_space(a)) for a in self.possible_agents}
         self._obs_spaces = {a: f.space for a, f in self._obs.items()}
         self._act_spaces = {a: d.space for a, d in self._act.items()}
 
@@ -429,7 +429,7 @@ class FlatActionWrapper(gym.ActionWrapper):
 
     def __init__(self, env: gym.Env):
         super().__init__(env)
-        self._decoder = _ActionDecoder(env.action_space)
+        self._decoder = ActionDecoder(env.action_space)
         self.action_space = self._decoder.space
         self._who = str(getattr(env.unwrapped, "agent", "agent"))   # named in errors
 

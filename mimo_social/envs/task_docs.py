@@ -3,9 +3,10 @@
 Each task package (``mimo_social/tasks/<task>/__init__.py``) starts with its title line and its
 table: one section per aspect (:data:`REQUIRED_ROWS`, extra rows allowed), the aspect's name
 and a colon on a line of its own, its text indented below it, wrapped within 100 columns
-(:func:`parse_docstring`); that table is the one source of the task's documentation. :func:`render` builds the whole page: a hand-written intro, an overview
-table read from the catalogue and the task classes, one section per catalogue entry (in the
-catalogue's order) and a hand-written outro. ``mimo-social docs`` writes it.
+(:func:`parse_docstring`); that table is the one source of the task's documentation. :func:`render`
+builds the whole page: a hand-written intro, an overview table read from the catalogue and the task
+classes, one section per catalogue entry (in the catalogue's order) and a hand-written outro.
+``mimo-social docs`` writes it.
 """
 
 from __future__ import annotations

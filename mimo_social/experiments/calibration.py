@@ -73,7 +73,7 @@ def static_scene(hands: str = "mitten") -> StaticScene:
 
     build = build_infant(hands, base="fixed")
     spec = build.spec
-    World._set_options(spec, _physics())
+    World.set_physics_options(spec, _physics())
     # held limbs overlap in the zero pose (arms through the hips): contacts would fight the holds
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
     by = {j.name: j for j in build.tables.joints}
@@ -192,7 +192,7 @@ def floating_scene(hands: str = "mitten"):
 
     build = build_infant(hands, base="free")
     spec = build.spec
-    World._set_options(spec, _physics())
+    World.set_physics_options(spec, _physics())
     model = spec.compile()
     by = {j.name: j for j in build.tables.joints}
     pose = POSTURES["standing"]["joints"]
@@ -241,7 +241,7 @@ def calibrate_vmax(hands: str = "mitten", episodes: int = 30, seconds: float = 3
             for _ in range(frame_skip):
                 act.substep(model, data)
                 mujoco.mj_step(model, data)
-                np.maximum(peak, moment * np.abs(data.qvel[act._dadr]), out=peak)
+                np.maximum(peak, moment * np.abs(data.qvel[act.dof_adr]), out=peak)
         if int(data.warning.number.sum()) > warnings:
             unstable += 1
             continue  # a diverged episode says nothing about speeds

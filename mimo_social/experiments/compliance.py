@@ -93,7 +93,7 @@ def _balance(world, act, kind: str, level: float) -> np.ndarray:
     q = d.qpos[qadr]
     from ..body.actuation.muscle import force_length, force_passive
     L = act.moment[:, 0] * q + act.offset[:, 0]
-    gain = act._gain[:, 0]                                   # torque per unit force F
+    gain = act.gain[:, 0]                                    # torque per unit force F
     t_neg = gain[0] * (force_length(L[0]) * level + force_passive(L[0]))
     a_pos = (need - t_neg - gain[1] * force_passive(L[1])) / (gain[1] * force_length(L[1]))
     if not 0.0 <= a_pos <= 1.0:

@@ -6,10 +6,21 @@ agents face to face, five-finger hands, skin on both arms and hands, a ball the 
 world: a high five. Its :attr:`~HighFiveThenHandover.phase` (set before ``env.reset``) says what
 the next episode is:
 
-| phase | reset | success (``is_success`` in the infos) | scripted agents (:func:`phase_partners`) |
-|---|---|---|---|
-| ``"high_five"`` | the receiver's right arm hanging (shifted at random, as in the handover), the giver's arm where the world starts it, the ball on the floor beside the giver | both right hands feel the other agent on their skin and touch each other (as in :mod:`mimo_social.tasks.high_five`); the episode does not end | ``infant_0``: :class:`~mimo_social.tasks.high_five.HighFiveController`; ``infant_1``: ``HandOffer(grip=False, release=None, palm="forward")`` |
-| ``"handover"`` | the handover's own: the ball in the giver's palm, its fingers closed on it | the handover's (the receiver's hand holds the ball, the giver's no longer touches it, for 0.3 s) | ``infant_0``: :class:`~mimo_social.tasks.handover.ReceiveController`; ``infant_1``: the handover's :func:`~mimo_social.tasks.handover.scripted_giver` |
+``"high_five"``:
+    reset: the receiver's right arm hanging (shifted at random, as in the handover), the giver's arm
+        where the world starts it, the ball on the floor beside the giver
+    success (``is_success`` in the infos): both right hands feel the other agent on their skin and
+        touch each other (as in :mod:`mimo_social.tasks.high_five`); the episode does not end
+    scripted agents (:func:`phase_partners`): ``infant_0``:
+        :class:`~mimo_social.tasks.high_five.HighFiveController`; ``infant_1``:
+        ``HandOffer(grip=False, release=None, palm="forward")``
+``"handover"``:
+    reset: the handover's own: the ball in the giver's palm, its fingers closed on it
+    success (``is_success`` in the infos): the handover's (the receiver's hand holds the ball, the
+        giver's no longer touches it, for 0.3 s)
+    scripted agents (:func:`phase_partners`): ``infant_0``:
+        :class:`~mimo_social.tasks.handover.ReceiveController`; ``infant_1``: the handover's
+        :func:`~mimo_social.tasks.handover.scripted_giver`
 
 Both phases keep running after success (the handover's ``end_on_success`` is off); a ball that
 falls ends the handover (as in the task). Rewards are the handover's in its phase, zero in the

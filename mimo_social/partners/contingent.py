@@ -7,11 +7,22 @@ acts only through its own action space (motors and face), as every scripted part
 
 **Cue events** (the onset of a cue; ``cues`` says which count):
 
-| cue | event (onset) | response |
-|---|---|---|
-| ``"expression"`` | ``face="smile"``: the learner starts smiling (its face becomes ``happy``); ``face="copy"``: its face changes to a non-neutral one | the caregiver shows ``happy`` (``"smile"``) or the learner's face of the event (``"copy"``) |
-| ``"gaze"`` | the learner's line of sight leaves the caregiver's face for a point on the floor (``gaze_point`` appears while ``gaze_on_face`` is false) | the caregiver turns head and eyes to where the learner looks on the floor (the point of the event; while the response lasts, the learner's current floor point, as long as it looks at the floor) |
-| ``"touch"`` | a hand of the learner starts touching the caregiver's body | a pat: the caregiver's right palm goes to 4 cm above the palm of the learner's touching hand (both touching, or none any more: the nearer one), down onto it, up, and back (each a quarter of the response; the arm's angles planned when the response starts) |
+``"expression"``:
+    event (onset): ``face="smile"``: the learner starts smiling (its face becomes ``happy``);
+        ``face="copy"``: its face changes to a non-neutral one
+    response: the caregiver shows ``happy`` (``"smile"``) or the learner's face of the event
+        (``"copy"``)
+``"gaze"``:
+    event (onset): the learner's line of sight leaves the caregiver's face for a point on the floor
+        (``gaze_point`` appears while ``gaze_on_face`` is false)
+    response: the caregiver turns head and eyes to where the learner looks on the floor (the point
+        of the event; while the response lasts, the learner's current floor point, as long as it
+        looks at the floor)
+``"touch"``:
+    event (onset): a hand of the learner starts touching the caregiver's body
+    response: a pat: the caregiver's right palm goes to 4 cm above the palm of the learner's
+        touching hand (both touching, or none any more: the nearer one), down onto it, up, and back
+        (each a quarter of the response; the arm's angles planned when the response starts)
 
 Each event is answered with probability ``probability`` (one draw from the partner's
 generator per event, seeded by :class:`~mimo_social.partners.wrapper.ScriptedPartners`), after

@@ -2,13 +2,14 @@
 
 Every ``hold_s`` seconds (a time drawn uniformly from the range) it picks another target at
 random (never the same twice in a row) and turns to it with its own motors: a PD law with
-compensation of gravity, springs and any force the task applies drives its head (swivel, tilt; sideways tilt to 0) and eye
-joints (horizontal, vertical; torsion to 0) from their current angles to the angles that look at
-the target. Those angles come from :class:`~mimo_social.core.kinematics.LookAt`, the geometry
-that the tasks' :class:`~mimo_social.core.kinematics.Gaze` sets directly (the head turns, swivel
-then tilt, to face the target from the neck; each eye then turns, horizontal then vertical, to
-look at it from its own centre), computed on a private copy of the state: the partner never writes the world's ``qpos``, so its head turn is physical (it takes
-about 0.3 s) and visible to whoever watches it.
+compensation of gravity, springs and any force the task applies drives its head (swivel, tilt;
+sideways tilt to 0) and eye joints (horizontal, vertical; torsion to 0) from their current angles to
+the angles that look at the target. Those angles come from
+:class:`~mimo_social.core.kinematics.LookAt`, the geometry that the tasks'
+:class:`~mimo_social.core.kinematics.Gaze` sets directly (the head turns, swivel then tilt, to face
+the target from the neck; each eye then turns, horizontal then vertical, to look at it from its own
+centre), computed on a private copy of the state: the partner never writes the world's ``qpos``, so
+its head turn is physical (it takes about 0.3 s) and visible to whoever watches it.
 
 How much of a gaze shift the head makes: ``head_share`` (a share ``s`` in [0, 1], or a range
 ``(lo, hi)`` drawn from anew at every shift; ``None``: the task's ``partner_head_share`` range

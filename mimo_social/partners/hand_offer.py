@@ -8,14 +8,60 @@ that hand carries it; ``"on_touch"`` (the first version) opens at the first touc
 hand. A high-five partner uses ``HandOffer(grip=False, release=None)``: hand out, fingers open,
 nothing to release.
 
-| | |
-|---|---|
-| target | ``posture`` (joint -> degrees; default :data:`OFFER_POSTURE_DEG`: upper arm forward, elbow half bent, palm up) or, with ``target=(forward, left, up)`` (m, from the right shoulder in the infant's heading frame), the posture whose palm centre reaches that point; the wrist is then solved for ``palm``: ``"up"`` (default: the palm faces up, leaning 0.15 toward the thumb and 0.1 toward the fingers, a pocket a ball rests in), ``"forward"`` (facing ahead as far as the wrist's range allows, about 25 deg off at the default posture; for a high five) or ``"posture"`` (the posture's wrist angles); see :func:`offer_posture` (damped least squares, solved once per reset on a scratch copy of the state) |
-| adult | an agent with the adult body (or whose arm differs from the other's by over 5 %: an infant of another size) offers where the other agent's hand reaches (a point beyond its own arm brought to 0.9 of it, raised if below): its palm centre at ``adult_reach_to`` from the other's right shoulder (default :data:`REACH_TO`, where the high five's 18-month-old partner holds its palm for the other; scaled with the other's arm), its own shoulder, elbow and wrist solved for it; ``reach_to`` does the same for any body |
-| arm | PD control per joint toward the target angles, gains from the joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio ``damping`` 1), plus gravity / Coriolis and passive-spring compensation read from MuJoCo (``qfrc_bias``, ``qfrc_spring``); the torque becomes the agent's controls: spring-damper motors ``u = tau / T_max`` (clipped to [-1, 1]); muscles: the agonist's activation giving ``tau`` at the current length on top of the passive muscle forces (isometric curve, clipped to [0, 1], antagonist off) |
-| fingers | closed (``grip`` and not released): a constant flexing command ``grip_strength`` (0.03 of the motor's strength or of full activation) on the four fingers' flexors (mcp, pip, dip, the little finger's cup; mitten: the one finger joint), ``thumb_strength`` (0: the thumb held at rest by the PD) on the thumb's; spread and pivot held by the PD. Open: PD toward straight fingers, the thumb at its rest angles. A gentle grip holds a ball lying in the palm; a strong one squeezes it out (measured: 0.3 and above lose a 3 cm ball within 6 s) |
-| release | ``None``: never (the fingers stay as ``grip`` says). ``"on_hold"`` (default): *present*: while another agent holds an open right hand out next to the giver's (its palm centre within ``ready_radius`` 8 cm of the giver's, lower than the object's centre, facing up within 45 deg) for ``ready_time`` (0.3 s), the palm tips toward its little-finger side (the palm's lean toward the thumb lowered by ``present``, 0.75, over ``present_time`` 0.5 s; it levels again when that hand goes away), so the object rolls toward that hand; *let go*: once the right hand of another agent, its palm facing the object, touches the object with >= ``hold_parts`` (2) segments and carries >= ``hold_load`` (0.5) of its weight (the upward component of that hand's contact forces on it, :meth:`HandOffer.carried`) for ``hold_time`` (0.2 s), the fingers open and the arm goes to a posture with the palm ``withdraw`` (3 cm back, 8 cm down) from the offer, shoulder and elbow solved, the wrist kept (at the handover's offer the arm gets the palm 1.9 cm back and 3.7 cm down). A touch of the back of the hand or a one-finger poke neither presents nor lets go. ``"on_touch"``: open once a geom of another agent's hand (either hand) touches the object ``prop`` (a contact with dist <= 0), ``release_delay`` s later; with ``pour`` > 0 the wrist then also tips the palm over the fingertips (slope ``pour``) so the object rolls toward the partner |
-| state | ``released`` (bool), ``touched_at`` (env time of the first touch, ``"on_touch"``, or of the first step the other hand held the object, ``"on_hold"``; else ``None``), ``tip`` (0-1: how far the palm is tipped toward the other hand), ``ready_steps``, ``held_steps``, ``load`` (the fraction of the weight the other hand carried last step), ``target_angles`` (rad, per motor: arm targets, open-finger targets), ``target_position`` (world, the palm centre of the holding posture) |
+target:
+    ``posture`` (joint -> degrees; default :data:`OFFER_POSTURE_DEG`: upper arm forward, elbow half
+    bent, palm up) or, with ``target=(forward, left, up)`` (m, from the right shoulder in the
+    infant's heading frame), the posture whose palm centre reaches that point; the wrist is then
+    solved for ``palm``: ``"up"`` (default: the palm faces up, leaning 0.15 toward the thumb and 0.1
+    toward the fingers, a pocket a ball rests in), ``"forward"`` (facing ahead as far as the wrist's
+    range allows, about 25 deg off at the default posture; for a high five) or ``"posture"`` (the
+    posture's wrist angles); see :func:`offer_posture` (damped least squares, solved once per reset
+    on a scratch copy of the state)
+adult:
+    an agent with the adult body (or whose arm differs from the other's by over 5 %: an infant of
+    another size) offers where the other agent's hand reaches (a point beyond its own arm brought to
+    0.9 of it, raised if below): its palm centre at ``adult_reach_to`` from the other's right
+    shoulder (default :data:`REACH_TO`, where the high five's 18-month-old partner holds its palm
+    for the other; scaled with the other's arm), its own shoulder, elbow and wrist solved for it;
+    ``reach_to`` does the same for any body
+arm:
+    PD control per joint toward the target angles, gains from the joint's own inertia (the diagonal
+    of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio
+    ``damping`` 1), plus gravity / Coriolis and passive-spring compensation read from MuJoCo
+    (``qfrc_bias``, ``qfrc_spring``); the torque becomes the agent's controls: spring-damper motors
+    ``u = tau / T_max`` (clipped to [-1, 1]); muscles: the agonist's activation giving ``tau`` at
+    the current length on top of the passive muscle forces (isometric curve, clipped to [0, 1],
+    antagonist off)
+fingers:
+    closed (``grip`` and not released): a constant flexing command ``grip_strength`` (0.03 of the
+    motor's strength or of full activation) on the four fingers' flexors (mcp, pip, dip, the little
+    finger's cup; mitten: the one finger joint), ``thumb_strength`` (0: the thumb held at rest by
+    the PD) on the thumb's; spread and pivot held by the PD. Open: PD toward straight fingers, the
+    thumb at its rest angles. A gentle grip holds a ball lying in the palm; a strong one squeezes it
+    out (measured: 0.3 and above lose a 3 cm ball within 6 s)
+release:
+    ``None``: never (the fingers stay as ``grip`` says). ``"on_hold"`` (default): *present*: while
+    another agent holds an open right hand out next to the giver's (its palm centre within
+    ``ready_radius`` 8 cm of the giver's, lower than the object's centre, facing up within 45 deg)
+    for ``ready_time`` (0.3 s), the palm tips toward its little-finger side (the palm's lean toward
+    the thumb lowered by ``present``, 0.75, over ``present_time`` 0.5 s; it levels again when that
+    hand goes away), so the object rolls toward that hand; *let go*: once the right hand of another
+    agent, its palm facing the object, touches the object with >= ``hold_parts`` (2) segments and
+    carries >= ``hold_load`` (0.5) of its weight (the upward component of that hand's contact forces
+    on it, :meth:`HandOffer.carried`) for ``hold_time`` (0.2 s), the fingers open and the arm goes
+    to a posture with the palm ``withdraw`` (3 cm back, 8 cm down) from the offer, shoulder and
+    elbow solved, the wrist kept (at the handover's offer the arm gets the palm 1.9 cm back and 3.7
+    cm down). A touch of the back of the hand or a one-finger poke neither presents nor lets go.
+    ``"on_touch"``: open once a geom of another agent's hand (either hand) touches the object
+    ``prop`` (a contact with dist <= 0), ``release_delay`` s later; with ``pour`` > 0 the wrist then
+    also tips the palm over the fingertips (slope ``pour``) so the object rolls toward the partner
+state:
+    ``released`` (bool), ``touched_at`` (env time of the first touch, ``"on_touch"``, or of the
+    first step the other hand held the object, ``"on_hold"``; else ``None``), ``tip`` (0-1: how far
+    the palm is tipped toward the other hand), ``ready_steps``, ``held_steps``, ``load`` (the
+    fraction of the weight the other hand carried last step), ``target_angles`` (rad, per motor: arm
+    targets, open-finger targets), ``target_position`` (world, the palm centre of the holding
+    posture)
 
 Both hand versions and both actuation models are supported (tests: the palm within 3 cm of the
 target after 1 s from the hanging arm, within 2 cm after 1.5 s, for all four combinations). The
@@ -41,10 +87,10 @@ from ..util.checks import (ConfigError, check_bool, check_choice, check_int, che
                            check_numbers, show)
 from .base import (Partner, agent_index, check_angles, motor_action, pd_gains, require_motors,
                    require_prop)
+from .offer_target import REACH_TO, adapts, is_adult, reach_target
 
-__all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "REACH_TO", "REF_ARM",
-           "SIZE_TOLERANCE", "finger_flexors", "offer_posture", "reach_target", "is_adult",
-           "arm_length", "nearest_other", "adapts"]
+__all__ = ["HandOffer", "OFFER_POSTURE_DEG", "OPEN_FINGERS_DEG", "finger_flexors",
+           "offer_posture"]
 
 # The right arm forward, the hand in front of the chest, elbow half bent, palm up (degrees): the
 # palm centre ~16 cm ahead of the right shoulder, 6 cm toward the midline, 10 cm lower.
@@ -61,94 +107,6 @@ RELEASES = (None, "on_touch", "on_hold")
 PALMS = ("up", "forward", "posture")
 # mitten: the finger joint closes towards its lower limit (-160 deg)
 MITTEN_CLOSE_SIGN = -1.0
-#: where an adult offers its palm centre by default: (forward, left, up) m from the other
-#: agent's right shoulder, in that agent's heading frame: where the high five's scripted partner
-#: (an 18-month-old, 0.35 m away) holds its palm for the other 18-month-old (measured on
-#: ``high_five_v0.scripted_env()``: HandOffer.target_position minus infant_0's shoulder)
-REACH_TO = (0.205, 0.152, -0.099)
-
-
-#: where an offering agent holds its palm when the point asked is out of its reach (farther than
-#: its arm, shoulder to palm centre): this fraction of its arm from the shoulder (the high five's
-#: 18-month-old partner holds its palm 0.896 of its arm from its shoulder)
-REACH_LIMIT = 0.9
-#: a partner whose arm differs from the other's by more than this fraction offers where the
-#: other reaches (:func:`adapts`)
-SIZE_TOLERANCE = 0.05
-#: m: the 18-month-old's right arm, shoulder to palm centre along the segments (arm_length)
-REF_ARM = 0.2157
-
-
-def arm_length(world, i: int) -> float:
-    """Agent ``i``'s right arm in the world, m: shoulder to elbow, elbow to wrist, wrist to
-    palm centre (the segments' origins and the palm site), whatever its posture."""
-    m, d = world.model, world.data
-    a = world.agents[i]
-    pts = [d.xpos[m.body(f"{a.name}/right_{s}").id] for s in ("upper_arm", "lower_arm", "hand")]
-    pts.append(d.site_xpos[a.palm_sites[0]])
-    return float(sum(np.linalg.norm(q - p) for p, q in zip(pts, pts[1:])))
-
-
-def is_adult(world, i: int) -> bool:
-    """Whether agent ``i`` of ``world`` has the adult caregiver's body."""
-    return getattr(world.tables[i], "body", "infant") == "adult"
-
-
-def nearest_other(world, i: int) -> int:
-    """The index of the agent nearest to agent ``i`` (hip to hip)."""
-    d = world.data
-    me = world.agents[i]
-    others = [j for j in range(len(world.agents)) if j != i]
-    if not others:
-        raise ValueError(f"HandOffer: {me.name} has no other agent to offer to")
-    return min(others, key=lambda k: np.linalg.norm(d.xpos[world.agents[k].root_body]
-                                                     - d.xpos[me.root_body]))
-
-
-def adapts(world, i: int) -> bool:
-    """Whether agent ``i`` offers where the other reaches (:func:`reach_target`): an adult, or
-    any body whose arm differs from the nearest other agent's by more than
-    :data:`SIZE_TOLERANCE` (two infants of different sizes meet where the other reaches, within
-    their own reach)."""
-    if is_adult(world, i):
-        return True
-    ratio = arm_length(world, i) / arm_length(world, nearest_other(world, i))
-    return abs(ratio - 1.0) > SIZE_TOLERANCE
-
-
-def reach_target(world, i: int, point) -> tuple[float, float, float]:
-    """``point`` (forward, left, up: m from the right shoulder of the agent nearest to agent
-    ``i``, in that agent's heading frame, for an 18-month-old's arm; times that agent's
-    :func:`arm_length` over :data:`REF_ARM`) as a target of agent ``i``'s own right shoulder
-    (forward, left, up in ``i``'s heading frame), for :func:`offer_posture`. A point beyond
-    agent ``i``'s arm is brought to :data:`REACH_LIMIT` of it: raised, if below, else pulled
-    toward the shoulder."""
-    m, d = world.model, world.data
-    me = world.agents[i]
-    j = nearest_other(world, i)
-
-    def frame(a):
-        R = d.xmat[a.root_body].reshape(3, 3)
-        h = np.arctan2(R[1, 0], R[0, 0])
-        c, s = np.cos(h), np.sin(h)
-        sh = d.xpos[m.body(f"{a.name}/right_upper_arm").id].copy()
-        return sh, np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-    sh_j, R_j = frame(world.agents[j])
-    sh_i, R_i = frame(me)
-    goal = sh_j + R_j @ np.asarray(point, float) * arm_length(world, j) / REF_ARM
-    local = R_i.T @ (goal - sh_i)
-    arm = arm_length(world, i)
-    reach = REACH_LIMIT * arm
-    if np.linalg.norm(local) > arm:
-        # out of its reach: below it, as low as it comfortably reaches above that point; else
-        # (or if even that is too far) on the line to its shoulder, within reach
-        across = float(np.linalg.norm(local[:2]))
-        if local[2] < 0.0 and across < reach:
-            local[2] = -np.sqrt(reach ** 2 - across ** 2)
-        else:
-            local = local * reach / np.linalg.norm(local)
-    return tuple(float(x) for x in local)
 
 
 def finger_flexors(names) -> np.ndarray:
@@ -269,19 +227,20 @@ class HandOffer(Partner):
     object) until released; ``release``: ``"on_hold"``, ``"on_touch"`` or ``None`` (see the
     module table; ``hold_parts``, ``hold_load``, ``hold_time``, ``present``, ``present_time``,
     ``ready_time``, ``ready_radius`` and ``withdraw`` = (back, down) m tune ``"on_hold"``);
-    ``release_delay``: seconds between the touch and the opening (``"on_touch"``); ``prop``: the held object's prop name; ``frequency`` (Hz)
-    and ``damping`` (ratio): the PD loop; ``grip_strength`` / ``thumb_strength``: the
-    fingers' / thumb's flexing command in [0, 1]; ``pour``: after the release, tip the palm over
-    the fingertips with this slope (0: keep it level); ``palm``: ``"up"`` (hold an object),
-    ``"forward"`` (facing the partner, e.g. for a high five) or ``"posture"`` (the wrist angles
-    of ``posture``), see :func:`offer_posture`; ``palm_tilt``: the upturned palm's lean (slopes
-    toward the thumb, toward the wrist); ``reach_to``: ``(forward, left, up)`` m from the
-    *other* (nearest) agent's right shoulder, in its heading frame, for an 18-month-old's arm
-    (scaled with that agent's arm): the palm centre goes there instead of ``target``, for any
-    body; ``adult_reach_to`` (default :data:`REACH_TO`) is that point for an agent with the
-    adult body, or an arm differing from the other's by over :data:`SIZE_TOLERANCE`, when
-    ``reach_to`` is None (a caregiver, or an infant of another size, offers where the other
-    reaches, within its own reach); ``adult_present``: ``present`` for an adult (None: the same).
+    ``release_delay``: seconds between the touch and the opening (``"on_touch"``); ``prop``: the
+    held object's prop name; ``frequency`` (Hz) and ``damping`` (ratio): the PD loop;
+    ``grip_strength`` / ``thumb_strength``: the fingers' / thumb's flexing command in [0, 1];
+    ``pour``: after the release, tip the palm over the fingertips with this slope (0: keep it
+    level); ``palm``: ``"up"`` (hold an object), ``"forward"`` (facing the partner, e.g. for a high
+    five) or ``"posture"`` (the wrist angles of ``posture``), see :func:`offer_posture`;
+    ``palm_tilt``: the upturned palm's lean (slopes toward the thumb, toward the wrist);
+    ``reach_to``: ``(forward, left, up)`` m from the *other* (nearest) agent's right shoulder, in
+    its heading frame, for an 18-month-old's arm (scaled with that agent's arm): the palm centre
+    goes there instead of ``target``, for any body; ``adult_reach_to`` (default :data:`REACH_TO`) is
+    that point for an agent with the adult body, or an arm differing from the other's by over
+    :data:`~mimo_social.partners.offer_target.SIZE_TOLERANCE`, when ``reach_to`` is None (a
+    caregiver, or an infant of another size, offers where the other reaches, within its own reach);
+    ``adult_present``: ``present`` for an adult (None: the same).
     """
 
     def __init__(self, posture: Mapping[str, float] | None = None, target=None,

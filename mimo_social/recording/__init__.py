@@ -4,9 +4,9 @@
 its docstring); ``episodes``: one episode (:func:`record_episode`) or every k-th episode during
 training (:class:`RecordingParallelEnv`, :func:`recording_env_fn`); ``summary``: what a file
 holds (:func:`summarize`); ``streams``: Rerun file streams that free their threads when closed and
-write errors that name the file and the cause (:class:`RecordingFileError`). The parts of a recording: ``geometry`` (geom shapes), ``faces``
-(expressions), ``eyes``, ``skin``, ``contacts``, ``blueprint`` (viewer layout), ``columns``
-(Arrow columns and the row buffer).
+write errors that name the file and the cause (:class:`RecordingFileError`). The parts of a
+recording: ``geometry`` (geom shapes), ``faces`` (expressions), ``eyes``, ``skin``, ``contacts``,
+``blueprint`` (viewer layout), ``columns`` (Arrow columns and the row buffer).
 """
 
 from .columns import SIM_TIME, STEP

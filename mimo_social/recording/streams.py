@@ -183,7 +183,7 @@ def release_dropped() -> None:
     the user (``rr.init``) stays. Nothing is done once a stream is stuck, or while an open one
     has lost its writer (that would block)."""
     with _LOCK:
-        if _STUCK or any(stream._writer_alive() is False for stream in list(_OPEN)):
+        if _STUCK or any(stream.writer_alive() is False for stream in list(_OPEN)):
             return             # a writer died under an open recording: its flush could block
         previous = rr.get_global_data_recording()
         bindings.flush_and_cleanup_orphaned_recordings()
@@ -236,7 +236,9 @@ class FileStream:
         with _LOCK:
             _OPEN.add(self)
 
-    def _writer_alive(self) -> bool | None:
+    def writer_alive(self) -> bool | None:
+        """Whether Rerun's file-writer thread of this stream still runs (``None``: unknown, when
+        the thread could not be told apart or the threads cannot be listed)."""
         if self._writer is None:
             return None
         threads = _writer_threads()
@@ -255,7 +257,7 @@ class FileStream:
             except RuntimeError as e:
                 message = str(e)
             timed_out = "timed out" in message
-            alive = self._writer_alive()
+            alive = self.writer_alive()
             if timed_out and alive is not False and time.monotonic() < deadline:
                 continue
             self._fail(message, stuck=timed_out)
@@ -263,7 +265,7 @@ class FileStream:
     def _fail(self, message: str, stuck: bool) -> None:
         code, cause = write_problem(self.path)
         if not cause:
-            alive = self._writer_alive()
+            alive = self.writer_alive()
             cause = (f"nothing got written for {self.write_timeout_s:g} s" if alive
                      else "Rerun's file writer stopped (its error is on stderr)")
             cause += f" ({message})"

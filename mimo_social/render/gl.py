@@ -14,9 +14,9 @@ process that renders): the eyes (:mod:`mimo_social.render.eye_renderer`) and ``e
 (:mod:`mimo_social.render.scene`). It is current only while a renderer draws, so any thread
 may render. OpenGL does not survive ``fork`` (Mesa hangs in the child): a process forked after
 its parent used OpenGL raises a RuntimeError when it tries to render, so subprocess vector envs
-must use the ``spawn`` or ``forkserver`` start method (or fork before anything renders). When ``mujoco`` was imported before
-``mimo_social`` (so it chose GLFW, useless without a display), :func:`gl_context_class` loads
-EGL's or OSMesa's context class when the first context is made.
+must use the ``spawn`` or ``forkserver`` start method (or fork before anything renders). When
+``mujoco`` was imported before ``mimo_social`` (so it chose GLFW, useless without a display),
+:func:`gl_context_class` loads EGL's or OSMesa's context class when the first context is made.
 """
 
 from __future__ import annotations

@@ -145,8 +145,9 @@ class AgentTouch:
     def read(self) -> np.ndarray:
         """This agent's ``touch`` vector as of the last update (a new float32 array)."""
         if self.config.normal_only:   # (>= 0: a -0.0 or rounding below 0 reads 0)
-            return np.maximum(self.system._normal[self.start:self.stop], 0.0).astype(np.float32)
-        return self.system._xyz[3 * self.start:3 * self.stop].astype(np.float32)
+            normal = self.system.force_normal[self.start:self.stop]
+            return np.maximum(normal, 0.0).astype(np.float32)
+        return self.system.force_xyz[3 * self.start:3 * self.stop].astype(np.float32)
 
     def info(self) -> dict:
         return {"touch": self.system.touched_by(self.agent)}

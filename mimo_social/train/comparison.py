@@ -22,7 +22,7 @@ from .plots import plot_compare
 from .runner import train
 from .tasks import ALGOS, TrainInputError, check_algo, check_mode, check_task, task_module
 
-__all__ = ["compare", "parse_steps_per_algo"]
+__all__ = ["compare", "parse_steps_per_algo", "value_per_algo", "kwargs_keyed_by_algo"]
 
 
 def _train_quiet(kwargs):
@@ -33,7 +33,7 @@ def _train_quiet(kwargs):
     return kwargs["out"], time.perf_counter() - t0
 
 
-def _per_algo(name: str, value, algos: list[str], per_algo: bool) -> dict:
+def value_per_algo(name: str, value, algos: list[str], per_algo: bool) -> dict:
     """``{algo: value}``: ``value`` itself for every algorithm, or (``per_algo``) its entries."""
     if not per_algo:
         return {a: value for a in algos}
@@ -44,9 +44,9 @@ def _per_algo(name: str, value, algos: list[str], per_algo: bool) -> dict:
     return {a: value[a] for a in algos}
 
 
-def _kwargs_per_algo(kwargs: Mapping[str, Any], algos=ALGOS,
-                     example: str = '{"ppo": {"n_steps": 512}, "sac": {"batch_size": 128}}'
-                     ) -> bool:
+def kwargs_keyed_by_algo(kwargs: Mapping[str, Any], algos=ALGOS,
+                         example: str = '{"ppo": {"n_steps": 512}, "sac": {"batch_size": 128}}'
+                         ) -> bool:
     """Whether ``algo_kwargs`` is keyed by algorithm (``{"ppo": {...}, "sac": {...}}``), the
     algorithms being ``algos`` (SB3's by default; the RLlib sweep passes its own)."""
     named = [k for k in kwargs if k in algos]
@@ -99,9 +99,10 @@ def compare(task: str, algos=ALGOS, seeds: int = 3, steps: int | Mapping[str, in
     jobs = int(jobs)
     if jobs < 1:
         raise TrainInputError(f"jobs={jobs}; allowed: a positive integer")
-    steps = _per_algo("steps", steps, algos, isinstance(steps, Mapping))
+    steps = value_per_algo("steps", steps, algos, isinstance(steps, Mapping))
     algo_kwargs = dict(algo_kwargs or {})
-    kwargs = _per_algo("algo_kwargs", algo_kwargs, algos, _kwargs_per_algo(algo_kwargs))
+    kwargs = value_per_algo("algo_kwargs", algo_kwargs, algos,
+                            kwargs_keyed_by_algo(algo_kwargs))
     runs = [dict(task=task, algo=a, steps=steps[a], seed=s, out=str(out / f"{a}_seed{s}"),
                  algo_kwargs=kwargs[a], **train_kwargs) for a in algos for s in range(int(seeds))]
     if not plot_only:

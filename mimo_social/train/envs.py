@@ -31,7 +31,7 @@ from ..envs.catalog import entry, register_envs
 from .tasks import check_task, task_module
 
 __all__ = ["make_env", "make_parallel_env", "make_scripted_env", "make_sb3_single",
-           "with_render"]
+           "with_render", "world_vec_env", "call_world", "vec_worker"]
 
 
 def with_render(env_kwargs: Mapping[str, Any], render_mode: str | None) -> dict:
@@ -89,14 +89,14 @@ def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
 
 
 # -- worker side of ``vector.SpawnConcatVecEnv`` ------------------------------------------------
-def _markov_env(env_fn: Callable[[], ParallelEnv]):
+def world_vec_env(env_fn: Callable[[], ParallelEnv]):
     """One world as SuperSuit's gymnasium vector env (one slot per agent)."""
     import supersuit as ss
     return ss.pettingzoo_env_to_vec_env_v1(FlattenParallel(env_fn()))
 
 
-def _world_call(par_env: FlattenParallel, kind: str, name: str, args: tuple = (),
-                kwargs: dict | None = None):
+def call_world(par_env: FlattenParallel, kind: str, name: str, args: tuple = (),
+               kwargs: dict | None = None):
     """Get or set an attribute of, or call a method of, one world (a FlattenParallel)."""
     if kind == "get":
         return getattr(par_env, name)
@@ -108,14 +108,14 @@ def _world_call(par_env: FlattenParallel, kind: str, name: str, args: tuple = ()
     raise ValueError(f"unknown world call {kind!r}")
 
 
-def _vec_worker(conn, payload: bytes, n_worlds: int) -> None:
+def vec_worker(conn, payload: bytes, n_worlds: int) -> None:
     """Process entry point: SuperSuit's in-process vector env of ``n_worlds`` worlds built from
     the cloudpickled ``env_fn`` in ``payload``; every answer on ``conn`` is ``(status, value)``."""
     try:
         import cloudpickle
         import supersuit as ss
         env_fn = cloudpickle.loads(payload)
-        venv = ss.concat_vec_envs_v1(_markov_env(env_fn), n_worlds, num_cpus=0,
+        venv = ss.concat_vec_envs_v1(world_vec_env(env_fn), n_worlds, num_cpus=0,
                                      base_class="gymnasium")
         par_envs = [m.par_env for m in venv.vec_envs]
         conn.send(("ok", (venv.num_envs, venv.observation_space, venv.action_space,
@@ -140,7 +140,7 @@ def _vec_worker(conn, payload: bytes, n_worlds: int) -> None:
                 elif cmd == "reset":
                     out = venv.reset(seed=data[0], options=data[1])
                 elif cmd == "world":
-                    out = [_world_call(p, *data) for p in par_envs]
+                    out = [call_world(p, *data) for p in par_envs]
                 else:
                     raise ValueError(f"unknown command {cmd!r}")
             except Exception:

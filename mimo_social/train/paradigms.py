@@ -82,7 +82,7 @@ class _Trained:
 
     def __init__(self, run: Path, config: Mapping[str, Any], model: str, obs_space, act_space,
                  deterministic: bool = True):
-        from ..core.wrappers import _ActionDecoder, _ObsFlattener
+        from ..core.wrappers import ActionDecoder, ObsFlattener
         from .tasks import algo_class
         path = {"final": run / "model.zip", "best": run / "best_model.zip"}[model]
         if not path.exists():
@@ -91,7 +91,7 @@ class _Trained:
         import torch
         torch.set_num_threads(1)
         self.model = algo_class(config["algo"]).load(str(path), device="cpu")
-        self.flatten, self.decode = _ObsFlattener(obs_space), _ActionDecoder(act_space)
+        self.flatten, self.decode = ObsFlattener(obs_space), ActionDecoder(act_space)
         if self.model.observation_space.shape != self.flatten.space.shape:
             raise TrainInputError(f"run {run}: its policy observes "
                                   f"{self.model.observation_space.shape} floats, the env gives "

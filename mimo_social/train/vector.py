@@ -55,9 +55,9 @@ from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper
 from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices
 from supersuit.vector.sb3_vector_wrapper import SB3VecEnvWrapper
 
-from .envs import _markov_env, _vec_worker, _world_call
+from .envs import call_world, vec_worker, world_vec_env
 
-# Worker processes run ``envs._vec_worker``: importing that module pulls in neither SB3 nor
+# Worker processes run ``envs.vec_worker``: importing that module pulls in neither SB3 nor
 # torch, so a spawned worker starts (and exits) in about a second instead of several.
 
 __all__ = ["sb3_vec_env", "SeededVecEnv", "SpawnConcatVecEnv"]
@@ -92,7 +92,7 @@ class SpawnConcatVecEnv(gymnasium.vector.VectorEnv):
         try:
             for p, k in enumerate(counts):
                 parent_end, child_end = ctx.Pipe()
-                proc = ctx.Process(target=_vec_worker, args=(child_end, payload, k), daemon=True,
+                proc = ctx.Process(target=vec_worker, args=(child_end, payload, k), daemon=True,
                                    name=f"mimo_social-vec-{p}")
                 proc.start()
                 child_end.close()
@@ -184,7 +184,7 @@ class SpawnConcatVecEnv(gymnasium.vector.VectorEnv):
         return self.step_wait()
 
     def call_worlds(self, kind: str, name: str, args: tuple = (), kwargs: dict | None = None):
-        """``_world_call`` on every world, in world order."""
+        """``call_world`` on every world, in world order."""
         self._send_all(("world", (kind, name, args, kwargs)) for _ in self._conns)
         return [r for part in self._gather() for r in part]
 
@@ -291,7 +291,7 @@ class SeededVecEnv(VecEnvWrapper):
         g = self.gym_venv
         if isinstance(g, SpawnConcatVecEnv):
             return g.call_worlds(kind, name, args, kwargs)
-        return [_world_call(m.par_env, kind, name, args, kwargs) for m in g.vec_envs]
+        return [call_world(m.par_env, kind, name, args, kwargs) for m in g.vec_envs]
 
     def _slots(self, per_world: list, indices: VecEnvIndices) -> list:
         k = self.agents_per_world
@@ -338,7 +338,7 @@ def sb3_vec_env(env_fn: Callable[[], ParallelEnv], n_envs: int = 1, n_cpus: int 
         raise ValueError(f"n_cpus={n_cpus!r}; allowed: 0 (in-process) or the number of processes")
     n_envs, n_cpus = int(n_envs), int(n_cpus)
     if n_cpus == 0:
-        venv = ss.concat_vec_envs_v1(_markov_env(env_fn), num_vec_envs=n_envs, num_cpus=0,
+        venv = ss.concat_vec_envs_v1(world_vec_env(env_fn), num_vec_envs=n_envs, num_cpus=0,
                                      base_class="stable_baselines3")
     else:
         venv = SB3VecEnvWrapper(SpawnConcatVecEnv(env_fn, n_envs, n_cpus, start_method))

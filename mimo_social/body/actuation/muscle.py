@@ -168,14 +168,14 @@ class Muscle(Actuation):
             self.fmax_pos = np.array(fmax_pos, dtype=float).reshape(n)
         self.fmax = np.stack([self.fmax_neg, self.fmax_pos])                   # (2, n)
         self._speed = self.moment / self.vmax                                  # dL / vmax per qdot
-        self._gain = -self.moment * self.fmax                                  # tau = sum(gain F)
+        self.gain = -self.moment * self.fmax                                   # tau = sum(gain F)
         self._model = None                                                     # re-widen ranges
 
     def isometric_torque(self, q, activation=1.0) -> tuple[np.ndarray, np.ndarray]:
         """Torques (negative, positive direction) of fully held joints at angles ``q`` (rad)."""
         L = self.moment * np.asarray(q, float) + self.offset
         F = force_length(L) * activation + force_passive(L)
-        t = self._gain * F
+        t = self.gain * F
         return t[0], t[1]
 
     # -- the interface ---------------------------------------------------------------------------
@@ -197,9 +197,9 @@ class Muscle(Actuation):
         ids = self.actuator_ids
         jnt = model.actuator_trnid[ids, 0]
         self._qadr = model.jnt_qposadr[jnt].astype(np.intp)
-        self._dadr = model.jnt_dofadr[jnt].astype(np.intp)
+        self.dof_adr = model.jnt_dofadr[jnt].astype(np.intp)   # the motors' dof addresses
         model.jnt_stiffness[jnt] = PASSIVE_FRACTION * self.stiffness
-        model.dof_damping[self._dadr] = PASSIVE_FRACTION * self.damping
+        model.dof_damping[self.dof_adr] = PASSIVE_FRACTION * self.damping
         peak = np.abs(self.moment * self.fmax) * (FVMAX + force_passive(LCE_MAX))
         lo, hi = -RANGE_MARGIN * peak[0], RANGE_MARGIN * peak[1]
         model.actuator_ctrlrange[ids] = np.stack([lo, hi], axis=1)
@@ -233,14 +233,14 @@ class Muscle(Actuation):
         np.take(self._qpos, self._qadr, out=self._q)    # virtual lengths and speeds
         np.multiply(self.moment, self._q, out=L)
         L += self.offset
-        np.take(self._qvel, self._dadr, out=self._qd)
+        np.take(self._qvel, self.dof_adr, out=self._qd)
         np.multiply(self._speed, self._qd, out=V)
         F = np.interp(L, _L_GRID, _FL_TABLE)             # F = FL FV a + FP
         F *= np.interp(V, _V_GRID, _FV_TABLE)
         F *= a
         F += np.interp(L, _L_GRID, _FP_TABLE)
         self.force = F
-        np.multiply(self._gain, F, out=tmp)
+        np.multiply(self.gain, F, out=tmp)
         np.add(tmp[0], tmp[1], out=self.joint_torque)
         self._ctrl[self.actuator_ids] = self.joint_torque
 

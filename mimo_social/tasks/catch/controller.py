@@ -3,13 +3,29 @@
 The infant stands with the right arm stretched forward, palm up; only the right wrist and the
 fingers move (the catch task). The controller
 
-| | |
-|---|---|
-| wrist | holds the palm tilted into a shallow cup: the palm's normal leans ``tilt[0]`` (slope, default 0.2) toward the thumb and ``tilt[1]`` (0.05) toward the wrist, so a ball landing in it rolls against the thumb and the base of the fingers instead of off the little finger's side (solved once per reset by damped least squares on a scratch copy of the state). PD control per joint toward those angles, gains from the joint's own inertia plus a ball of ``ball_mass`` kg 5 cm away (natural frequency ``frequency`` 6 Hz, damping ratio ``damping`` 1), plus gravity / passive-spring compensation read from MuJoCo (``qfrc_bias``, ``qfrc_spring``) |
-| fingers | before the ball touches the hand: PD toward a loose cup (``cup``: mcp, pip, dip degrees, default 20, 20, 10; spread and the little finger's cup at their start angles); from the first step the ball touches the hand on: a constant flexing command ``grip`` (0.3 of full activation, or of the motor's strength with spring-damper motors) on every mcp, pip and dip joint |
-| controls | muscles: the agonist's activation giving the wanted torque at the current length on top of the passive muscle forces (isometric curve, clipped to [0, 1], antagonist off): :func:`torque_controls`; spring-damper motors: ``u = tau / T_max`` clipped to [-1, 1] |
-| reads | the joint state, MuJoCo's bias forces, and whether the ball touches the hand (the contacts); it writes nothing but the agent's action |
-| state | ``touched`` (bool: the ball has touched the hand this episode), ``target_angles`` (rad, per motor) |
+wrist:
+    holds the palm tilted into a shallow cup: the palm's normal leans ``tilt[0]`` (slope, default
+    0.2) toward the thumb and ``tilt[1]`` (0.05) toward the wrist, so a ball landing in it rolls
+    against the thumb and the base of the fingers instead of off the little finger's side (solved
+    once per reset by damped least squares on a scratch copy of the state). PD control per joint
+    toward those angles, gains from the joint's own inertia plus a ball of ``ball_mass`` kg 5 cm
+    away (natural frequency ``frequency`` 6 Hz, damping ratio ``damping`` 1), plus gravity /
+    passive-spring compensation read from MuJoCo (``qfrc_bias``, ``qfrc_spring``)
+fingers:
+    before the ball touches the hand: PD toward a loose cup (``cup``: mcp, pip, dip degrees, default
+    20, 20, 10; spread and the little finger's cup at their start angles); from the first step the
+    ball touches the hand on: a constant flexing command ``grip`` (0.3 of full activation, or of the
+    motor's strength with spring-damper motors) on every mcp, pip and dip joint
+controls:
+    muscles: the agonist's activation giving the wanted torque at the current length on top of the
+    passive muscle forces (isometric curve, clipped to [0, 1], antagonist off):
+    :func:`torque_controls`; spring-damper motors: ``u = tau / T_max`` clipped to [-1, 1]
+reads:
+    the joint state, MuJoCo's bias forces, and whether the ball touches the hand (the contacts); it
+    writes nothing but the agent's action
+state:
+    ``touched`` (bool: the ball has touched the hand this episode), ``target_angles`` (rad, per
+    motor)
 
 It needs the right wrist's 3 joints and the fingers' joints in the agent's action (the catch
 task's action). Measured success rate: the catch tests (``tests/tasks/test_catch.py``).

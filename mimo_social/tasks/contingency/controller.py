@@ -1,12 +1,32 @@
 """``ContingencyDetectorController``: the scripted infant of the contingency paradigm.
 
-| | |
-|---|---|
-| reads | each step, from the world: its own face and the other agent's (``env.world.expression_of``); nothing else |
-| estimates | Watson's contingency of the other's smiles on its own: ``p_after``, the share of its own smiles followed by the other's smile onset within ``window_s`` (1.5 s), minus ``p_base``, the share of its quiet windows (``window_s`` long, no smile onset of its own in them nor in the ``window_s`` before) in which the other begins to smile; with prior counts (1 of 2 smiles answered, 1 of 4 windows hit: an estimate of 0.25 at the start) |
-| acts | smiles through its own ``expression`` action (motors, if any, at rest). From a neutral face it begins to smile at a rate (per second) of ``base_rate`` (1.5) x exp(``gain`` (5) x (estimate - ``expected`` (0.25))), kept within 0.05-10. A smile lasts while it waits for an answer (up to ``bid_s``, 0.8 s) and, once answered, as long as the other smiles; then a neutral pause drawn from ``pause_s`` (0.05-1 s) and, after an answered smile while its estimate is at least ``expected``, a new smile at once (a run of smiles, each answered anew); but with probability ``probe`` (0.3) it stays neutral for a whole window instead (a test: does the other smile anyway?). Unanswered smiles and smiles that come regardless of its own lower its estimate and its smiling |
-| why the pause and the probes | a replay of a live session is as rhythmic as the live answers; a learner that renewed its smile at a fixed moment would lock onto the replayed rhythm and see it as contingent. Random pauses move its smiles out of the recorded phase, and quiet probe windows measure how often the other smiles unprompted (never, when live) |
-| expected pattern | more smiling (share of the steps), a higher contingency index and more shared smiling in live than in replay and non-contingent (`contingency_v0`'s table, `condition_summary`) |
+reads:
+    each step, from the world: its own face and the other agent's (``env.world.expression_of``);
+    nothing else
+estimates:
+    Watson's contingency of the other's smiles on its own: ``p_after``, the share of its own smiles
+    followed by the other's smile onset within ``window_s`` (1.5 s), minus ``p_base``, the share of
+    its quiet windows (``window_s`` long, no smile onset of its own in them nor in the ``window_s``
+    before) in which the other begins to smile; with prior counts (1 of 2 smiles answered, 1 of 4
+    windows hit: an estimate of 0.25 at the start)
+acts:
+    smiles through its own ``expression`` action (motors, if any, at rest). From a neutral face it
+    begins to smile at a rate (per second) of ``base_rate`` (1.5) x exp(``gain`` (5) x (estimate -
+    ``expected`` (0.25))), kept within 0.05-10. A smile lasts while it waits for an answer (up to
+    ``bid_s``, 0.8 s) and, once answered, as long as the other smiles; then a neutral pause drawn
+    from ``pause_s`` (0.05-1 s) and, after an answered smile while its estimate is at least
+    ``expected``, a new smile at once (a run of smiles, each answered anew); but with probability
+    ``probe`` (0.3) it stays neutral for a whole window instead (a test: does the other smile
+    anyway?). Unanswered smiles and smiles that come regardless of its own lower its estimate and
+    its smiling
+why the pause and the probes:
+    a replay of a live session is as rhythmic as the live answers; a learner that renewed its smile
+    at a fixed moment would lock onto the replayed rhythm and see it as contingent. Random pauses
+    move its smiles out of the recorded phase, and quiet probe windows measure how often the other
+    smiles unprompted (never, when live)
+expected pattern:
+    more smiling (share of the steps), a higher contingency index and more shared smiling in live
+    than in replay and non-contingent (`contingency_v0`'s table, `condition_summary`)
 
 It writes no state; its randomness (when a bout begins) comes from the generator given at reset.
 """

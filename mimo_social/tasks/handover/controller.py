@@ -4,13 +4,36 @@ The receiver stands facing the giver, who holds a ball out on its upturned right
 controller holds its own right hand out, open and palm up, next to the giver's hand (the
 request gesture of give-and-take games), lets the ball roll into it and closes the fingers on it:
 
-| | |
-|---|---|
-| reads | the ball's position (the prop body ``prop``) at reset and at each phase change, the right arm's joints, MuJoCo's bias and spring forces on them, and the ball's contacts (whether it touches the own right hand, whether another agent's hand still touches it); it writes nothing but the agent's action |
-| posture | the *cup*: the palm centre ``offset`` (forward, left, up; m, in the receiver's heading frame) from the ball (default 1 cm ahead, 5.5 cm to the right, 4.7 cm lower: beside the giver's palm, on its little-finger side), the palm facing up and leaning ``lean`` (slopes toward the wrist and toward the thumb) so a ball that rolls in settles against the palm's heel and the thumb; fingers pointing straight ahead, slightly curled (``cup_deg``: mcp, pip, dip), the thumb at rest; solved by damped least squares over shoulder, elbow and wrist (palm position and hand orientation together) on a scratch copy of the state |
-| phases | ``reach``: PD toward the cup posture via a point ``below`` (m) lower and 3 cm further out (so the hand comes up beside the giver's, not through it), then the cup itself; ``cup``: hold the cup; ``close`` (once the ball has touched the own hand for ``close_after`` s): the fingers' and thumb's flexors get the constant command ``grip`` (a gentle grip, of the motor's strength or of full activation), the arm holds; ``hold`` (once no other hand has touched the ball for ``settle`` s): the hand draws back ``draw_back`` (m) toward the body and keeps the grip |
-| arm | PD control per joint toward the phase's target angles, gains from each joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency``, damping ratio ``damping``) plus the bias-force and passive-spring compensation read from MuJoCo (``qfrc_bias``, ``qfrc_spring``); torques become controls as in :func:`~mimo_social.partners.base.torque_controls` (spring-damper motors ``u = tau / T_max``; muscles: the agonist's activation on the isometric curve) |
-| state | ``phase`` (str), ``residual`` (m: the IK's remaining palm distance at the cup), ``target_angles`` (rad, per motor) |
+reads:
+    the ball's position (the prop body ``prop``) at reset and at each phase change, the right arm's
+    joints, MuJoCo's bias and spring forces on them, and the ball's contacts (whether it touches the
+    own right hand, whether another agent's hand still touches it); it writes nothing but the
+    agent's action
+posture:
+    the *cup*: the palm centre ``offset`` (forward, left, up; m, in the receiver's heading frame)
+    from the ball (default 1 cm ahead, 5.5 cm to the right, 4.7 cm lower: beside the giver's palm,
+    on its little-finger side), the palm facing up and leaning ``lean`` (slopes toward the wrist and
+    toward the thumb) so a ball that rolls in settles against the palm's heel and the thumb; fingers
+    pointing straight ahead, slightly curled (``cup_deg``: mcp, pip, dip), the thumb at rest; solved
+    by damped least squares over shoulder, elbow and wrist (palm position and hand orientation
+    together) on a scratch copy of the state
+phases:
+    ``reach``: PD toward the cup posture via a point ``below`` (m) lower and 3 cm further out (so
+    the hand comes up beside the giver's, not through it), then the cup itself; ``cup``: hold the
+    cup; ``close`` (once the ball has touched the own hand for ``close_after`` s): the fingers' and
+    thumb's flexors get the constant command ``grip`` (a gentle grip, of the motor's strength or of
+    full activation), the arm holds; ``hold`` (once no other hand has touched the ball for
+    ``settle`` s): the hand draws back ``draw_back`` (m) toward the body and keeps the grip
+arm:
+    PD control per joint toward the phase's target angles, gains from each joint's own inertia (the
+    diagonal of the joint-space mass matrix at reset; natural frequency ``frequency``, damping ratio
+    ``damping``) plus the bias-force and passive-spring compensation read from MuJoCo
+    (``qfrc_bias``, ``qfrc_spring``); torques become controls as in
+    :func:`~mimo_social.partners.base.torque_controls` (spring-damper motors ``u = tau / T_max``;
+    muscles: the agonist's activation on the isometric curve)
+state:
+    ``phase`` (str), ``residual`` (m: the IK's remaining palm distance at the cup),
+    ``target_angles`` (rad, per motor)
 
 It needs the right arm's motors (shoulder, elbow, wrist) and the five fingers' in its action (the
 handover task's action). Measured success: the handover table (``tasks/handover/task.py``) and

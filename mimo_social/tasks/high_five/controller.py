@@ -1,11 +1,25 @@
 """``HighFiveController``: the scripted solution of the high five (the learner's side).
 
-| | |
-|---|---|
-| reads | every ``replan_steps`` control steps, from the world: where the partner's right palm centre is (the other agent's palm site); each step: its own right arm's joint angles and speeds, and MuJoCo's bias and passive-spring forces on them |
-| target | the arm posture whose right palm centre reaches the partner's palm, pushed ``push`` (m) further along its own heading (toward the partner), the palm facing forward: :func:`~mimo_social.partners.hand_offer.offer_posture` (damped least squares on a scratch copy of the state, from the offer posture, alternating position and wrist orientation); the fingers straight, the thumb at rest |
-| arm | PD control per joint toward the target angles, gains from each joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio ``damping`` 1), plus compensation of gravity / Coriolis (``qfrc_bias``) and joint springs (``qfrc_spring``); the torques become the agent's controls (:func:`~mimo_social.partners.base.torque_controls`: spring-damper motors ``u = tau / T_max``, muscles the agonist's activation) |
-| acts | only through the agent's action (the expression, if any, neutral); it writes no state and changes no model value |
+reads:
+    every ``replan_steps`` control steps, from the world: where the partner's right palm centre is
+    (the other agent's palm site); each step: its own right arm's joint angles and speeds, and
+    MuJoCo's bias and passive-spring forces on them
+target:
+    the arm posture whose right palm centre reaches the partner's palm, pushed ``push`` (m) further
+    along its own heading (toward the partner), the palm facing forward:
+    :func:`~mimo_social.partners.hand_offer.offer_posture` (damped least squares on a scratch copy
+    of the state, from the offer posture, alternating position and wrist orientation); the fingers
+    straight, the thumb at rest
+arm:
+    PD control per joint toward the target angles, gains from each joint's own inertia (the diagonal
+    of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio
+    ``damping`` 1), plus compensation of gravity / Coriolis (``qfrc_bias``) and joint springs
+    (``qfrc_spring``); the torques become the agent's controls
+    (:func:`~mimo_social.partners.base.torque_controls`: spring-damper motors ``u = tau / T_max``,
+    muscles the agonist's activation)
+acts:
+    only through the agent's action (the expression, if any, neutral); it writes no state and
+    changes no model value
 
 The palm it aims at moves while the partner brings its hand out, so the posture is solved
 again every ``replan_steps`` steps (50 ms by default). Measured success on ``high_five_v0``'s

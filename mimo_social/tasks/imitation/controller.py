@@ -1,9 +1,15 @@
 """``ImitationController``: the scripted learner of the imitation task (an oracle baseline).
 
-| | |
-|---|---|
-| reads | from the task (duck-typed): the episode's demonstrated action (``env.task.demonstrated_action``) and whether the learner's turn has begun (``env.task.turn``): what a learner has to find out from its eyes |
-| acts | through its own arm motors only (``actuation="positional"``): holds its start pose through the demonstration, then moves its arms through the action's poses (:data:`~mimo_social.tasks.imitation.demonstrator.ACTION_POSES`, the demonstrator's own), ``move_s`` (0.3 s) each, and holds the last; it needs ``actuation="positional"``; it writes no state |
+reads:
+    from the task (duck-typed): the episode's demonstrated action (``env.task.demonstrated_action``)
+    and whether the learner's turn has begun (``env.task.turn``): what a learner has to find out
+    from its eyes
+acts:
+    through its own arm motors only (``actuation="positional"``): holds its start pose through the
+    demonstration, then moves its arms through the action's poses
+    (:data:`~mimo_social.tasks.imitation.demonstrator.ACTION_POSES`, the demonstrator's own),
+    ``move_s`` (0.3 s) each, and holds the last; it needs ``actuation="positional"``; it writes no
+    state
 
 ``ImitationController(action="clap")`` performs one fixed action whatever was demonstrated (the
 "always the same act" hack, and the way the tests make each action's outcome on purpose).

@@ -1,10 +1,24 @@
 """``Demonstrator``: the scripted caregiver of the imitation task, who shows one action.
 
-| | |
-|---|---|
-| reads | at reset and each step, from the task (duck-typed: ``env.task.demonstrated_action``, the name of the episode's action, and ``env.task.demo_steps``, the length of the demonstration phase in steps; ``env.task.step_count``) |
-| acts | through its own arm motors only (``actuation="positional"``: the controls are target angles, :func:`~mimo_social.body.actuation.positional_controls`): holds its start pose for ``lead_s``, moves its arms through the action's poses (:data:`ACTION_POSES`), ``move_s`` each (the targets interpolated linearly), holds the last ``hold_s``, moves back the same way and holds its start pose for the rest of the episode (still during the learner's turn). A demonstration phase shorter than the script compresses it in proportion |
-| poses | per action, target angles (deg) of the arm joints (:data:`ACTION_POSES`), the same for the kneeling adult and an 18-month-old, found by searches over shoulder and elbow angles (kinematics, then simulation with both bodies): `head_touch` right hand on the head; `hand_raise` right arm straight up; `clap` both arms forward, hands together in front of the chest; `push_box` two poses: the right hand lifted behind its box, then reaching forward through it (`tests/tasks/test_imitation.py` checks that each produces its outcome alone, for both bodies) |
+reads:
+    at reset and each step, from the task (duck-typed: ``env.task.demonstrated_action``, the name of
+    the episode's action, and ``env.task.demo_steps``, the length of the demonstration phase in
+    steps; ``env.task.step_count``)
+acts:
+    through its own arm motors only (``actuation="positional"``: the controls are target angles,
+    :func:`~mimo_social.body.actuation.positional_controls`): holds its start pose for ``lead_s``,
+    moves its arms through the action's poses (:data:`ACTION_POSES`), ``move_s`` each (the targets
+    interpolated linearly), holds the last ``hold_s``, moves back the same way and holds its start
+    pose for the rest of the episode (still during the learner's turn). A demonstration phase
+    shorter than the script compresses it in proportion
+poses:
+    per action, target angles (deg) of the arm joints (:data:`ACTION_POSES`), the same for the
+    kneeling adult and an 18-month-old, found by searches over shoulder and elbow angles
+    (kinematics, then simulation with both bodies): `head_touch` right hand on the head;
+    `hand_raise` right arm straight up; `clap` both arms forward, hands together in front of the
+    chest; `push_box` two poses: the right hand lifted behind its box, then reaching forward through
+    it (`tests/tasks/test_imitation.py` checks that each produces its outcome alone, for both
+    bodies)
 
 The same poses are what the scripted learner
 (:class:`~mimo_social.tasks.imitation.controller.ImitationController`) reproduces.

@@ -1,11 +1,21 @@
 """``GazeFollowController``: the scripted solution of joint attention (a perfect gaze reader).
 
-| | |
-|---|---|
-| reads | each step, from the world: the partner's eye cameras (where its two eyes are and point: the same gaze ray the task uses, from between its eyes along the mean of their viewing axes) and the toys' positions (``env.task.toy_bodies``); with ``read="head"`` (a hack, not a solution) the partner's head direction instead of its eyes |
-| target | the toy nearest the partner's gaze ray, once the ray passes within ``max_angle_deg`` (10) of its centre (the toys are at least 25 degrees apart); kept while the partner's gaze is between toys. ``read="head"``: the toy nearest the partner's head's facing direction, once the head has turned ``min_head_deg`` (5) from facing the follower |
-| head and eyes | :class:`~mimo_social.partners.gaze.GazeAtTarget`'s PD law drives the follower's own head and eye motors to the angles that look at the target (head turned fully, the eyes correcting) |
-| acts | only through the agent's 9 head and eye motors; it writes no state and changes no model value; a zero action until the partner's gaze first lands near a toy |
+reads:
+    each step, from the world: the partner's eye cameras (where its two eyes are and point: the same
+    gaze ray the task uses, from between its eyes along the mean of their viewing axes) and the
+    toys' positions (``env.task.toy_bodies``); with ``read="head"`` (a hack, not a solution) the
+    partner's head direction instead of its eyes
+target:
+    the toy nearest the partner's gaze ray, once the ray passes within ``max_angle_deg`` (10) of its
+    centre (the toys are at least 25 degrees apart); kept while the partner's gaze is between toys.
+    ``read="head"``: the toy nearest the partner's head's facing direction, once the head has turned
+    ``min_head_deg`` (5) from facing the follower
+head and eyes:
+    :class:`~mimo_social.partners.gaze.GazeAtTarget`'s PD law drives the follower's own head and eye
+    motors to the angles that look at the target (head turned fully, the eyes correcting)
+acts:
+    only through the agent's 9 head and eye motors; it writes no state and changes no model value; a
+    zero action until the partner's gaze first lands near a toy
 
 Measured on ``joint_attention_v0.scripted_env()`` (seeds 1000-1019): see the task's table and
 ``docs/social/joint_attention.md``.

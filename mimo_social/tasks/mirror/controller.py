@@ -1,10 +1,15 @@
 """``MirrorController``: the scripted solution of the mirror task (an oracle baseline).
 
-| | |
-|---|---|
-| reads | each step, from the world: the face the other agent shows now (``env.world.expression_of``; duck-typed, any env whose world tells the faces) |
-| acts | shows that face through its own ``expression`` action; its motors (if any) at rest; it writes no state |
-| timing | it reads the partner's face before the partner acts on the same step, so it copies with a lag of one control step: it misses one step per change of the partner's face (about 99 % of the steps matched with the default ``ExpressionShow``, a new face every 1-2 s) |
+reads:
+    each step, from the world: the face the other agent shows now (``env.world.expression_of``;
+    duck-typed, any env whose world tells the faces)
+acts:
+    shows that face through its own ``expression`` action; its motors (if any) at rest; it writes no
+    state
+timing:
+    it reads the partner's face before the partner acts on the same step, so it copies with a lag of
+    one control step: it misses one step per change of the partner's face (about 99 % of the steps
+    matched with the default ``ExpressionShow``, a new face every 1-2 s)
 
 ``MirrorController(face=...)`` with a fixed ``face`` (a name of
 :data:`~mimo_social.expressions.faces.EXPRESSIONS` or an id) is the "always the same face" hack

@@ -1,11 +1,23 @@
 """``ReachController``: the scripted solution of the reach task (an oracle baseline).
 
-| | |
-|---|---|
-| reads | at reset, from the world: where the ball is (the prop body ``ball``), the right shoulder, the right arm's joints; each step: the arm's joint angles and speeds, and MuJoCo's passive and bias forces on them |
-| target | the arm posture whose right fingertips lie ``depth`` inside the ball on the line from the shoulder to the ball's centre, the fingers straight: damped least squares over shoulder, elbow and wrist, once per reset, on a scratch copy of the state, from the middle of the joint ranges (the hand leads: the arm stretches toward the ball) |
-| arm | PD control per joint toward the target angles, gains from each joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency``, damping ratio ``damping``), plus compensation of MuJoCo's bias forces (``qfrc_bias``) and joint springs (``qfrc_spring``); the torque becomes the agent's controls: spring-damper motors ``u = tau / T_max`` clipped to [-1, 1]; muscles: the agonist's activation giving ``tau`` at the current length on top of the passive muscle forces (isometric curve, clipped to [0, 1], antagonist off) |
-| acts | only through the agent's action; it writes no state and changes no model value |
+reads:
+    at reset, from the world: where the ball is (the prop body ``ball``), the right shoulder, the
+    right arm's joints; each step: the arm's joint angles and speeds, and MuJoCo's passive and bias
+    forces on them
+target:
+    the arm posture whose right fingertips lie ``depth`` inside the ball on the line from the
+    shoulder to the ball's centre, the fingers straight: damped least squares over shoulder, elbow
+    and wrist, once per reset, on a scratch copy of the state, from the middle of the joint ranges
+    (the hand leads: the arm stretches toward the ball)
+arm:
+    PD control per joint toward the target angles, gains from each joint's own inertia (the diagonal
+    of the joint-space mass matrix at reset; natural frequency ``frequency``, damping ratio
+    ``damping``), plus compensation of MuJoCo's bias forces (``qfrc_bias``) and joint springs
+    (``qfrc_spring``); the torque becomes the agent's controls: spring-damper motors ``u = tau /
+    T_max`` clipped to [-1, 1]; muscles: the agonist's activation giving ``tau`` at the current
+    length on top of the passive muscle forces (isometric curve, clipped to [0, 1], antagonist off)
+acts:
+    only through the agent's action; it writes no state and changes no model value
 
 Measured success on ``reach_v0`` (tests/tasks/test_reach.py): see the task's table.
 """

@@ -1,12 +1,31 @@
 """``SelfBodyController``: the scripted solution of the self-body task (touch a named primitive).
 
-| | |
-|---|---|
-| reads | the target primitive (``env.task.target``: a geom name of the agent, e.g. ``"left_shin"``; or ``target=`` given to the controller) and the world's state at reset |
-| plan | once per reset, on scratch copies of the state: waypoints by damped least squares over the right arm's joints (:func:`touch_posture`): the arm raised to the side (:data:`RAISE_DEG`, clear of the crossed legs), the palm `lift` (12 cm) above the target, the hand's nearest point `approach` (4 cm) from it, then `depth` (1 cm) inside the target primitive (`mj_geomDistance` between every hand geom and the target), every right-arm geom pushed out of the other primitives; each plan of :data:`VARIANTS` (other lifts and raises, the touching posture alone, plans backwards from touching postures found from seeded random starts, with other paces) is run with this controller's own PD law on a scratch copy of the world (`mj_step`, the motors' torques) and the first that touches within `good_steps` (else the fastest) is kept; the waypoint advances when every joint is within `tolerance` (0.1 rad) or after `hold_steps` (80) steps |
-| arm | PD control per joint toward the planned angles, gains from the joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio ``damping`` 1), plus gravity / Coriolis and passive-spring compensation (``qfrc_bias``, ``qfrc_spring``); the torque becomes the controls ``u = tau / T_max`` (clipped to [-1, 1]) |
-| fingers | held straight by the same PD (the mitten's finger joint) |
-| state | ``target_angles`` (rad, per motor: the current waypoint), ``waypoints``, ``variant`` (the plan kept), ``planned_steps`` (steps to the touch on the scratch world; inf: no plan touched, and the first is run), ``plan_distance`` (m: the planned hand-target signed distance; negative = pressing in) |
+reads:
+    the target primitive (``env.task.target``: a geom name of the agent, e.g. ``"left_shin"``; or
+    ``target=`` given to the controller) and the world's state at reset
+plan:
+    once per reset, on scratch copies of the state: waypoints by damped least squares over the right
+    arm's joints (:func:`touch_posture`): the arm raised to the side (:data:`RAISE_DEG`, clear of
+    the crossed legs), the palm `lift` (12 cm) above the target, the hand's nearest point `approach`
+    (4 cm) from it, then `depth` (1 cm) inside the target primitive (`mj_geomDistance` between every
+    hand geom and the target), every right-arm geom pushed out of the other primitives; each plan of
+    :data:`VARIANTS` (other lifts and raises, the touching posture alone, plans backwards from
+    touching postures found from seeded random starts, with other paces) is run with this
+    controller's own PD law on a scratch copy of the world (`mj_step`, the motors' torques) and the
+    first that touches within `good_steps` (else the fastest) is kept; the waypoint advances when
+    every joint is within `tolerance` (0.1 rad) or after `hold_steps` (80) steps
+arm:
+    PD control per joint toward the planned angles, gains from the joint's own inertia (the diagonal
+    of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio
+    ``damping`` 1), plus gravity / Coriolis and passive-spring compensation (``qfrc_bias``,
+    ``qfrc_spring``); the torque becomes the controls ``u = tau / T_max`` (clipped to [-1, 1])
+fingers:
+    held straight by the same PD (the mitten's finger joint)
+state:
+    ``target_angles`` (rad, per motor: the current waypoint), ``waypoints``, ``variant`` (the plan
+    kept), ``planned_steps`` (steps to the touch on the scratch world; inf: no plan touched, and the
+    first is run), ``plan_distance`` (m: the planned hand-target signed distance; negative =
+    pressing in)
 
 It acts only through the agent's own motors (no ``qpos`` writes) and reads what it needs from the
 world (it imports no task). Measured (seeds 0-19, random targets): 20 of 20 episodes, mean return

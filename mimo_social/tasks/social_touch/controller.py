@@ -1,13 +1,31 @@
 """``SocialTouchController``: the scripted toucher of the social touch task (touch a named part of
 the partner with the palm, touching nothing else first), and two hack policies that game it.
 
-| | |
-|---|---|
-| reads | the target part (``env.task.target``: a body part name of the partner, e.g. ``"left_hand"``; or ``target=`` given to the controller) and the world's state at reset |
-| plan | once per reset, on scratch copies of the state: postures by damped least squares over the right arm's shoulder, elbow and wrist (:func:`hand_posture`, the fingers straight): the palm's face ``standoff`` (5 cm) off the target's nearest surface and facing it, then ``depth`` (1 cm) into it; every geom of the arm kept ``clearance`` (1.5 cm) from the partner's other parts (the forearm and upper arm from the target too) and from the toucher's own body; each plan of :data:`VARIANTS` (the arm first raised ``lift`` above the target or not, other stand-offs, IK from seeded random starts) is run with this controller's own PD law on a scratch copy of the world (``mj_step``, the motors' torques) and the first whose first contact with the partner is the palm side of the hand on the target within ``good_steps`` is kept (else the fastest that does; else the first) |
-| arm | PD control per joint toward the current waypoint, gains from each joint's own inertia (the diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping ratio ``damping`` 1), plus gravity / Coriolis and passive-spring compensation (``qfrc_bias``, ``qfrc_spring``); ``u = tau / T_max`` clipped to [-1, 1]; the waypoint advances when every joint is within ``tolerance`` (0.1 rad) or after ``hold_steps`` (60) |
-| fingers | held straight by the same PD |
-| state | ``target_part``, ``waypoints``, ``variant`` (the plan kept), ``planned_steps`` (steps to the touch on the scratch world; inf: no plan touched the target first) |
+reads:
+    the target part (``env.task.target``: a body part name of the partner, e.g. ``"left_hand"``; or
+    ``target=`` given to the controller) and the world's state at reset
+plan:
+    once per reset, on scratch copies of the state: postures by damped least squares over the right
+    arm's shoulder, elbow and wrist (:func:`hand_posture`, the fingers straight): the palm's face
+    ``standoff`` (5 cm) off the target's nearest surface and facing it, then ``depth`` (1 cm) into
+    it; every geom of the arm kept ``clearance`` (1.5 cm) from the partner's other parts (the
+    forearm and upper arm from the target too) and from the toucher's own body; each plan of
+    :data:`VARIANTS` (the arm first raised ``lift`` above the target or not, other stand-offs, IK
+    from seeded random starts) is run with this controller's own PD law on a scratch copy of the
+    world (``mj_step``, the motors' torques) and the first whose first contact with the partner is
+    the palm side of the hand on the target within ``good_steps`` is kept (else the fastest that
+    does; else the first)
+arm:
+    PD control per joint toward the current waypoint, gains from each joint's own inertia (the
+    diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping
+    ratio ``damping`` 1), plus gravity / Coriolis and passive-spring compensation (``qfrc_bias``,
+    ``qfrc_spring``); ``u = tau / T_max`` clipped to [-1, 1]; the waypoint advances when every joint
+    is within ``tolerance`` (0.1 rad) or after ``hold_steps`` (60)
+fingers:
+    held straight by the same PD
+state:
+    ``target_part``, ``waypoints``, ``variant`` (the plan kept), ``planned_steps`` (steps to the
+    touch on the scratch world; inf: no plan touched the target first)
 
 Hack policies (they ignore the instruction; each scores less than the controller, see
 tests/partners/test_touch_controller.py): :class:`NearestPartToucher` touches, palm first, the
@@ -19,6 +37,8 @@ world and ``env.task`` (it imports no task).
 """
 
 from __future__ import annotations
+
+from collections.abc import Mapping
 
 import mujoco
 import numpy as np
@@ -279,10 +299,11 @@ def surface_point(world, geometry: _Geometry, n: np.ndarray):
 def reach_posture(world, i: int, j: int, part: str, depth: float = 0.005,
                   clearance: float = 0.0) -> tuple[np.ndarray, float, float]:
     """A right-arm posture of agent ``i`` with its hand (finger pads) ``depth`` into agent
-    ``j``'s ``part``, the arm ``clearance`` from everything else (0: touching nothing else): :func:`hand_posture` along the
-    line to the part's nearest point and in from each of :data:`SIDES`; the best (deepest with
-    the smallest violation). Returns the angles, the hand's signed distance to the part (m) and
-    the worst clearance violation (m). The task's reachability check."""
+    ``j``'s ``part``, the arm ``clearance`` from everything else (0: touching nothing else):
+    :func:`hand_posture` along the line to the part's nearest point and in from each of
+    :data:`SIDES`; the best (deepest with the smallest violation). Returns the angles, the hand's
+    signed distance to the part (m) and the worst clearance violation (m). The task's reachability
+    check."""
     geo = _Geometry(world, i, j, part)
     best = None
     kw = {"clearance": clearance, "geometry": geo}
@@ -308,11 +329,11 @@ class SocialTouchController(Partner):
     ``target``: a body part name of the partner, or ``None`` to read the task's target at each
     reset (``env.task.target``); ``standoff`` (m): the palm's gap to the part before moving in;
     ``depth`` (m): how far into the part the hand is aimed; ``tilt_deg``: the touching
-    direction, the palm's normal tipped this far towards the fingertips (the finger pads); ``lift`` (m): where variants raise
-    the palm above the part first; ``frequency`` (Hz) and ``damping`` (ratio): the PD loop;
-    ``tolerance`` (rad) and ``hold_steps``: when a waypoint gives way to the next; ``variants``:
-    the plans tried at reset (default :data:`VARIANTS`); ``good_steps``: the first plan that
-    touches the target first within this many steps on the scratch world is kept.
+    direction, the palm's normal tipped this far towards the fingertips (the finger pads); ``lift``
+    (m): where variants raise the palm above the part first; ``frequency`` (Hz) and ``damping``
+    (ratio): the PD loop; ``tolerance`` (rad) and ``hold_steps``: when a waypoint gives way to the
+    next; ``variants``: the plans tried at reset (default :data:`VARIANTS`); ``good_steps``: the
+    first plan that touches the target first within this many steps on the scratch world is kept.
     """
 
     who = "SocialTouchController"
@@ -340,7 +361,9 @@ class SocialTouchController(Partner):
         return f"{type(self).__name__}(target={self.target!r})"
 
     # -- set-up shared with the hacks ------------------------------------------------------------
-    def _bind(self, env, agent):
+    def bind(self, env, agent):
+        """Take ``agent`` of ``env`` as the toucher: its right arm's motors, joint ranges and PD
+        gains, the partner; checks that the env is a dyad and the actuation is not muscles."""
         w = env.world
         m, d = w.model, w.data
         i = agent_index(env, agent)
@@ -381,7 +404,7 @@ class SocialTouchController(Partner):
 
     def reset(self, env, agent, rng):
         super().reset(env, agent, rng)
-        self._bind(env, agent)
+        self.bind(env, agent)
         self.target_part = self._part(env)
         w = env.world
         self._geo = _Geometry(w, self._i, self._j, self.target_part)
@@ -399,19 +422,34 @@ class SocialTouchController(Partner):
                 break
         if best is None:
             raise ValueError(f"{self.who}: no plan for {self.target_part!r}")
-        self.planned_steps, self.waypoints, self.variant = best
+        self.planned_steps, _, self.variant = best
+        self.follow(best[1])
+
+    def follow(self, waypoints: list[np.ndarray]) -> None:
+        """Drive the arm through ``waypoints`` (motor angles, rad) from the first one on."""
+        self.waypoints = waypoints
         self._wp, self._in_wp = 0, 0
         self.target_angles = self.waypoints[0]
+
+    def posture(self, angles_deg: Mapping[str, float]) -> np.ndarray:
+        """Motor angles (rad): each joint at 0 (clipped to its range), but those named in
+        ``angles_deg`` (joint name -> degrees), clipped to the joints' ranges."""
+        names = list(self._a.actuated_names)
+        q = np.clip(np.zeros(len(names)), self._lo, self._hi)
+        for name, deg in angles_deg.items():
+            q[names.index(name)] = np.deg2rad(deg)
+        return np.clip(q, self._lo, self._hi)
 
     def _plan(self, w, lift: float | None = None, standoff: float | None = None,
               seed: int | None = None, side: str | None = None,
               raise_arm: bool = False, tilt_deg: float | None = None) -> list[np.ndarray]:
         """Waypoints: (the hand ``lift`` above its stand-off,) the hand ``standoff`` off the
         part facing it, then 40 % of that, then ``depth`` into it, moving in along one line.
-        ``tilt_deg``: another touching direction. ``raise_arm``: first the arm raised to the side (:data:`RAISE_DEG`). ``side`` (a key of :data:`SIDES`): come in along that side's normal to the point of the
-        part's surface hit by a ray from that side through its centre; else along the line
-        between the hand and the part's nearest point; the IK starts from the current posture
-        or from a seeded random one."""
+        ``tilt_deg``: another touching direction. ``raise_arm``: first the arm raised to the side
+        (:data:`RAISE_DEG`). ``side`` (a key of :data:`SIDES`): come in along that side's normal to
+        the point of the part's surface hit by a ray from that side through its centre; else along
+        the line between the hand and the part's nearest point; the IK starts from the current
+        posture or from a seeded random one."""
         standoff = self.standoff if standoff is None else standoff
         start = None
         if seed is not None:
@@ -525,18 +563,10 @@ class ArmSweep(Partner):
         super().reset(env, agent, rng)
         helper = SocialTouchController(frequency=self.frequency, hold_steps=self.hold_steps)
         helper.who = "ArmSweep"
-        helper._bind(env, agent)
-        names = list(helper._a.actuated_names)
-        q0 = np.clip(np.zeros(len(names)), helper._lo, helper._hi)
-        waypoints = []
-        for h, ab, el in self.PATH:
-            q = q0.copy()
-            for n, deg in (("right_shoulder_horizontal", h), ("right_shoulder_abduction", ab),
-                           ("right_elbow", el)):
-                q[names.index(n)] = np.deg2rad(deg)
-            waypoints.append(np.clip(q, helper._lo, helper._hi))
-        helper.waypoints, helper.target_angles = waypoints, waypoints[0]
-        helper._wp = helper._in_wp = 0
+        helper.bind(env, agent)
+        helper.follow([helper.posture({"right_shoulder_horizontal": h,
+                                       "right_shoulder_abduction": ab, "right_elbow": el})
+                       for h, ab, el in self.PATH])
         self._helper = helper
 
     def act(self, env, agent, observation):

@@ -1,11 +1,22 @@
 """``StandupController``: a scripted solution of the standup task (pull to stand on the crib rail).
 
-| | |
-|---|---|
-| push and pull | the feet and hands are welded, so the body rises by pushing them: each foot pushes on the floor with ``foot_force`` (N, world frame; default 60 N down) and each hand pulls on the rail with ``hand_force`` (default 10 N down and 10 N back toward the body); the joint torques are ``J^T F`` over the agent's motors (``J``: the foot's or hand's Jacobian, read from MuJoCo at every step) |
-| posture | plus a compliant PD per joint toward a *standing posture* (:data:`STAND_DEG`: trunk, hips, knees and ankles straight; the other joints keep their start angle), gains ``stiffness`` (0.3) times those of a ``frequency`` (3 Hz) loop from the joint's own inertia (the diagonal of the joint-space mass matrix at reset), critically damped, plus gravity / Coriolis and passive-spring compensation (``qfrc_bias``, ``qfrc_spring``) |
-| controls | the torque becomes the agent's controls ``u = tau / T_max``, clipped to [-1, 1] |
-| acts through | the agent's own motors only (no state writes, no model edits); it reads the state (joint angles, velocities, Jacobians) |
+push and pull:
+    the feet and hands are welded, so the body rises by pushing them: each foot pushes on the floor
+    with ``foot_force`` (N, world frame; default 60 N down) and each hand pulls on the rail with
+    ``hand_force`` (default 10 N down and 10 N back toward the body); the joint torques are ``J^T
+    F`` over the agent's motors (``J``: the foot's or hand's Jacobian, read from MuJoCo at every
+    step)
+posture:
+    plus a compliant PD per joint toward a *standing posture* (:data:`STAND_DEG`: trunk, hips, knees
+    and ankles straight; the other joints keep their start angle), gains ``stiffness`` (0.3) times
+    those of a ``frequency`` (3 Hz) loop from the joint's own inertia (the diagonal of the
+    joint-space mass matrix at reset), critically damped, plus gravity / Coriolis and passive-spring
+    compensation (``qfrc_bias``, ``qfrc_spring``)
+controls:
+    the torque becomes the agent's controls ``u = tau / T_max``, clipped to [-1, 1]
+acts through:
+    the agent's own motors only (no state writes, no model edits); it reads the state (joint angles,
+    velocities, Jacobians)
 
 Spring-damper motors only (the standup task's actuation); both hand versions. Measured
 (``python tests/tasks/test_standup.py 20``): 20/20 seeded episodes succeed (the head 22.8 cm up

@@ -1,12 +1,30 @@
 """``StillFaceInfantController``: the scripted infant of the still-face paradigm (a baseline).
 
-| | |
-|---|---|
-| reads | the phase of the coming step from the task (``env.task.phase_at(env.steps)``: a scripted controller may read the env's state; a learner sees only the caregiver's face and movements), the caregiver's face centre (its ``head_centre`` site) and its own body (at reset) |
-| interaction and reunion | smiles (``engaged_face``, "happy"), renewing its smile every ``bid_every_s`` (1 s) of these phases with one step of a neutral face (a new smile onset: a bid that a contingent caregiver answers; ``ContingentCaregiver`` smiles back for ``duration_s`` (1 s) after ``delay_s`` (0.5 s) per onset, so a smile held without renewal is answered once), and looks at the caregiver's face: :class:`~mimo_social.partners.gaze.GazeAtTarget`'s PD law on its own head and eye motors (head turned fully toward the face, the eyes correcting); its arms held by a PD at the angles they had at reset |
-| still face | a neutral face (``still_face``), looks away at its own right hand, and with ``self_touch`` (on) brings both hands to its chest, pressed together (self-comforting, Tronick et al. 1978): PD on its shoulder and elbow motors toward angles found at reset by damped least squares (both palm centres to a point 1.2 chest radii in front of the upper body's centre, i.e. inside the chest, so the hands press on it and on each other) |
-| arm PD | per joint, gains from its own inertia (``pd_gains``: natural frequency ``arm_frequency`` 3 Hz, damping ratio 1), plus gravity / Coriolis and passive-spring compensation; torque over the joint's limit gives the control |
-| acts | only through its own motors (head, eyes, shoulders, elbows) and its face; it writes no state. It needs the spring-damper actuation and the task's free arms (``arms_free``) for the self-touch |
+reads:
+    the phase of the coming step from the task (``env.task.phase_at(env.steps)``: a scripted
+    controller may read the env's state; a learner sees only the caregiver's face and movements),
+    the caregiver's face centre (its ``head_centre`` site) and its own body (at reset)
+interaction and reunion:
+    smiles (``engaged_face``, "happy"), renewing its smile every ``bid_every_s`` (1 s) of these
+    phases with one step of a neutral face (a new smile onset: a bid that a contingent caregiver
+    answers; ``ContingentCaregiver`` smiles back for ``duration_s`` (1 s) after ``delay_s`` (0.5 s)
+    per onset, so a smile held without renewal is answered once), and looks at the caregiver's face:
+    :class:`~mimo_social.partners.gaze.GazeAtTarget`'s PD law on its own head and eye motors (head
+    turned fully toward the face, the eyes correcting); its arms held by a PD at the angles they had
+    at reset
+still face:
+    a neutral face (``still_face``), looks away at its own right hand, and with ``self_touch`` (on)
+    brings both hands to its chest, pressed together (self-comforting, Tronick et al. 1978): PD on
+    its shoulder and elbow motors toward angles found at reset by damped least squares (both palm
+    centres to a point 1.2 chest radii in front of the upper body's centre, i.e. inside the chest,
+    so the hands press on it and on each other)
+arm PD:
+    per joint, gains from its own inertia (``pd_gains``: natural frequency ``arm_frequency`` 3 Hz,
+    damping ratio 1), plus gravity / Coriolis and passive-spring compensation; torque over the
+    joint's limit gives the control
+acts:
+    only through its own motors (head, eyes, shoulders, elbows) and its face; it writes no state. It
+    needs the spring-damper actuation and the task's free arms (``arms_free``) for the self-touch
 
 Measured on ``still_face_v0.scripted_env()``: see the task's table.
 """

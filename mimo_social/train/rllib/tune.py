@@ -36,7 +36,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..comparison import _kwargs_per_algo, _per_algo
+from ..comparison import kwargs_keyed_by_algo, value_per_algo
 from ..plots import plot_compare
 from ..tasks import TrainInputError, check_mode, check_task
 from .config import RLLIB_ALGOS, check_algo
@@ -96,11 +96,11 @@ def compare_rllib(task: str, algos=("ppo",), seeds: int = 3,
         raise TrainInputError(f"seeds={seeds}; allowed: a positive integer")
     if max_concurrent is not None and int(max_concurrent) < 1:
         raise TrainInputError(f"max_concurrent={max_concurrent}; allowed: a positive integer")
-    steps = _per_algo("steps", steps, algos, isinstance(steps, Mapping))
+    steps = value_per_algo("steps", steps, algos, isinstance(steps, Mapping))
     algo_kwargs = dict(algo_kwargs or {})
-    kwargs = _per_algo("algo_kwargs", algo_kwargs, algos,
-                       _kwargs_per_algo(algo_kwargs, RLLIB_ALGOS,
-                                        '{"ppo": {"num_epochs": 5}, "appo": {}}'))
+    kwargs = value_per_algo("algo_kwargs", algo_kwargs, algos,
+                            kwargs_keyed_by_algo(algo_kwargs, RLLIB_ALGOS,
+                                                 '{"ppo": {"num_epochs": 5}, "appo": {}}'))
     runs = {f"{a}_seed{s}": dict(task=task, algo=a, steps=steps[a], seed=s,
                                  out=str(out / f"{a}_seed{s}"), mode=mode,
                                  algo_kwargs=kwargs[a], progress=False,
