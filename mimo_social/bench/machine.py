@@ -26,7 +26,7 @@ def _gl_renderer() -> str | None:
     try:
         from ..render import eye_renderer
 
-        if eye_renderer._GL is None or eye_renderer._GL_PID != os.getpid():
+        if not eye_renderer.has_gl_context():
             return None
         eye_renderer.shared_gl_context()
         from OpenGL.GL import GL_RENDERER, GL_VERSION, glGetString

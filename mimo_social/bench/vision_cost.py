@@ -138,10 +138,10 @@ def bench_images(sizes=(64, 256), agents=(1, 2), rounds: int = 5, n_states: int 
     rgb, rgba = np.empty((256, 512, 3), np.uint8), np.empty((256, 512, 4), np.uint8)
 
     def read_rgb():
-        mujoco.mjr_readPixels(rgb, None, rect, r._con)
+        mujoco.mjr_readPixels(rgb, None, rect, r.render_context)
 
     def read_rgba():
-        r._read(0, 0, 512, 256, 0x1908, 0x1401, rgba.ctypes.data_as(ctypes.c_void_p))
+        r.read_pixels(0, 0, 512, 256, 0x1908, 0x1401, rgba.ctypes.data_as(ctypes.c_void_p))
 
     for name, fn in (("readback_rgb_mjr_readPixels", read_rgb),
                      ("readback_rgba_glReadPixels", read_rgba)):

@@ -49,8 +49,9 @@ import numpy as np
 
 from .gl import INSTALL_HINT, gl_backend, gl_context_class
 
-__all__ = ["shared_gl_context", "gl_current", "free_shared_gl_context", "TileRenderer", "Tile",
-           "tessellation_for", "coarse_planes", "free_render_context", "MAX_BUFFER_SIDE"]
+__all__ = ["shared_gl_context", "gl_current", "free_shared_gl_context", "has_gl_context",
+           "TileRenderer", "Tile", "tessellation_for", "coarse_planes", "free_render_context",
+           "MAX_BUFFER_SIDE"]
 
 MAX_BUFFER_SIDE = 4096      # tiles are packed in batches no larger than this (pixels per side)
 _GL = None                  # the process's GL context
@@ -62,6 +63,11 @@ _FORKED_FROM = None         # (parent pid, what it had made) in a child forked a
 _TLS = threading.local()    # .depth: gl_current blocks open on this thread
 _PENDING = []               # MjrContexts to free when the current render ends
 _LEFT_ON = None             # the thread shared_gl_context() left the context current on
+
+
+def has_gl_context() -> bool:
+    """Whether this process has made the shared GL context (a forked child has not)."""
+    return _GL is not None and _GL_PID == os.getpid()
 
 
 def _gl_state_in_use() -> str | None:
@@ -389,6 +395,18 @@ class TileRenderer:
         # reversed-z depth d in [0, 1] (1 at near) -> metres along the view axis: a / (d + b)
         self._depth_a = np.float32(far * near / (far - near))
         self._depth_b = np.float32(near / (far - near))
+
+    @property
+    def render_context(self):
+        """The ``mujoco.MjrContext`` the tiles are drawn with (None before the first render or
+        after :meth:`close`); for read-back measurements."""
+        return self._con
+
+    @property
+    def read_pixels(self):
+        """The raw ``glReadPixels`` function the tiles are read back with
+        (``(x, y, width, height, format, type, pointer)``); for read-back measurements."""
+        return self._read
 
     def close(self):
         free_render_context(getattr(self, "_con", None))
