@@ -18,6 +18,7 @@ import numpy as np
 
 from ..body.tables import AGE_RANGE, BODY_KINDS, HAND_VERSIONS, SCALE_RANGE, STRENGTH_RANGE
 from ..senses import SENSES
+from ..senses.delays import CHANNELS
 from ..senses.proprioception import ProprioceptionConfig
 from ..senses.touch import TouchConfig
 from ..senses.vestibular import VestibularConfig
@@ -38,8 +39,8 @@ FACING_LIMIT = 100.0   # m: how far the point an agent faces may be
 POSTURES = ("standing", "sitting", "kneeling", "lying")
 #: body kinds: the infant (its age from ``age_months``) and an adult caregiver
 BODIES = BODY_KINDS
-#: what can be delayed (``delays``): each sense and the motor command
-DELAY_CHANNELS = ("proprioception", "vestibular", "touch", "vision", "motor")
+#: what can be delayed (``delays``): each sense of the registry and the motor command
+DELAY_CHANNELS = CHANNELS
 #: the longest delay allowed per channel, milliseconds
 DELAY_LIMIT_MS = 1000.0
 

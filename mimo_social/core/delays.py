@@ -31,7 +31,6 @@ from .config import DELAY_CHANNELS
 __all__ = ["delays_ms", "delay_steps", "SenseDelay", "MotorDelay", "delay_sensors",
            "fill_sensor_history", "VESTIBULAR_SENSORS"]
 
-assert tuple(CHANNELS) == tuple(DELAY_CHANNELS), "senses.delays.CHANNELS != config.DELAY_CHANNELS"
 
 #: the agent's MuJoCo sensors of the vestibular sense (unprefixed names)
 VESTIBULAR_SENSORS = ("vestibular_gyro", "vestibular_accel")

@@ -44,7 +44,7 @@ from ..body.tables import load_body
 from ..core.config import AgentConfig
 from ..core.kinematics import LookAt
 from ..core.world import AgentSetup, World
-from ..partners.hand_offer import REACH_TO
+from ..partners.offer_target import REACH_TO
 
 __all__ = ["CLEARANCE", "ADULT_LEAN_DEG", "LAWS", "Extent", "is_standard", "tables_of",
            "held_angles", "measure", "pair_distance", "gap_distance", "facing_gaze", "DyadPlan",

@@ -81,7 +81,7 @@ def test_a_trained_run_is_a_learner_with_its_env_settings(tmp_path, capsys):
 
 
 def test_bad_library_arguments_are_refused():
-    with pytest.raises(TrainInputError, match="allowed: still_face, contingency, imitation"):
+    with pytest.raises(TrainInputError, match="allowed: contingency, still_face, imitation"):
         run_paradigm("mirror", ["zero"])
     with pytest.raises(TrainInputError, match="positive integer"):
         run_paradigm("still_face", ["zero"], episodes=0)

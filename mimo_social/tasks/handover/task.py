@@ -14,8 +14,8 @@ from ...body.tables import load_body
 from ...core.kinematics import Gaze, hand_geoms
 from ...core.task import Plot, Task, TaskOptions
 from ...core.world import AgentSetup, Prop
-from ...partners.hand_offer import (OPEN_FINGERS_DEG, HandOffer, adapts, offer_posture,
-                                   reach_target)
+from ...partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
+from ...partners.offer_target import adapts, reach_target
 
 __all__ = ["Handover", "HandoverOptions", "scripted_giver", "OFFER_TARGET", "parallel_env", "env",
            "scripted_env"]
