@@ -21,6 +21,7 @@ from __future__ import annotations
 from ...util.checks import check_number
 from ...partners.base import Partner, motor_action
 from .demonstrator import ACTION_POSES, PoseScript
+from .task import Imitation
 
 __all__ = ["ImitationController"]
 
@@ -43,7 +44,7 @@ class ImitationController(Partner):
     def reset(self, env, agent, rng):
         super().reset(env, agent, rng)
         task = env.task
-        if not hasattr(task, "demonstrated_action"):
+        if not isinstance(task, Imitation):
             raise ValueError(f"ImitationController: the task {task.name!r} demonstrates no "
                              "action; allowed: the imitation task")
         self._script = PoseScript(env, agent, "ImitationController")

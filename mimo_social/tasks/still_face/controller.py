@@ -39,6 +39,7 @@ from ...expressions.faces import EXPRESSIONS
 from ...util.checks import ConfigError, check_bool, check_number, show
 from ...partners.base import agent_index, pd_gains
 from ...partners.gaze import GazeAtTarget
+from .task import StillFace
 
 __all__ = ["StillFaceInfantController"]
 
@@ -88,7 +89,7 @@ class StillFaceInfantController(GazeAtTarget):
 
     def reset(self, env, agent, rng):
         who = "StillFaceInfantController"
-        if not callable(getattr(env.task, "phase_at", None)):
+        if not isinstance(env.task, StillFace):
             raise ValueError(f"{who} reads the still-face phase (task.phase_at); the task "
                              f"{env.task.name!r} has none")
         agents = list(env.possible_agents)
