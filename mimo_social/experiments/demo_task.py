@@ -54,8 +54,8 @@ class HighFiveThenHandover(Handover):
     #: what the next reset starts (one of :data:`PHASES`)
     phase = "high_five"
 
-    def _bind(self, env):
-        super()._bind(env)
+    def bind(self, env):
+        super().bind(env)
         w = env.world
         hands = [hand_geoms(w, i) for i in (RECEIVER, GIVER)]
         self._hands_meet = ContactProbe(w.model.ngeom, hands[0], hands[1])
@@ -80,8 +80,6 @@ class HighFiveThenHandover(Handover):
         if self.phase == "handover":
             super().reset(env, rng)
             return
-        if getattr(self, "_world", None) is not env.world:
-            self._bind(env)
         w = env.world
         d = w.data
         r = w.agents[RECEIVER]
