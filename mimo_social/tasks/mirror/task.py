@@ -89,11 +89,13 @@ class Mirror(Task):
         """Whether one of two learners leads (its face set by the task) this env."""
         return self.options.roles == "leader" and not self.options.scripted_partner
 
+    def bind(self, env):
+        """Index tables of this world (once per world: :meth:`Task.bind`)."""
+        w = env.world
+        self._gaze = [Gaze(w, i) for i in range(2)] if self.options.assisted_gaze else []
+        self._faces = [int(w.agents[i].head_site) for i in range(2)]
+
     def reset(self, env, rng):
-        if not hasattr(self, "_faces"):
-            w = env.world
-            self._gaze = [Gaze(w, i) for i in range(2)] if self.options.assisted_gaze else []
-            self._faces = [int(w.agents[i].head_site) for i in range(2)]
         self._rng = rng
         self._leader = int(rng.integers(2)) if self.leading else -1
         if self._leader >= 0:
