@@ -193,11 +193,12 @@ def resolve_agents(n_agents: int, common: Mapping[str, Any],
 class PhysicsConfig:
     timestep: float = 0.005        # s per physics step
     frame_skip: int = 2            # physics steps per control step (control at 100 Hz)
-    # dense: MuJoCo 4.0.0's Newton solver with the sparse Jacobian factors the Hessian wrongly
-    # when contacts couple branches of a body's tree (mujoco#3767, fixed in 4.0.1, not on PyPI
-    # here): fingers touching fingers, two infants touching, diverged or were silently wrong
-    # (docs/reliability.md); sparse was ~20 % faster (BENCHMARKS.md)
-    jacobian: str = "dense"
+    # sparse: MuJoCo >= 4.0.1 (4.0.0's sparse Cholesky factorization, mujoco#3767, made the
+    # Newton solver diverge when contacts coupled branches of a body tree, so "dense" was the
+    # default then): 0 divergences in 27 bang-bang runs of 10k control steps (docs/reliability.md)
+    # and the fastest physics: 0.88x dense's time for one infant, 0.59x for eight; MuJoCo Warp
+    # takes no dense Jacobian above 60 degrees of freedom
+    jacobian: str = "sparse"
     solver: str = "newton"
     cone: str = "pyramidal"
     iterations: int = 50

@@ -221,7 +221,7 @@ def test_every_age_holds_a_posture_and_plays_stably(age):
 @pytest.mark.parametrize("hands, actuation", [
     ("mitten", "spring_damper"), ("five_fingers", "spring_damper"), ("mitten", "muscle"),
     # five fingers with muscles diverged under MuJoCo 4.0.0's sparse-Jacobian bug (a big toe at
-    # step 430; mujoco#3767): the default physics is dense since (docs/reliability.md)
+    # step 430; mujoco#3767), fixed in 4.0.1, which the package requires (docs/reliability.md)
     ("five_fingers", "muscle")])
 def test_newborn_at_full_strength_survives_bang_bang_actions(hands, actuation):
     """Every motor at its lowest or highest control, redrawn each step, for the smallest body
