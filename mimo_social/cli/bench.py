@@ -1,6 +1,7 @@
 """``mimo-social bench MEASUREMENT``: the measuring commands, one module each.
 
     mimo-social bench sim          real s per simulated s by component     (cli/bench_sim.py)
+    mimo-social bench floor        the env step against bare mj_step       (cli/bench_floor.py)
     mimo-social bench vision       eye images per OpenGL backend           (cli/bench_vision.py)
     mimo-social bench recording    the Rerun recording's cost and size     (cli/bench_recording.py)
     mimo-social bench development  build time per age, delays, acuity      (cli/bench_development.py)
@@ -22,14 +23,15 @@ import argparse
 import functools
 import sys
 
-from . import bench_development, bench_engines, bench_recording, bench_sim, bench_soak
-from . import bench_vision
+from . import bench_development, bench_engines, bench_floor, bench_recording, bench_sim
+from . import bench_soak, bench_vision
 
 __all__ = ["MEASUREMENTS", "OLD_NAMES", "add_parser", "old_form"]
 
 #: measurement -> its module, in the order of the help
-MEASUREMENTS = {module.NAME: module for module in (bench_sim, bench_vision, bench_recording,
-                                                   bench_development, bench_engines, bench_soak)}
+MEASUREMENTS = {module.NAME: module for module in (bench_sim, bench_floor, bench_vision,
+                                                   bench_recording, bench_development,
+                                                   bench_engines, bench_soak)}
 #: old top-level command -> its measurement (kept for one release, not listed in the help)
 OLD_NAMES = {"bench-vision": "vision", "bench-recording": "recording",
              "bench-development": "development", "bench-engines": "engines", "soak": "soak"}

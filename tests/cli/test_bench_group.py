@@ -10,7 +10,7 @@ import pytest
 from mimo_social import cli
 from mimo_social.cli import bench
 
-NEW = ["sim", "vision", "recording", "development", "engines", "soak"]
+NEW = ["sim", "floor", "vision", "recording", "development", "engines", "soak"]
 #: old command line -> the same command under its new name (every argument has a default but
 #: engines' --out)
 OLD = {
@@ -63,7 +63,9 @@ def test_the_old_names_are_not_listed_at_the_top(capsys):
     with pytest.raises(SystemExit):
         cli.main(["--help"])
     out = capsys.readouterr().out
-    listed = [line.split()[0] for line in out.splitlines() if line.startswith("    ")]
+    # a command's line is indented 4 spaces; its help's continuation lines more
+    listed = [line.split()[0] for line in out.splitlines()
+              if line.startswith("    ") and not line.startswith("     ")]
     assert "bench" in listed and "demo" in listed
     assert not set(listed) & {*bench.OLD_NAMES, "check-viewer"}
 
@@ -107,7 +109,7 @@ def test_bench_alone_is_a_one_line_usage_error_naming_the_measurements(calls, ca
     err = capsys.readouterr().err
     assert err.startswith("usage: mimo-social bench ") and "Traceback" not in err
     last = err.strip().splitlines()[-1]
-    assert last.startswith("mimo-social bench: error: give a measurement: sim, vision, ")
+    assert last.startswith("mimo-social bench: error: give a measurement: sim, floor, vision, ")
     assert "mimo-social bench sim" in last
 
 
