@@ -189,6 +189,18 @@ def resolve_agents(n_agents: int, common: Mapping[str, Any],
     return out
 
 
+#: The physics settings that hold: beyond them a body at the largest allowed strength (3) diverged
+#: under bang-bang actions (docs/reliability.md, "Instability": every case of
+#: tests/body/test_hand_stability.py, 600 control steps, seeds 0-2, each setting at its limit
+#: alone and all at their limits together: 0 divergences; e.g. 4 Newton iterations, 16 CG
+#: iterations, a timestep of 0.0125 s or a tolerance of 1 diverged).
+TIMESTEP_MAX = 0.006                                   # s
+TOLERANCE_MAX = 1e-3
+MIN_ITERATIONS = {"newton": 10, "cg": 32, "pgs": 1}    # solver iterations per physics step
+UNSTABLE = ("outside it a body at strength 3 diverged under bang-bang actions: "
+            "docs/reliability.md, 'Instability'")
+
+
 @dataclass(frozen=True)
 class PhysicsConfig:
     timestep: float = 0.005        # s per physics step
@@ -207,14 +219,19 @@ class PhysicsConfig:
 
     def __post_init__(self):
         put = partial(object.__setattr__, self)
-        put("timestep", check_number("physics", "timestep", self.timestep, 1e-4, 0.02))
+        put("timestep", check_number("physics", "timestep", self.timestep, 1e-4, TIMESTEP_MAX,
+                                     why=UNSTABLE))
         put("frame_skip", check_int("physics", "frame_skip", self.frame_skip, 1, 100))
         for key, allowed in (("jacobian", ("dense", "sparse", "auto")),
                              ("solver", ("newton", "cg", "pgs")),
                              ("cone", ("pyramidal", "elliptic"))):
             check_choice("physics", key, getattr(self, key), allowed)
-        put("iterations", check_int("physics", "iterations", self.iterations, 1, 1000))
-        put("tolerance", check_number("physics", "tolerance", self.tolerance, 0.0, 1.0))
+        low = MIN_ITERATIONS[self.solver]
+        put("iterations", check_int("physics", "iterations", self.iterations, low, 1000,
+                                    why=f"with solver={self.solver!r}" + (
+                                        f"; {UNSTABLE}" if low > 1 else "")))
+        put("tolerance", check_number("physics", "tolerance", self.tolerance, 0.0, TOLERANCE_MAX,
+                                      why=UNSTABLE))
         put("gravity", check_numbers("physics", "gravity", self.gravity, 3, -100.0, 100.0,
                                      "(x, y, z) in m/s^2, each from -100 to 100"))
 

@@ -62,24 +62,25 @@ def _finite_real(value: Any) -> bool:
 
 
 def check_number(owner: str, name: str, value: Any, lo: float | None = None,
-                 hi: float | None = None) -> float:
+                 hi: float | None = None, why: str = "") -> float:
     """``value`` as a float if it is a finite real number (not a bool) in [lo, hi], else a
     :class:`ConfigError` naming the owner (agent, task, partner; an empty owner: the caller
-    names it), the setting and the range."""
+    names it), the setting and the range (``why``: said after the range)."""
     if not _finite_real(value) or (lo is not None and value < lo) \
             or (hi is not None and value > hi):
         raise ConfigError(f"{_who(owner)}{name}={show(value)} not allowed; allowed: "
-                          f"{_range_text(lo, hi, 'a number')}")
+                          f"{_range_text(lo, hi, 'a number')}" + (f" ({why})" if why else ""))
     return float(value)
 
 
 def check_int(owner: str, name: str, value: Any, lo: int | None = None,
-              hi: int | None = None) -> int:
-    """``value`` as an int if it is an integer (not a bool) in [lo, hi], else a ConfigError."""
+              hi: int | None = None, why: str = "") -> int:
+    """``value`` as an int if it is an integer (not a bool) in [lo, hi], else a ConfigError
+    (``why``: said after the range)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) \
             or (lo is not None and value < lo) or (hi is not None and value > hi):
         raise ConfigError(f"{_who(owner)}{name}={show(value)} not allowed; allowed: "
-                          f"{_range_text(lo, hi, 'an integer')}")
+                          f"{_range_text(lo, hi, 'an integer')}" + (f" ({why})" if why else ""))
     return int(value)
 
 

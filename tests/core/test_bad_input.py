@@ -84,7 +84,7 @@ def test_action_without_expression_when_expressions_are_on(env):
     ({"vision": {"every": 0}}, r"every=0"),
     ({"vision": {"fov": 90}}, r"infant_0: vision: unknown setting.*fov.*allowed.*width"),
     ({"touch": "yes"}, r"infant_0: touch='yes'; allowed: False, True or a mapping of.*density"),
-    ({"physics": {"timestep": 1.0}}, r"timestep.*0.0001 to 0.02"),
+    ({"physics": {"timestep": 1.0}}, r"timestep.*0.0001 to 0.006"),
     ({"physics": {"integrator": "rk4"}}, r"unknown setting.*integrator"),
     ({"physics": {"jacobian": "fast"}}, r"jacobian.*dense"),
     ({"per_agent": [{}]}, r"per_agent must be a list of 2"),
