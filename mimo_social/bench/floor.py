@@ -32,19 +32,23 @@ STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 
 @dataclass(frozen=True)
 class FloorConfig:
-    """One configuration: ``n_agents`` standing infants, the skin on or off."""
+    """One configuration: ``n_agents`` standing infants, the skin on or off, the constraint
+    Jacobian (None: the default physics)."""
 
     n_agents: int
     touch: bool
+    jacobian: str | None = None
 
     @property
     def name(self) -> str:
         return f"{self.n_agents} infant{'s' if self.n_agents > 1 else ''}" \
-               + (", touch" if self.touch else "")
+               + (", touch" if self.touch else "") \
+               + (f", {self.jacobian} Jacobian" if self.jacobian else "")
 
     def env(self):
+        physics = {"jacobian": self.jacobian} if self.jacobian else None
         return free_play_v0.parallel_env(n_agents=self.n_agents, touch=self.touch,
-                                         vision=False, max_steps=10 ** 9)
+                                         vision=False, max_steps=10 ** 9, physics=physics)
 
 
 #: the configurations of BENCHMARKS.md: 1, 2 and 8 infants, without and with touch

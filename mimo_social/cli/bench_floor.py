@@ -32,6 +32,10 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
     parser.add_argument("--agents", type=comma_choices(counts, "agent count"),
                         default=counts, help=f"the agent counts to measure (default "
                                              f"{','.join(counts)}), each without and with touch")
+    parser.add_argument("--jacobian", type=comma_choices(("default", "dense", "sparse", "auto"),
+                                                         "jacobian"), default=["default"],
+                        help="the constraint Jacobians to measure, each configuration with each "
+                             "in turn (default: the default physics'; e.g. dense,sparse)")
     parser.add_argument("--chunks", type=positive_int, default=10,
                         help="chunks per configuration; the median is shown (default 10)")
     parser.add_argument("--chunk", type=positive_int, default=100,
@@ -43,7 +47,9 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    configs = [c for c in floor.FLOOR_CONFIGS if str(c.n_agents) in args.agents]
+    configs = [floor.FloorConfig(c.n_agents, c.touch, None if j == "default" else j)
+               for c in floor.FLOOR_CONFIGS if str(c.n_agents) in args.agents
+               for j in args.jacobian]
     results = floor.measure(configs, chunks=args.chunks, chunk=args.chunk, seed=args.seed,
                             progress=True)
     print(floor.format_results(results))

@@ -35,7 +35,12 @@ def test_bench_floor_command(tmp_path, capsys):
     assert [r["config"] for r in results] == ["1 infant", "1 infant, touch"]
     assert all(r["same_trajectory"] for r in results)
     assert "env / floor" in capsys.readouterr().out
-    for bad in (["--chunks", "0"], ["--agents", "3"]):
+    assert cli.main(["bench", "floor", "--agents", "1", "--jacobian", "dense,sparse", "--chunks",
+                     "1", "--chunk", "5", "--json", str(out)]) == 0
+    assert [r["config"] for r in json.loads(out.read_text())] == [
+        "1 infant, dense Jacobian", "1 infant, sparse Jacobian", "1 infant, touch, dense Jacobian",
+        "1 infant, touch, sparse Jacobian"]
+    for bad in (["--chunks", "0"], ["--agents", "3"], ["--jacobian", "fast"]):
         with pytest.raises(SystemExit) as e:
             cli.main(["bench", "floor", *bad])
         assert e.value.code == 2
