@@ -450,7 +450,7 @@ class World:
     #: 1.0e4 rad/s^2; bang-bang actions (every motor at -1 or +1, redrawn each step) at every
     #: allowed strength and scale at most 275 rad/s and 6.6e4 rad/s^2 (a finger); five-finger hands
     #: 888 rad/s and 1.3e5 rad/s^2 (a fingertip; measured with the sparse Jacobian under MuJoCo
-    #: 4.0.0's factorization bug; with the dense default, 214 rad/s and 4.3e4 rad/s^2 at strength
+    #: 4.0.0's factorization bug; with the dense Jacobian (then the default), 214 rad/s and 4.3e4 rad/s^2 at strength
     #: 3 over 20k physics steps: docs/reliability.md). A diverging simulation grows about tenfold per
     #: physics step from there, so it passes the limits within a step or two of leaving the
     #: normal range, long before MuJoCo's own check (1e10).
