@@ -165,7 +165,7 @@ class MimoParallelEnv(ParallelEnv):
         if not self._needs_substep:
             return w.step(n)
         m, d = w.model, w.data
-        acts = [act for act in self.actuation if act.needs_substep]
+        acts = self.actuation   # a model without per-step dynamics has a no-op substep
 
         def substep():
             for act in acts:
