@@ -44,8 +44,8 @@ class EnvEntry:
     #: the scripted controller that solves the task (a Partner class made without arguments,
     #: from the task's ``controller.py``), for the one-learner env; None where the task has none
     controller: type | None = None
-    #: a paradigm's measures (its ``measures.py`` module: ``run(learner, episodes, seed,
-    #: env_kwargs)`` -> summary, ``rows(summaries)`` -> table lines, ``UNIT``); None for a task
+    #: a paradigm's measures (its ``measures.py`` module: ``run(learner, episodes, seed, env)``
+    #: -> summary, in the scripted env, ``rows(summaries)`` -> table lines, ``UNIT``); None for a task
     #: whose success and return say it all
     measures: ModuleType | None = None
 

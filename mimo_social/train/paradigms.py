@@ -197,12 +197,12 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
     measures = entry(task).measures
     results = []
     for spec in specs:
-        probe = entry(task).scripted_env(**kw)   # the learner's spaces
+        env = entry(task).scripted_env(**kw)   # the learner's spaces, and its episodes
         try:
-            learner = make_learner(task, spec, probe, model, deterministic)
+            learner = make_learner(task, spec, env, model, deterministic)
+            summ = measures.run(learner, episodes, seed, env)
         finally:
-            probe.close()
-        summ = measures.run(learner, episodes, seed, kw)
+            env.close()
         results.append({"learner": getattr(learner, "name", type(learner).__name__),
                         "spec": spec, "summary": summ})
     return {"task": task, "episodes": episodes, "seed": seed, "env_kwargs": kw,

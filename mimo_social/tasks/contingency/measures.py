@@ -61,24 +61,30 @@ def condition_summary(episodes: int = 5, seed: int = 0, controller: Any = None,
                           "allowed: e.g. ('live', 'replay', 'non_contingent')")
     learner = ContingencyDetectorController() if controller is None else controller
     env = scripted_env(**dict(env_kwargs or {}))
-    task = env.unwrapped.task
-    finals = []
     try:
-        for block in range(int(episodes)):
-            for k, cond in enumerate(conditions):
-                task.set_condition(cond)
-                [episode] = run_episodes(env, {AGENT: learner}, 1, seed + block,
-                                         policy_seeds=[[seed + block, k]])
-                finals.append(episode.last_infos[AGENT])
+        return _blocks(env, learner, episodes, seed, conditions)
     finally:
         env.close()
+
+
+def _blocks(env, learner, episodes: int, seed: int, conditions: Sequence[str]) -> dict:
+    """:func:`condition_summary` in ``env``, the scripted form (conditions checked)."""
+    task = env.unwrapped.task
+    finals = []
+    for block in range(int(episodes)):
+        for k, cond in enumerate(conditions):
+            task.set_condition(cond)
+            [episode] = run_episodes(env, {AGENT: learner}, 1, seed + block,
+                                     policy_seeds=[[seed + block, k]])
+            finals.append(episode.last_infos[AGENT])
     return summarize(finals)
 
 
-def run(learner, episodes: int, seed: int, env_kwargs: Mapping[str, Any] | None = None) -> dict:
-    """``learner`` in ``episodes`` blocks of live, replay and non-contingent episodes
-    (:func:`condition_summary`)."""
-    return condition_summary(episodes, seed, controller=learner, env_kwargs=env_kwargs)
+def run(learner, episodes: int, seed: int, env) -> dict:
+    """``learner`` in ``episodes`` blocks of live, replay and non-contingent episodes of
+    ``env`` (the scripted form, :func:`~mimo_social.tasks.contingency.task.scripted_env`, which
+    the caller made and closes), as :func:`condition_summary`."""
+    return _blocks(env, learner, episodes, seed, CONDITIONS)
 
 
 def format_summary(table: Mapping[str, Mapping[str, tuple[float, float]]]) -> str:

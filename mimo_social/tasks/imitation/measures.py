@@ -8,12 +8,12 @@ entry's ``measures``); :func:`rows` its lines in the side-by-side table.
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 
 from ...core.episodes import run_episodes
-from .task import ACTIONS, scripted_env
+from .task import ACTIONS
 
 __all__ = ["UNIT", "AGENT", "records", "summary", "run", "rows"]
 
@@ -54,14 +54,11 @@ def summary(records) -> dict:
     return out
 
 
-def run(learner, episodes: int, seed: int, env_kwargs: Mapping[str, Any] | None = None) -> dict:
-    """``learner`` in ``episodes`` episodes of the scripted imitation env: :func:`summary` of
-    its :func:`records`."""
-    env = scripted_env(**dict(env_kwargs or {}))
-    try:
-        return summary(records(env, learner, episodes, seed))
-    finally:
-        env.close()
+def run(learner, episodes: int, seed: int, env) -> dict:
+    """``learner`` in ``episodes`` episodes of ``env``, the scripted imitation env
+    (:func:`~mimo_social.tasks.imitation.task.scripted_env`, which the caller made and closes):
+    :func:`summary` of its :func:`records`."""
+    return summary(records(env, learner, episodes, seed))
 
 
 def rows(summaries: Sequence[Mapping]) -> list[tuple[str, list[str]]]:

@@ -8,12 +8,12 @@ entry's ``measures``); :func:`rows` its lines in the side-by-side table.
 
 from __future__ import annotations
 
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
 from ...core.episodes import run_episodes
-from .task import MEASURES, PHASES, scripted_env
+from .task import MEASURES, PHASES
 
 __all__ = ["UNIT", "AGENT", "still_face_summary", "format_still_face_summary", "run", "rows"]
 
@@ -56,15 +56,13 @@ def format_still_face_summary(summary: Mapping) -> str:
     return "\n".join(lines)
 
 
-def run(learner, episodes: int, seed: int, env_kwargs: Mapping[str, Any] | None = None) -> dict:
+def run(learner, episodes: int, seed: int, env) -> dict:
     """``learner`` (a policy for ``infant_0``: ``act(env, agent, obs)``, optional ``reset``) in
-    ``episodes`` episodes of the scripted still face (seeds ``seed``, ``seed + 1``, ...):
-    :func:`still_face_summary` of the last infos, plus ``return``: (mean, sd) over episodes."""
-    env = scripted_env(**dict(env_kwargs or {}))
-    try:
-        done = run_episodes(env, {AGENT: learner}, episodes, seed)
-    finally:
-        env.close()
+    ``episodes`` episodes of ``env``, the scripted still face
+    (:func:`~mimo_social.tasks.still_face.task.scripted_env`, which the caller made and closes;
+    seeds ``seed``, ``seed + 1``, ...): :func:`still_face_summary` of the last infos, plus
+    ``return``: (mean, sd) over episodes."""
+    done = run_episodes(env, {AGENT: learner}, episodes, seed)
     out = still_face_summary([e.last_infos[AGENT] for e in done])
     returns = [e.returns[AGENT] for e in done]
     out["return"] = (float(np.mean(returns)), float(np.std(returns)))
