@@ -44,6 +44,36 @@ from .world import World
 __all__ = ["MimoParallelEnv", "TIMING_KEYS"]
 
 TIMING_KEYS = ("actuation", "physics", *SENSES, "task", "other")
+#: the action dtypes read as they are (the common case: no conversion)
+_PLAIN_FLOATS = (np.dtype(np.float32), np.dtype(np.float64))
+#: the keys of an action when expressions are on
+_ACTION_KEYS = frozenset(("motors", "expression"))
+
+
+def _expression_id(agent: str, given) -> int:
+    """The expression id of an action: an integer 0..len(EXPRESSIONS) - 1, also as a numpy or
+    tensor scalar or a 1-element array; else a ValueError naming the agent, the value and what
+    is allowed."""
+    if type(given) is int or type(given) in _INT_SCALARS:      # the common cases, quickly
+        if 0 <= given < len(EXPRESSIONS):
+            return int(given)
+        ok = False
+    else:
+        try:
+            e = np.asarray(given)
+            ok = e.shape in ((), (1,)) and e.dtype.kind in "iu" \
+                and 0 <= int(e.reshape(())) < len(EXPRESSIONS)
+        except Exception:  # noqa: BLE001  (ragged lists, tensors that need grad ...)
+            ok = False
+        if ok:
+            return int(e.reshape(()))
+    raise ValueError(f"{agent}: expression={show(given, 120)} not allowed; allowed: an integer "
+                     f"0..{len(EXPRESSIONS) - 1}: "
+                     + ", ".join(f"{k}={n}" for k, n in enumerate(EXPRESSIONS)))
+
+
+_INT_SCALARS = frozenset((np.int64, np.int32, np.int16, np.int8, np.uint64, np.uint32,
+                          np.uint16, np.uint8))
 
 
 class MimoParallelEnv(ParallelEnv):
@@ -272,15 +302,9 @@ class MimoParallelEnv(ParallelEnv):
         return obs, rew, term, trunc, infos
 
     def _apply_actions(self, actions):
-        if not isinstance(actions, Mapping):
-            raise ValueError(f"actions must be a dict agent -> action, got {type(actions).__name__}")
-        unknown = [a for a in actions if a not in self._index]
-        if unknown:
-            raise ValueError(f"actions for unknown agent(s) {unknown}; agents: {self.possible_agents}")
-        missing = [a for a in self.agents if a not in actions]
-        if missing:
-            raise ValueError(f"no action for live agent(s) {missing}; every live agent of "
-                             f"{self.agents} needs one")
+        if not (type(actions) is dict and actions.keys() == set(self.agents)):
+            # not the common case (a dict with one action per live agent): look closer
+            self._check_action_keys(actions)
         # every live agent's action is read and checked before any is applied: a bad action
         # leaves the env as it was (no agent's controls or face changed)
         checked = []
@@ -290,23 +314,13 @@ class MimoParallelEnv(ParallelEnv):
             action = actions[a]
             expression = None
             if self.agent_configs[i].expressions:
-                if not isinstance(action, Mapping) or set(action) != {"motors", "expression"}:
+                if not (type(action) is dict and action.keys() == _ACTION_KEYS) and (
+                        not isinstance(action, Mapping) or set(action) != _ACTION_KEYS):
                     raise ValueError(f"{a}: action must be a dict with keys 'motors' and "
                                      f"'expression' (expressions are on), got "
                                      f"{show(action, 120)}")
                 motors, given = action["motors"], action["expression"]
-                try:        # an integer id, also as a numpy or tensor scalar or 1-element array
-                    e = np.asarray(given)
-                    ok = e.shape in ((), (1,)) and e.dtype.kind in "iu" \
-                        and 0 <= int(e.reshape(())) < len(EXPRESSIONS)
-                except Exception:  # noqa: BLE001  (ragged lists, tensors that need grad ...)
-                    ok = False
-                if not ok:
-                    raise ValueError(
-                        f"{a}: expression={show(given, 120)} not allowed; allowed: an integer "
-                        f"0..{len(EXPRESSIONS) - 1}: "
-                        + ", ".join(f"{k}={n}" for k, n in enumerate(EXPRESSIONS)))
-                expression = int(e.reshape(()))
+                expression = _expression_id(a, given)
             else:
                 motors = action
             checked.append((i, act, expression, self._motor_values(a, act, motors)))
@@ -318,12 +332,27 @@ class MimoParallelEnv(ParallelEnv):
             # the env's own buffer: the caller's array is never written to nor kept
             c = self.controls[i]
             ring = self._motor_delays[i]
+            # clipped into [low, high] by two ufuncs (np.clip's wrappers cost a few µs more)
             if ring is None:
-                np.clip(u, act.control_low, act.control_high, out=c)
+                np.minimum(np.maximum(u, act.control_low, out=c), act.control_high, out=c)
             else:   # the controls given k steps ago are applied
-                np.clip(u, act.control_low, act.control_high, out=ring.slot())
+                slot = ring.slot()
+                np.minimum(np.maximum(u, act.control_low, out=slot), act.control_high, out=slot)
                 np.copyto(c, ring.advance())
             act.apply(w.model, w.data, c)
+
+    def _check_action_keys(self, actions) -> None:
+        """A ValueError unless ``actions`` is a mapping with an action for every live agent
+        (actions for agents that ended are allowed and ignored)."""
+        if not isinstance(actions, Mapping):
+            raise ValueError(f"actions must be a dict agent -> action, got {type(actions).__name__}")
+        unknown = [a for a in actions if a not in self._index]
+        if unknown:
+            raise ValueError(f"actions for unknown agent(s) {unknown}; agents: {self.possible_agents}")
+        missing = [a for a in self.agents if a not in actions]
+        if missing:
+            raise ValueError(f"no action for live agent(s) {missing}; every live agent of "
+                             f"{self.agents} needs one")
 
     @staticmethod
     def _motor_values(agent: str, act, motors) -> np.ndarray:
@@ -333,7 +362,14 @@ class MimoParallelEnv(ParallelEnv):
         Accepted: anything numpy reads as an array of shape ``(n_controls,)`` of integers or
         floats of any width (Python numbers too, ints beyond 64 bits included) whose values are
         finite in float64. Refused: bools, complex numbers, strings, bytes, dates, masked
-        entries, tensors that need a gradient, NaN/inf and values beyond float64."""
+        entries, tensors that need a gradient, NaN/inf and values beyond float64.
+
+        What learners send, a float32 or float64 numpy array of the right shape, is checked for
+        finite values only (and read, never copied: the caller's array is not written to); the
+        rest, and every message, takes the general path."""
+        if (type(motors) is np.ndarray and motors.dtype in _PLAIN_FLOATS
+                and motors.shape == act.control_low.shape and np.isfinite(motors).all()):
+            return motors
         lo = f"{act.control_low.min():g}" if act.n_controls else "-1"
         hi = f"{act.control_high.max():g}" if act.n_controls else "1"
         allowed = (f"allowed: {act.n_controls} finite numbers in [{lo}, {hi}] (motors "
@@ -378,9 +414,9 @@ class MimoParallelEnv(ParallelEnv):
     def _info(self, i: int) -> dict:
         act = self.actuation[i]
         u = self.controls[i]
+        cost, weighted = act.costs(u)
         info = {"expression": EXPRESSIONS[self._expression[i]], "step": self.steps,
-                "time": float(self.world.data.time),
-                "cost": act.cost(u), "weighted_cost": act.weighted_cost(u)}
+                "time": float(self.world.data.time), "cost": cost, "weighted_cost": weighted}
         for sense in self.senses[i]:
             if hasattr(sense, "info"):
                 info.update(sense.info())

@@ -20,6 +20,7 @@ import numpy as np
 from gymnasium import spaces
 
 from ..util.checks import check_number
+from ..util.indexing import as_slice
 from ..body.actuation.muscle import Muscle
 from ..body.actuation.spring_damper import SpringDamper
 from .base import SenseEntry, components
@@ -82,6 +83,15 @@ class Proprioception:
                 low[sl], high[sl] = _actuation_bounds(actuation)
         self.space = spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
         self.spaces = {self.name: self.space}
+        # the agent's joints in MuJoCo's arrays: a slice (a view) when consecutive, as they are
+        self._qpos = as_slice(agent.qpos_adr)
+        self._dof = as_slice(agent.dof_adr)
+        self._q = np.empty(n)                    # the clipped angles, float64 (limits read them)
+        # limit sensors as max(A + q/m, 0) - max(B - q/m, 0): the formula of _limit_values with
+        # its constants folded (equal to it within rounding)
+        self._A = 1.0 - self._hi * self._inv_margin
+        self._B = 1.0 + self._lo * self._inv_margin
+        self._s, self._t = np.empty(n), np.empty(n)
 
     def _limit_values(self, q: np.ndarray) -> np.ndarray:
         """The limit sensors at joint angles ``q``: 1 - distance/margin, floored at 0, each side
@@ -94,18 +104,22 @@ class Proprioception:
         out[self.name] = self.read(model, data)
 
     def read(self, model, data) -> np.ndarray:
-        a = self.agent
         out = np.empty(self.size, np.float32)
-        q = np.clip(data.qpos[a.qpos_adr], self._q_lo, self._q_hi)
+        q = self._q
+        np.minimum(np.maximum(data.qpos[self._qpos], self._q_lo, out=q), self._q_hi, out=q)
         for c, sl in self.slices.items():
             if c == "qpos":
                 out[sl] = q
             elif c == "qvel":
-                out[sl] = data.qvel[a.dof_adr]
+                out[sl] = data.qvel[self._dof]
             elif c == "torque":
-                out[sl] = data.qfrc_actuator[a.dof_adr]
+                out[sl] = data.qfrc_actuator[self._dof]
             elif c == "limits":  # 1 - distance/margin, floored at 0, on each side
-                out[sl] = self._limit_values(q)
+                s, t = self._s, self._t
+                np.multiply(q, self._inv_margin, out=s)
+                np.maximum(np.subtract(self._B, s, out=t), 0.0, out=t)     # lower side
+                np.maximum(np.add(self._A, s, out=s), 0.0, out=s)          # upper side
+                np.subtract(s, t, out=out[sl])
             else:
                 out[sl] = self.actuation.observation(data)
         return out

@@ -64,3 +64,8 @@ class Actuation(ABC):
     @abstractmethod
     def weighted_cost(self, controls: np.ndarray) -> float:
         """The paper's c_w(u): effort weighted by actuator strength."""
+
+    def costs(self, controls: np.ndarray) -> tuple[float, float]:
+        """``(cost(controls), weighted_cost(controls))``, what the infos report each step (a
+        model overrides it where the two share work)."""
+        return self.cost(controls), self.weighted_cost(controls)

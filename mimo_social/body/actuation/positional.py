@@ -179,6 +179,12 @@ class Positional(SpringDamper):
             return 0.0
         return float((v * v) @ t) / (v.size * float(t.sum()))
 
+    def costs(self, controls):
+        v, t = self.effort()
+        if not v.size:
+            return 0.0, 0.0
+        return float(v @ v) / v.size, float((v * v) @ t) / (v.size * float(t.sum()))
+
     # -- pickling: the bound model and data never travel -------------------------------------------
     def __getstate__(self):
         state = self.__dict__.copy()

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...util.indexing import as_slice
 from .base import Actuation
 
 
@@ -24,6 +25,8 @@ class SpringDamper(Actuation):
         self._high = np.ones(len(self.joints), dtype=np.float32)
         self._torque = np.zeros(len(self.joints))
         self._u = np.zeros(len(self.joints))
+        self._ctrl = as_slice(self.actuator_ids)   # where the torques go in data.ctrl
+        self._strength = self.strength(self._u)
 
     @property
     def control_low(self):
@@ -38,13 +41,15 @@ class SpringDamper(Actuation):
 
     def apply(self, model, data, controls):
         self._u = np.asarray(controls, dtype=float)
-        self._torque = self.torque(self._u)
-        data.ctrl[self.actuator_ids] = self._torque
+        self._strength = self.strength(self._u)    # kept for the costs of these controls
+        self._torque = self._u * self._strength
+        data.ctrl[self._ctrl] = self._torque
 
     def reset(self, model, data):
         self._u[:] = 0.0
+        self._strength = self.strength(self._u)
         self._torque[:] = 0.0
-        data.ctrl[self.actuator_ids] = 0.0
+        data.ctrl[self._ctrl] = 0.0
 
     @property
     def observation_size(self):
@@ -67,3 +72,11 @@ class SpringDamper(Actuation):
             return 0.0
         t = self.strength(u)
         return float((u * u) @ t) / (u.size * float(t.sum()))
+
+    def costs(self, controls):
+        u = np.asarray(controls, dtype=float)
+        if not u.size:
+            return 0.0, 0.0
+        # the controls just applied (the env's infos): their strengths are known
+        t = self._strength if u is self._u else self.strength(u)
+        return float(u @ u) / u.size, float((u * u) @ t) / (u.size * float(t.sum()))
