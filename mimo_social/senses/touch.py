@@ -38,8 +38,8 @@ How a contact is felt
 
     ``mj_step`` leaves contacts at the positions before its last integration while the world
     brings body poses up to date after stepping; each contact point is carried along with its
-    body over that last step (velocities from ``mujoco.mj_comVel``; ``data`` is left as it was)
-    before it is placed on the skin.
+    body over that last step (the body velocities ``mujoco.mj_comVel`` would compute, summed from
+    ``cdof`` and ``qvel``; ``data`` is only read) before it is placed on the skin.
 
 Infos
     ``infos[agent]["touch"]``: per body part touched this step (unprefixed name, parts in contact
@@ -106,7 +106,8 @@ class TouchConfig:
 _SHIFT = 0.5   # a contact is looked up this many spacings outward along its normal
 _PYRAMIDAL = int(mujoco.mjtCone.mjCONE_PYRAMIDAL)
 _AR3 = np.arange(3)
-_SIGN = np.array([[-1.0], [1.0]])
+_SIGN3 = np.array([-1.0, 1.0]).reshape(2, 1, 1)   # per side: geom1, geom2
+_SHIFT_ROW = np.array([-_SHIFT / GRID_CELL, 0.0, 0.0])   # in the contact frame, in cells
 # cross products as matrix products: a x b = [a]x b, with the 3x3 matrix [a]x = (a @ _SKEW)
 _LEVI_CIVITA = np.zeros((3, 3, 3))
 for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
@@ -115,6 +116,28 @@ _SKEW = np.transpose(_LEVI_CIVITA, (1, 0, 2)).reshape(3, 9)
 _AR4 = np.arange(4)
 # pyramid edge forces (f0+, f0-, f1+, f1-) -> (normal, f0+ - f0-, f1+ - f1-)
 _PYRAMID = np.array([[1.0, 1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 0.0, 1.0], [1.0, 0.0, -1.0]])
+
+
+def _part_dofs(m, bodies) -> tuple[np.ndarray, np.ndarray]:
+    """The dofs that move each body (its own and its ancestors', in dof order), padded to the
+    longest list: (n, D) dof indices (padding 0) and (n, D) 1.0 for a dof, 0.0 for padding. A
+    body's com velocity ``cvel`` is the sum of ``cdof * qvel`` over these dofs (as
+    ``mj_comVel`` adds them up from the root down)."""
+    lists = []
+    for b in bodies:
+        dofs = []
+        while b > 0:
+            a = int(m.body_dofadr[b])
+            dofs[:0] = range(a, a + int(m.body_dofnum[b])) if a >= 0 else []
+            b = int(m.body_parentid[b])
+        lists.append(dofs)
+    D = max((len(x) for x in lists), default=0)
+    idx = np.zeros((len(lists), D), dtype=np.intp)
+    on = np.zeros((len(lists), D))
+    for i, x in enumerate(lists):
+        idx[i, :len(x)] = x
+        on[i, :len(x)] = 1.0
+    return idx, on
 
 
 class AgentTouch:
@@ -134,6 +157,10 @@ class AgentTouch:
         low = 0.0 if self.config.normal_only else -np.inf
         self.space = spaces.Box(low, np.inf, (size,), np.float32)
         self.spaces = {self.name: self.space}
+        # where this agent's values lie in the system's force array (see TouchSystem.force_xyz,
+        # force_normal): x, y, z of its points, or their normal forces
+        n0 = 3 * (system.n_points + 1) + self.start
+        self._span = (n0, n0 + n) if self.config.normal_only else (3 * self.start, 3 * self.stop)
 
     @property
     def n_points(self) -> int:
@@ -144,10 +171,11 @@ class AgentTouch:
 
     def read(self) -> np.ndarray:
         """This agent's ``touch`` vector as of the last update (a new float32 array)."""
-        if self.config.normal_only:   # (>= 0: a -0.0 or rounding below 0 reads 0)
-            normal = self.system.force_normal[self.start:self.stop]
-            return np.maximum(normal, 0.0).astype(np.float32)
-        return self.system.force_xyz[3 * self.start:3 * self.stop].astype(np.float32)
+        a, b = self._span
+        values = self.system._acc[a:b]       # (one call each step: no view property)
+        if self.config.normal_only:          # (>= 0: a -0.0 or rounding below 0 reads 0)
+            return np.maximum(values, 0.0, out=np.empty(b - a, np.float32))
+        return values.astype(np.float32)
 
     def info(self) -> dict:
         return {"touch": self.system.touched_by(self.agent)}
@@ -243,7 +271,10 @@ class TouchSystem:
         K = max(a.shape[1] for a in nbr)
         self.points = np.concatenate(pts)
         self.normals = np.concatenate(nrm)
-        self.scaled = np.concatenate(scaled + [np.full((1, 3), 1e9)])  # points / spacing
+        # the points in grid cells (GRID_CELL spacings), coordinate after coordinate (3, N + 1)
+        # so that the per-contact arithmetic runs along the neighbours; point N lies far away
+        self.scaled = np.ascontiguousarray(
+            np.concatenate(scaled + [np.full((1, 3), 1e9)]).T * (1.0 / GRID_CELL))
         self.nbr = np.concatenate([np.pad(a, ((0, 0), (0, K - a.shape[1])), constant_values=N)
                                    for a in nbr])
         self.point_part = np.concatenate(parts)
@@ -255,7 +286,16 @@ class TouchSystem:
         self.part_start = np.array(part_start, dtype=np.intp)
         self.part_world = np.array(part_world, bool)
         self.part_nearest = np.array(part_nearest, bool)
+        # per part: 1 / spacing, grid origin (3), largest cell (3), cell strides (3), first cell
         self.part_params = np.array(params)
+        # the same for the update, one row a part: numbers (1 / (spacing GRID_CELL), grid
+        # origin, largest cell, in grid cells; 1 for each dof that moves the part, 0 for padding)
+        # and integers (body, root body, cell strides, first cell, the dofs that move the part)
+        dofs, on = _part_dofs(m, self.part_body)
+        self._part_grid = np.concatenate(
+            [self.part_params[:, :7] * ([1.0 / GRID_CELL] * 4 + [1.0] * 3), on], axis=1)
+        self._part_ints = np.concatenate([self.part_body[:, None], self.part_root[:, None],
+                                          self.part_params[:, 7:].astype(np.intp), dofs], axis=1)
         # one more entry, -1, so that the geom id -1 of a flex contact reads as "no skin", "world"
         self.geom_part = np.append(geom_part, -1)
         self.geom_agent = np.append(np.asarray(self.world.geom_agent, dtype=np.intp), -1)
@@ -339,90 +379,119 @@ class TouchSystem:
         return f
 
     def update(self, model, data) -> None:
-        """Read the contacts once and compute every agent's point forces."""
-        self._clear()
-        h = 0.0 if self._just_reset else model.opt.timestep
+        """Read the contacts once and compute every agent's point forces.
+
+        Each numpy call costs a microsecond or two, whatever the size, for the few contacts of
+        a step, so the work is a short, fixed sequence of calls over all contacts at once:
+        ``take`` rather than fancy indexing, in-place ufuncs, one table row a part, lengths in
+        grid cells (no rescaling) and the neighbours of a contact as the inner (long) axis."""
+        if self._touched is not None:                    # zero only what the last update wrote
+            self._acc[self._touched] = 0.0
+            self._touched = None
+        self._sides = None
+        self._info = {}
+        opt = model.opt
+        h = 0.0 if self._just_reset else opt.timestep
         self._just_reset = False
         if data.ncon == 0:
             return
         c = data.contact
         geom = c.geom.ravel()                            # geom1, geom2 of each contact
-        gp = self.geom_part[geom]
-        sides = np.flatnonzero(gp >= 0)                  # one row per skinned side of a contact
+        gp = self.geom_part.take(geom)
+        sides = (gp >= 0).nonzero()[0]                   # one row per skinned side of a contact
         if not len(sides):
             return
         ci = sides >> 1
-        ea = c.efc_address[ci]
+        ea = c.efc_address.take(ci)
         if ea.min() < 0:                                 # contacts MuJoCo left out (no dofs ...)
             keep = ea >= 0
             sides, ci, ea = sides[keep], ci[keep], ea[keep]
             if not len(sides):
                 return
+        S = len(sides)
+        # rows, in the contact frame: the grid look-up's shift (_SHIFT spacings along the normal
+        # n, geom1 -> geom2, in grid cells) and the force on geom2
+        F = np.empty((S, 2, 3))
+        F[:, 0] = _SHIFT_ROW
         efc = data.efc_force
-        pyramidal = model.opt.cone == _PYRAMIDAL         # (read each step: it may change)
+        pyramidal = opt.cone == _PYRAMIDAL               # (read each step: it may change)
         if self._all_dim3 and pyramidal:                 # as mj_contactForce does
-            f = efc[ea[:, None] + _AR4] @ _PYRAMID       # normal, p0 - p1, p2 - p3
-            f[:, 1:] *= c.friction[ci, :2]
-        else:                                            # (S, 3) contact frame, on geom2
-            f = self._decode(c, ci, ea, efc, pyramidal, self._all_dim3)
-        part = gp[sides]
-        body = self.part_body[part]
-        sign = _SIGN[sides & 1]                          # geom2 feels +F, geom1 -F
-        # rows: the contact point relative to the body, the outward normal of the touched skin
-        # and the force on it, all in the world frame
-        frame = c.frame[ci].reshape(-1, 3, 3)            # rows: normal (geom1 -> geom2), tangents
-        V = np.empty((len(ci), 3, 3))
-        V[:, 0] = c.pos[ci]
-        V[:, 1] = frame[:, 0]
-        np.matmul((f * sign)[:, None, :], frame, out=V[:, 2:])
+            f = F[:, 1]
+            np.matmul(efc.take(ea[:, None] + _AR4), _PYRAMID, out=f)   # normal, p0-p1, p2-p3
+            f[:, 1:] *= c.friction.take(ci, 0)[:, :2]
+        else:
+            F[:, 1] = f = self._decode(c, ci, ea, efc, pyramidal, self._all_dim3)
+        part = gp.take(sides)
+        ints = self._part_ints.take(part, 0)             # body, root, cell strides, first cell
+        body = ints[:, 0]
+        # the same rows in the world frame, for the touched side: geom2 feels +F and its skin's
+        # outward normal is -n, geom1 feels -F and has +n: the contact frame times the sign
+        frame = c.frame.take(ci, 0).reshape(S, 3, 3)
+        frame *= _SIGN3.take(sides, 0, mode="wrap")      # sides & 1: 0 geom1 (-), 1 geom2 (+)
+        V = np.empty((S, 3, 3))                          # point (to be made relative), shift, force
+        V[:, 0] = c.pos.take(ci, 0)
+        np.matmul(F, frame, out=V[:, 1:])
+        prm = self._part_grid.take(part, 0)
         if h > 0.0:
             # carry the contact point along with its body over the last physics step: the
             # bodies moved by h times their velocities of now (semi-implicit Euler), expressed in
-            # the com frames of the contacts' time (``cdof``, ``subtree_com`` are still those)
-            kept = data.cvel.copy(), data.cdof_dot.copy()
-            mujoco.mj_comVel(model, data)
-            cv = data.cvel[body]                         # [angular; linear at the root's com]
-            data.cvel[:], data.cdof_dot[:] = kept        # leave MjData as the step left it
-            arm = V[:, 0] - data.subtree_com[self.part_root[part]]
-            spin = (cv[:, :3] @ _SKEW).reshape(-1, 3, 3)    # [w]x
+            # the com frames of the contacts' time (``cdof``, ``subtree_com`` are still those):
+            # the body's cvel as mj_comVel computes it, sum of cdof * qvel over its dofs
+            # (MjData is only read)
+            dofs = ints[:, 6:]
+            q = data.qvel.take(dofs)
+            q *= prm[:, 7:]                              # padding: 0
+            cv = (q[:, None, :] @ data.cdof.take(dofs, 0))[:, 0]   # [angular; linear at com]
+            arm = V[:, 0] - data.subtree_com.take(ints[:, 1], 0)
+            spin = (cv[:, :3] @ _SKEW).reshape(S, 3, 3)  # [w]x
             V[:, 0] += h * (cv[:, 3:] + (spin @ arm[:, :, None])[:, :, 0])
-        V[:, 0] -= data.xpos[body]
-        R = data.xmat[body].reshape(-1, 3, 3)
-        B = V @ R                                        # the same rows in the body frame
-        prm = self.part_params[part]
-        qs = B[:, 0] * prm[:, :1]                        # contact point, in spacings
-        cell = np.floor((qs - (_SHIFT * sign) * B[:, 1] - prm[:, 1:4]) * (1.0 / GRID_CELL))
-        np.clip(cell, 0.0, prm[:, 4:7], out=cell)
-        flat = np.einsum("si,si->s", cell, prm[:, 7:10]) + prm[:, 10]
-        nb = np.take(self.nbr, np.take(self.grid, flat.astype(np.intp)), axis=0)  # (S, K)
-        diff = np.take(self.scaled, nb, axis=0) - qs[:, None, :]
-        d = np.sqrt(np.einsum("skj,skj->sk", diff, diff))  # in spacings
-        w = np.maximum(1.0 - 0.5 * d, 0.0)
+        V[:, 0] -= data.xpos.take(body, 0)
+        B = V @ data.xmat.take(body, 0).reshape(S, 3, 3)  # the same rows in the body frame
+        # the contact point in grid cells, and the cell of the point moved outward: clipped to
+        # the part's grid, then truncated (= rounded down, as it is >= 0)
+        qs = B[:, 0] * prm[:, :1]
+        x = qs + B[:, 1]
+        x -= prm[:, 1:4]
+        np.maximum(x, 0.0, out=x)
+        np.minimum(x, prm[:, 4:7], out=x)
+        cell1 = np.empty((S, 4), np.intp)                # (cell x, y, z, 1)
+        cell1[:, :3] = x
+        cell1[:, 3] = 1
+        flat = (cell1[:, None, :] @ ints[:, 2:6, None]).ravel()    # . (strides, first cell)
+        nb = self.nbr.take(self.grid.take(flat), 0)      # (S, K) the cell's neighbourhood
+        # distances (in grid cells) from the contact to the neighbours, coordinate by coordinate
+        diff = self.scaled.take(nb, 1)                   # (3, S, K)
+        diff -= qs.T[:, :, None]
+        diff *= diff
+        d = np.add.reduce(diff, 0)
+        np.sqrt(d, out=d)
+        w = d * (-0.5 * GRID_CELL)
+        w += 1.0
+        np.maximum(w, 0.0, out=w)                        # max(0, 1 - distance / 2 spacings)
         if self._any_nearest:
-            near = np.flatnonzero(self.part_nearest[part])
+            near = self.part_nearest.take(part).nonzero()[0]
             if len(near):
                 w[near] = 0.0
                 w[near, d[near].argmin(1)] = 1.0
-        total = w.sum(1)
+        total = np.add.reduce(w, 1)
         if total.min() <= 0.0:                           # no point within 2 s: the nearest
-            lone = np.flatnonzero(total <= 0.0)
+            lone = (total <= 0.0).nonzero()[0]
             w[lone, d[lone].argmin(1)] = 1.0
             total[lone] = 1.0
         # per side: force (output frame) and normal force, divided by the summed weights
-        out = np.empty((len(ci), 4))
-        if self._all_world:
-            out[:, :3] = V[:, 2]
-        else:
-            out[:, :3] = B[:, 2]
-            if self._any_world:
-                world = self.part_world[part]
-                out[world, :3] = V[world, 2]
-        out[:, 3] = f[:, 0]
-        out /= total[:, None]
-        slots = np.take(self._slots, nb, axis=0).ravel()
-        np.add.at(self._acc, slots, (w[:, :, None] * out[:, None, :]).ravel())
+        out = np.empty((S, 4))
+        np.divide(V[:, 2] if self._all_world else B[:, 2], total[:, None], out=out[:, :3])
+        if self._any_world and not self._all_world:
+            world = self.part_world.take(part).nonzero()[0]
+            out[world, :3] = V[world, 2] / total[world, None]
+        np.divide(f[:, 0], total, out=out[:, 3])
+        # added up: only the neighbours with weight (a third or so of them)
+        w = w.ravel()
+        on = w.nonzero()[0]
+        slots = self._slots.take(nb.ravel().take(on), 0).ravel()   # 4 places a point
+        np.add.at(self._acc, slots, (w.take(on)[:, None] * out.take(on // nb.shape[1], 0)).ravel())
         self._touched = slots
-        self._sides = (part, geom[sides ^ 1], f[:, 0])
+        self._sides = (part, geom.take(sides ^ 1), f[:, 0])
 
     # -- who touches what ------------------------------------------------------------------------
     def touched_by(self, agent: int) -> dict:
@@ -436,8 +505,8 @@ class TouchSystem:
             part, other, fn = self._sides
             info: dict = {i: {} for i, sk in enumerate(self.skins) if sk is not None}
             names, part_names = self.names, self.part_names
-            for p, owner, src, f in zip(part.tolist(), self.part_agent[part].tolist(),
-                                        self.geom_agent[other].tolist(), fn.tolist()):
+            for p, owner, src, f in zip(part.tolist(), self.part_agent.take(part).tolist(),
+                                        self.geom_agent.take(other).tolist(), fn.tolist()):
                 if f <= 0.0:
                     continue
                 entry = info[owner].get(part_names[p])
@@ -452,7 +521,8 @@ class TouchSystem:
                     entry["agents"].append(names[src])
             for parts in info.values():
                 for entry in parts.values():
-                    entry["agents"].sort()
+                    if len(entry["agents"]) > 1:
+                        entry["agents"].sort()
             self._info = info
         return self._info.get(agent, {})
 

@@ -505,3 +505,24 @@ def test_a_valid_archive_with_wrong_arrays_is_rebuilt_not_fatal(tmp_path, monkey
     monkeypatch.setattr(skin_module, "_MEMORY", {})
     third = skin(free_play_v0.parallel_env(n_agents=1, touch={"density": 0.3})).skins[0]
     assert third.from_cache == "disk"                # the rewritten file is good
+
+
+def test_part_velocities_as_mj_comvel():
+    """The carry reads each touched body's com velocity as the sum of ``cdof * qvel`` over the
+    dofs that move it (MjData only read): the same as ``mujoco.mj_comVel`` computes."""
+    import copy
+
+    from mimo_social.senses.touch import _part_dofs
+
+    env = _lying_pair()
+    env.reset(seed=4)
+    _rollout(env, 4, 20)
+    m, d = env.world.model, env.world.data
+    system = skin(env)
+    dofs, on = _part_dofs(m, system.part_body)
+    q = d.qvel[dofs] * on
+    mine = np.einsum("pd,pdk->pk", q, d.cdof[dofs])
+    check = copy.copy(d)                              # cdof of the contacts' time, qvel of now
+    mujoco.mj_comVel(m, check)
+    np.testing.assert_allclose(mine, check.cvel[system.part_body], rtol=1e-12, atol=1e-12)
+    assert np.abs(mine).max() > 0.01
