@@ -68,6 +68,7 @@ from gymnasium import spaces
 from ..util.checks import (ConfigError, check_bool, check_choice, check_names,
                            check_number)
 from .base import SenseEntry
+from .contact_forces import AR4, PYRAMID, PYRAMIDAL_CONE, SKEW, body_dofs, contact_forces
 from .skin import GRID_CELL, Skin, build_skin
 
 __all__ = ["TouchConfig", "build_touch", "TouchSystem", "AgentTouch", "save_skin_png", "SENSE",
@@ -104,40 +105,8 @@ class TouchConfig:
 
 
 _SHIFT = 0.5   # a contact is looked up this many spacings outward along its normal
-_PYRAMIDAL = int(mujoco.mjtCone.mjCONE_PYRAMIDAL)
-_AR3 = np.arange(3)
 _SIGN3 = np.array([-1.0, 1.0]).reshape(2, 1, 1)   # per side: geom1, geom2
 _SHIFT_ROW = np.array([-_SHIFT / GRID_CELL, 0.0, 0.0])   # in the contact frame, in cells
-# cross products as matrix products: a x b = [a]x b, with the 3x3 matrix [a]x = (a @ _SKEW)
-_LEVI_CIVITA = np.zeros((3, 3, 3))
-for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
-    _LEVI_CIVITA[_i, _j, _k], _LEVI_CIVITA[_i, _k, _j] = 1.0, -1.0
-_SKEW = np.transpose(_LEVI_CIVITA, (1, 0, 2)).reshape(3, 9)
-_AR4 = np.arange(4)
-# pyramid edge forces (f0+, f0-, f1+, f1-) -> (normal, f0+ - f0-, f1+ - f1-)
-_PYRAMID = np.array([[1.0, 1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 0.0, 1.0], [1.0, 0.0, -1.0]])
-
-
-def _part_dofs(m, bodies) -> tuple[np.ndarray, np.ndarray]:
-    """The dofs that move each body (its own and its ancestors', in dof order), padded to the
-    longest list: (n, D) dof indices (padding 0) and (n, D) 1.0 for a dof, 0.0 for padding. A
-    body's com velocity ``cvel`` is the sum of ``cdof * qvel`` over these dofs (as
-    ``mj_comVel`` adds them up from the root down)."""
-    lists = []
-    for b in bodies:
-        dofs = []
-        while b > 0:
-            a = int(m.body_dofadr[b])
-            dofs[:0] = range(a, a + int(m.body_dofnum[b])) if a >= 0 else []
-            b = int(m.body_parentid[b])
-        lists.append(dofs)
-    D = max((len(x) for x in lists), default=0)
-    idx = np.zeros((len(lists), D), dtype=np.intp)
-    on = np.zeros((len(lists), D))
-    for i, x in enumerate(lists):
-        idx[i, :len(x)] = x
-        on[i, :len(x)] = 1.0
-    return idx, on
 
 
 class AgentTouch:
@@ -172,7 +141,7 @@ class AgentTouch:
     def read(self) -> np.ndarray:
         """This agent's ``touch`` vector as of the last update (a new float32 array)."""
         a, b = self._span
-        values = self.system._acc[a:b]       # (one call each step: no view property)
+        values = self.system.acc[a:b]       # (one call each step: no view property)
         if self.config.normal_only:          # (>= 0: a -0.0 or rounding below 0 reads 0)
             return np.maximum(values, 0.0, out=np.empty(b - a, np.float32))
         return values.astype(np.float32)
@@ -291,7 +260,7 @@ class TouchSystem:
         # the same for the update, one row a part: numbers (1 / (spacing GRID_CELL), grid
         # origin, largest cell, in grid cells; 1 for each dof that moves the part, 0 for padding)
         # and integers (body, root body, cell strides, first cell, the dofs that move the part)
-        dofs, on = _part_dofs(m, self.part_body)
+        dofs, on = body_dofs(m, self.part_body)
         self._part_grid = np.concatenate(
             [self.part_params[:, :7] * ([1.0 / GRID_CELL] * 4 + [1.0] * 3), on], axis=1)
         self._part_ints = np.concatenate([self.part_body[:, None], self.part_root[:, None],
@@ -302,10 +271,11 @@ class TouchSystem:
         self._any_world = bool(self.part_world.any())
         self._all_world = bool(self.part_world.all())
         self._any_nearest = bool(self.part_nearest.any())
-        # the forces of all points, one flat array: [x, y, z of point 0, 1, ..., N | normal force
-        # of point 0, 1, ..., N]; point N is the sink of padded neighbours. Per point, the four
-        # places it owns in that array:
-        self._acc = np.zeros(4 * (N + 1))
+        # the forces of all points, one flat array, public for the agents' senses to read (never
+        # written but by update/reset): [x, y, z of point 0, 1, ..., N | normal force of point
+        # 0, 1, ..., N]; point N is the sink of padded neighbours. Per point, the four places it
+        # owns in that array:
+        self.acc = np.zeros(4 * (N + 1))
         p = np.arange(N + 1)
         self._slots = np.stack([3 * p, 3 * p + 1, 3 * p + 2, 3 * (N + 1) + p], axis=1)
         self._touched = None
@@ -314,25 +284,25 @@ class TouchSystem:
 
     # -- the shared-system interface -------------------------------------------------------------
     def reset(self, model, data) -> None:
-        self._acc[:] = 0.0
+        self.acc[:] = 0.0
         self._touched = None
         self._just_reset = True   # the next update reads contacts of mj_forward: no integration
         self._clear()
 
     def _clear(self):
         if self._touched is not None:   # zero only what the last update wrote
-            self._acc[self._touched] = 0.0
+            self.acc[self._touched] = 0.0
             self._touched = None
         self._sides = None
         self._info = {}
 
     @property
     def _xyz(self) -> np.ndarray:
-        return self._acc[:3 * (self.n_points + 1)]
+        return self.acc[:3 * (self.n_points + 1)]
 
     @property
     def _normal(self) -> np.ndarray:
-        return self._acc[3 * (self.n_points + 1):]
+        return self.acc[3 * (self.n_points + 1):]
 
     @property
     def force_xyz(self) -> np.ndarray:
@@ -348,36 +318,6 @@ class TouchSystem:
         v.flags.writeable = False
         return v
 
-    @staticmethod
-    def _decode(c, ci, ea, efc, pyramidal: bool, all_dim3: bool) -> np.ndarray:
-        """Normal and two friction forces (contact frame) of the contacts ``ci``: what
-        ``mujoco.mj_contactForce`` returns, for all contacts at once."""
-        if all_dim3:
-            if pyramidal:
-                f = efc[ea[:, None] + _AR4] @ _PYRAMID      # normal, p0 - p1, p2 - p3
-                f[:, 1:] *= c.friction[ci, :2]
-                return f
-            return efc[ea[:, None] + _AR3]
-        dim = c.dim[ci]
-        f = np.zeros((len(ci), 3))
-        fr = dim >= 3
-        if pyramidal:
-            rows = np.where(dim > 1, 2 * (dim - 1), 1)
-            width = int(rows.max())
-            cols = np.arange(width)
-            mask = cols < rows[:, None]
-            P = np.where(mask, efc[np.where(mask, ea[:, None] + cols, 0)], 0.0)
-            f[:, 0] = P.sum(1)
-            if width >= 4:
-                mu = c.friction[ci]
-                f[fr, 1] = (P[fr, 0] - P[fr, 1]) * mu[fr, 0]
-                f[fr, 2] = (P[fr, 2] - P[fr, 3]) * mu[fr, 1]
-        else:
-            f[:, 0] = efc[ea]
-            f[fr, 1] = efc[ea[fr] + 1]
-            f[fr, 2] = efc[ea[fr] + 2]
-        return f
-
     def update(self, model, data) -> None:
         """Read the contacts once and compute every agent's point forces.
 
@@ -386,7 +326,7 @@ class TouchSystem:
         ``take`` rather than fancy indexing, in-place ufuncs, one table row a part, lengths in
         grid cells (no rescaling) and the neighbours of a contact as the inner (long) axis."""
         if self._touched is not None:                    # zero only what the last update wrote
-            self._acc[self._touched] = 0.0
+            self.acc[self._touched] = 0.0
             self._touched = None
         self._sides = None
         self._info = {}
@@ -414,13 +354,13 @@ class TouchSystem:
         F = np.empty((S, 2, 3))
         F[:, 0] = _SHIFT_ROW
         efc = data.efc_force
-        pyramidal = opt.cone == _PYRAMIDAL               # (read each step: it may change)
+        pyramidal = opt.cone == PYRAMIDAL_CONE               # (read each step: it may change)
         if self._all_dim3 and pyramidal:                 # as mj_contactForce does
             f = F[:, 1]
-            np.matmul(efc.take(ea[:, None] + _AR4), _PYRAMID, out=f)   # normal, p0-p1, p2-p3
+            np.matmul(efc.take(ea[:, None] + AR4), PYRAMID, out=f)   # normal, p0-p1, p2-p3
             f[:, 1:] *= c.friction.take(ci, 0)[:, :2]
         else:
-            F[:, 1] = f = self._decode(c, ci, ea, efc, pyramidal, self._all_dim3)
+            F[:, 1] = f = contact_forces(c, ci, ea, efc, pyramidal, self._all_dim3)
         part = gp.take(sides)
         ints = self._part_ints.take(part, 0)             # body, root, cell strides, first cell
         body = ints[:, 0]
@@ -443,7 +383,7 @@ class TouchSystem:
             q *= prm[:, 7:]                              # padding: 0
             cv = (q[:, None, :] @ data.cdof.take(dofs, 0))[:, 0]   # [angular; linear at com]
             arm = V[:, 0] - data.subtree_com.take(ints[:, 1], 0)
-            spin = (cv[:, :3] @ _SKEW).reshape(S, 3, 3)  # [w]x
+            spin = (cv[:, :3] @ SKEW).reshape(S, 3, 3)  # [w]x
             V[:, 0] += h * (cv[:, 3:] + (spin @ arm[:, :, None])[:, :, 0])
         V[:, 0] -= data.xpos.take(body, 0)
         B = V @ data.xmat.take(body, 0).reshape(S, 3, 3)  # the same rows in the body frame
@@ -489,7 +429,7 @@ class TouchSystem:
         w = w.ravel()
         on = w.nonzero()[0]
         slots = self._slots.take(nb.ravel().take(on), 0).ravel()   # 4 places a point
-        np.add.at(self._acc, slots, (w.take(on)[:, None] * out.take(on // nb.shape[1], 0)).ravel())
+        np.add.at(self.acc, slots, (w.take(on)[:, None] * out.take(on // nb.shape[1], 0)).ravel())
         self._touched = slots
         self._sides = (part, geom.take(sides ^ 1), f[:, 0])
 

@@ -24,6 +24,7 @@ from mimo_social.core.world import AgentSetup, Prop
 from mimo_social.figures import hand_ball_scene
 from mimo_social.senses import skin as skin_module
 from mimo_social.senses.touch import save_skin_png
+from mimo_social.senses.contact_forces import contact_forces
 
 G = 9.81
 # right arm forward, palm up (deg), sitting
@@ -430,7 +431,7 @@ def test_contact_forces_decoded_as_mujoco_does(cone):
         mujoco.mj_contactForce(m, d, int(i), f)
         expected[k] = f[:3]
     for all_dim3 in (True, False):                    # the fast path and the general one
-        got = system._decode(d.contact, ci, d.contact.efc_address[ci], d.efc_force,
+        got = contact_forces(d.contact, ci, d.contact.efc_address[ci], d.efc_force,
                              cone == "pyramidal", all_dim3)
         np.testing.assert_allclose(got, expected, rtol=1e-10, atol=1e-12)
 
@@ -512,14 +513,14 @@ def test_part_velocities_as_mj_comvel():
     dofs that move it (MjData only read): the same as ``mujoco.mj_comVel`` computes."""
     import copy
 
-    from mimo_social.senses.touch import _part_dofs
+    from mimo_social.senses.contact_forces import body_dofs
 
     env = _lying_pair()
     env.reset(seed=4)
     _rollout(env, 4, 20)
     m, d = env.world.model, env.world.data
     system = skin(env)
-    dofs, on = _part_dofs(m, system.part_body)
+    dofs, on = body_dofs(m, system.part_body)
     q = d.qvel[dofs] * on
     mine = np.einsum("pd,pdk->pk", q, d.cdof[dofs])
     check = copy.copy(d)                              # cdof of the contacts' time, qvel of now
