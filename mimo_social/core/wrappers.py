@@ -31,6 +31,14 @@
 ``FlatObservationWrapper`` / ``FlatActionWrapper`` / ``ExpressionActionWrapper``
     The same flat observations and actions for a Gymnasium env (one agent);
     :func:`mimo_social.train.envs.make_sb3_single` puts them around an env for SB3.
+
+``DictObservationWrapper(env, frame_stack=1)``
+    For a Gymnasium env whose ``Dict`` observation holds images (the eyes): each image key stays
+    a ``uint8`` image, channel-first ``(C * frame_stack, H, W)`` (what SB3's
+    ``MultiInputPolicy`` takes as an image without transposing it), the last ``frame_stack``
+    frames stacked along the channels, oldest first (``reset`` fills them with its frame); every
+    other key, nested dicts included, becomes ONE float32 Box ``"vector"`` (the
+    :class:`ObsFlattener` of those keys; left out when it has no entries).
 """
 
 from __future__ import annotations
@@ -46,7 +54,8 @@ from ..util.checks import number_array
 
 __all__ = ["ParallelWrapper", "FlattenParallel", "NumericInfos", "INFO_KINDS", "FlatActionWrapper",
            "FlatObservationWrapper", "ExpressionActionWrapper", "is_expression_only",
-           "flat_action_space", "flat_observation_space", "ObsFlattener", "ActionDecoder"]
+           "flat_action_space", "flat_observation_space", "ObsFlattener", "ActionDecoder",
+           "DictObservationWrapper", "image_keys", "is_image_box", "VECTOR_KEY"]
 
 LOGIT_LOW, LOGIT_HIGH = -1.0, 1.0
 
@@ -109,6 +118,100 @@ class FlatObservationWrapper(gym.ObservationWrapper):
 def flat_observation_space(space: spaces.Space) -> spaces.Box:
     """The float32 ``Box`` that :class:`FlattenParallel` gives for an observation space."""
     return ObsFlattener(space).space
+
+
+#: the key of :class:`DictObservationWrapper`'s observation that holds every non-image part
+VECTOR_KEY = "vector"
+
+
+def is_image_box(space: spaces.Space) -> bool:
+    """True for a ``uint8`` Box of bounds 0..255 shaped ``(H, W)`` or ``(H, W, C)``, C in 1..4
+    (what the eyes give: ``(H, W, 3)``)."""
+    if not (isinstance(space, spaces.Box) and space.dtype == np.uint8):
+        return False
+    shape = space.shape
+    if not (len(shape) == 2 or (len(shape) == 3 and 1 <= shape[2] <= 4)) or min(shape) < 1:
+        return False
+    return bool(np.all(space.low == 0) and np.all(space.high == 255))
+
+
+def image_keys(space: spaces.Space) -> tuple[str, ...]:
+    """The top-level keys of a ``Dict`` observation space that hold images
+    (:func:`is_image_box`); ``()`` for any other space."""
+    if not isinstance(space, spaces.Dict):
+        return ()
+    return tuple(k for k, sub in space.spaces.items() if is_image_box(sub))
+
+
+class DictObservationWrapper(gym.Wrapper):
+    """A Gymnasium env's ``Dict`` observation with images as the ``Dict`` SB3's
+    ``MultiInputPolicy`` takes (see the module docstring): image keys channel-first ``uint8``
+    ``(C * frame_stack, H, W)``, the rest one float32 Box under :data:`VECTOR_KEY`.
+
+    ``frame_stack`` (>= 1): how many frames of each image key are stacked along the channels,
+    oldest first; ``reset`` fills every slot with its frame. ``C * frame_stack`` may not exceed
+    ``min(H, W)``: SB3 takes the smallest axis of an image for its channels.
+    """
+
+    def __init__(self, env: gym.Env, frame_stack: int = 1):
+        super().__init__(env)
+        space = env.observation_space
+        self.image_keys = image_keys(space)
+        if not self.image_keys:
+            raise TypeError(f"DictObservationWrapper needs a Dict observation with an image "
+                            f"(a uint8 Box (H, W) or (H, W, C<=4), bounds 0..255), got {space}")
+        if (isinstance(frame_stack, bool) or not isinstance(frame_stack, (int, np.integer))
+                or frame_stack < 1):
+            raise ValueError(f"frame_stack = {frame_stack!r} not allowed; allowed: an integer "
+                             ">= 1 (1: no stacking)")
+        self.frame_stack = k = int(frame_stack)
+        out: dict[str, spaces.Space] = {}
+        self._channels: dict[str, int] = {}
+        for key in self.image_keys:
+            shape = space[key].shape
+            h, w = shape[:2]
+            c = shape[2] if len(shape) == 3 else 1
+            if c * k > min(h, w):
+                raise ValueError(f"frame_stack = {k} not allowed for image {key!r} of shape "
+                                 f"{shape}: {c} x {k} channels exceed its smaller side "
+                                 f"{min(h, w)}; allowed: frame_stack <= {min(h, w) // c}")
+            self._channels[key] = c
+            out[key] = spaces.Box(0, 255, (c * k, h, w), np.uint8)
+        rest = {key: sub for key, sub in space.spaces.items() if key not in self._channels}
+        self._vector = ObsFlattener(spaces.Dict(rest)) if rest else None
+        if self._vector is not None and self._vector.space.shape[0] > 0:
+            if VECTOR_KEY in out:
+                raise ValueError(f"an image key is named {VECTOR_KEY!r}, the key of the "
+                                 "non-image parts")
+            out[VECTOR_KEY] = self._vector.space
+        else:
+            self._vector = None
+        self.observation_space = spaces.Dict(out)
+        self._frames = {key: np.zeros(out[key].shape, np.uint8) for key in self.image_keys}
+
+    def _observe(self, obs: Mapping[str, Any], first: bool) -> dict[str, np.ndarray]:
+        out = {}
+        for key, c in self._channels.items():
+            img = np.asarray(obs[key], dtype=np.uint8)
+            chw = img.transpose(2, 0, 1) if img.ndim == 3 else img[None]
+            frames = self._frames[key]
+            if first:
+                frames.reshape(self.frame_stack, *chw.shape)[:] = chw
+            else:  # drop the oldest frame, the newest goes last
+                frames[:-c] = frames[c:]
+                frames[-c:] = chw
+            out[key] = frames.copy()
+        if self._vector is not None:
+            out[VECTOR_KEY] = self._vector(obs)
+        return out
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        obs, info = self.env.reset(seed=seed, options=options)
+        return self._observe(obs, True), info
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        return self._observe(obs, False), reward, terminated, truncated, info
 
 
 # -- actions ------------------------------------------------------------------------------------

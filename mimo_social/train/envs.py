@@ -6,10 +6,14 @@
     catalogue registers every id), then :func:`make_sb3_single`.
 ``make_parallel_env(task)`` / ``make_scripted_env(task)``
     A social task's ParallelEnv (every agent, or the learner only) as ``FlattenParallel``.
-``make_sb3_single(env_id_or_env)``
-    A Gymnasium env with a ``Box`` observation and a ``Box`` action (expression logits, when the
-    env has a ``Dict`` action), or a ``Discrete`` expression for a face-only agent (the flat
-    wrappers of :mod:`mimo_social.core.wrappers`).
+``make_sb3_single(env_id_or_env, flat=False, frame_stack=1)``
+    A Gymnasium env with a ``Box`` action (expression logits, when the env has a ``Dict``
+    action), or a ``Discrete`` expression for a face-only agent (the flat wrappers of
+    :mod:`mimo_social.core.wrappers`). The observation: when the learner sees images (its eyes)
+    a ``Dict`` of channel-first ``uint8`` images plus one float32 ``"vector"`` (for
+    ``MultiInputPolicy`` and the CNN of :mod:`mimo_social.train.encoders`, see
+    :func:`~mimo_social.train.encoders.policy_spec`), optionally the last ``frame_stack``
+    frames of each image; without images, or with ``flat=True``, one float32 ``Box``.
 
 The worker side of :class:`~mimo_social.train.vector.SpawnConcatVecEnv` lives here too: a spawned
 worker imports the module of its target function, and this one imports neither SB3 nor torch.
@@ -25,8 +29,9 @@ import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-from ..core.wrappers import (ExpressionActionWrapper, FlatActionWrapper, FlatObservationWrapper,
-                             FlattenParallel, is_expression_only)
+from ..core.wrappers import (DictObservationWrapper, ExpressionActionWrapper, FlatActionWrapper,
+                             FlatObservationWrapper, FlattenParallel, image_keys,
+                             is_expression_only)
 from ..envs.catalog import entry, register_envs
 from .tasks import check_task, task_module
 
@@ -42,12 +47,15 @@ def with_render(env_kwargs: Mapping[str, Any], render_mode: str | None) -> dict:
     return kw
 
 
-def make_env(task: str, render_mode: str | None = None, **env_kwargs):
-    """The task's one-learner Gymnasium env with Box observations and actions (for SB3): the
-    catalogue's Gymnasium id of the task (for a social task: its learner, the partner
-    scripted)."""
+def make_env(task: str, render_mode: str | None = None, *, flat: bool = False,
+             frame_stack: int = 1, **env_kwargs):
+    """The task's one-learner Gymnasium env for SB3: the catalogue's Gymnasium id of the task
+    (for a social task: its learner, the partner scripted) in :func:`make_sb3_single`: Box
+    actions; a ``Dict`` observation (images + ``"vector"``) when the learner sees images and
+    ``flat`` is False, else one Box; ``frame_stack`` frames of each image."""
     check_task(task)
-    return make_sb3_single(entry(task).gym_id, **with_render(env_kwargs, render_mode))
+    return make_sb3_single(entry(task).gym_id, flat=flat, frame_stack=frame_stack,
+                           **with_render(env_kwargs, render_mode))
 
 
 def make_parallel_env(task: str, render_mode: str | None = None, **env_kwargs):
@@ -60,14 +68,21 @@ def make_scripted_env(task: str, render_mode: str | None = None, **env_kwargs):
     return FlattenParallel(task_module(task).scripted_env(**with_render(env_kwargs, render_mode)))
 
 
-def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
-    """A one-agent Gymnasium env with a ``Box`` observation and a ``Box`` action, for SB3.
+def make_sb3_single(env_id_or_env, *, flat: bool = False, frame_stack: int = 1,
+                    **make_kwargs) -> gym.Env:
+    """A one-agent Gymnasium env for SB3: a ``Box`` action (or a ``Discrete`` expression) and a
+    ``Dict`` observation with images, or a ``Box`` one.
 
     ``env_id_or_env``: a registered id (``"mimo_social/Reach-v0"``; ``make_kwargs`` go to
-    ``gymnasium.make``) or a ``gymnasium.Env``. A non-Box observation is flattened by
-    :class:`FlatObservationWrapper` (images scaled to [0, 1]); a ``Dict(motors, expression)``
-    action becomes the flat Box of :class:`FlatActionWrapper`, or, when the agent has no motors,
-    the ``Discrete`` expression of :class:`ExpressionActionWrapper`.
+    ``gymnasium.make``) or a ``gymnasium.Env``. A ``Dict`` observation with images (the eyes)
+    becomes, unless ``flat``, the ``Dict`` of :class:`DictObservationWrapper` (each image
+    channel-first ``uint8``, the last ``frame_stack`` frames stacked along the channels; the
+    other keys one float32 ``"vector"``), for ``MultiInputPolicy``
+    (:func:`mimo_social.train.encoders.policy_spec`). Any other non-Box observation, or any with
+    ``flat=True``, is flattened by :class:`FlatObservationWrapper` (images scaled to [0, 1]).
+    ``frame_stack > 1`` needs images and ``flat=False``. A ``Dict(motors, expression)`` action
+    becomes the flat Box of :class:`FlatActionWrapper`, or, when the agent has no motors, the
+    ``Discrete`` expression of :class:`ExpressionActionWrapper`.
     """
     if isinstance(env_id_or_env, str):
         register_envs()
@@ -79,7 +94,17 @@ def make_sb3_single(env_id_or_env, **make_kwargs) -> gym.Env:
     else:
         raise TypeError(f"make_sb3_single takes an env id or a gymnasium.Env, got "
                         f"{type(env_id_or_env).__name__}")
-    if not isinstance(env.observation_space, spaces.Box) or env.observation_space.dtype == np.uint8:
+    images = bool(image_keys(env.observation_space))
+    if frame_stack != 1 and (flat or not images):
+        if isinstance(env_id_or_env, str):
+            env.close()     # made here
+        why = "flat=True" if flat else f"an observation without images ({env.observation_space})"
+        raise ValueError(f"frame_stack = {frame_stack!r} not allowed with {why}; frame "
+                         "stacking stacks the images of a Dict observation (flat=False)")
+    if images and not flat:
+        env = DictObservationWrapper(env, frame_stack=frame_stack)
+    elif (not isinstance(env.observation_space, spaces.Box)
+          or env.observation_space.dtype == np.uint8):
         env = FlatObservationWrapper(env)
     if is_expression_only(env.action_space):
         env = ExpressionActionWrapper(env)

@@ -329,7 +329,7 @@ def test_flat_wrappers():
     flat.reset(seed=0)
     _, rew, *_ = flat.step({a: np.zeros(9, np.float32) for a in flat.agents})
     assert set(rew) == {"infant_0", "infant_1"}
-    single = make_sb3_single(SingleAgentEnv(joint_attention_v0.scripted_env()))
+    single = make_sb3_single(SingleAgentEnv(joint_attention_v0.scripted_env()), flat=True)
     assert isinstance(single.observation_space, spaces.Box)
     assert single.action_space.shape == (9,)
     obs, _ = single.reset(seed=0)

@@ -143,7 +143,7 @@ def test_flat_wrappers_work_with_the_empty_motor_box():
     assert rew["infant_0"] == 1.0
     _, rew, *_ = flat.step({"infant_0": 3, "infant_1": 4})
     assert rew["infant_0"] == 0.0
-    single = make_sb3_single(SingleAgentEnv(mirror_v0.scripted_env()))
+    single = make_sb3_single(SingleAgentEnv(mirror_v0.scripted_env()), flat=True)
     assert isinstance(single.observation_space, spaces.Box)
     assert single.action_space == spaces.Discrete(7)
     obs, _ = single.reset(seed=0)

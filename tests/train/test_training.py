@@ -241,7 +241,7 @@ def test_flat_observations_scale_eye_images_to_unit_range():
             assert np.array_equal(chunk, value), key
         start += size
     assert start == space.shape[0]
-    single = make_sb3_single(SingleAgentEnv(mirror_v0.scripted_env()))
+    single = make_sb3_single(SingleAgentEnv(mirror_v0.scripted_env()), flat=True)
     o, _ = single.reset(seed=0)
     assert single.observation_space.contains(o) and o.shape == space.shape
 
