@@ -83,8 +83,9 @@ def _convs(model) -> list:
 
 
 @pytest.mark.parametrize("task", ["joint_attention", "mirror"])
-def test_ppo_learns_and_predicts_through_the_cnn(task):
-    """joint_attention: eyes + vector, Box action; mirror: eyes only, Discrete action."""
+def test_ppo_learns_and_predicts_through_the_cnn(task, tmp_path):
+    """joint_attention: eyes + vector, Box action; mirror: eyes only, Discrete action; saved
+    and loaded (the shared eye encoder too), the same actions."""
     env = make_env(task, **SMALL)
     policy, kw = policy_spec(env.observation_space)
     model = PPO(policy, env, n_steps=64, batch_size=32, n_epochs=1, seed=0, device="cpu",
@@ -94,6 +95,10 @@ def test_ppo_learns_and_predicts_through_the_cnn(task):
     obs, _ = env.reset(seed=1)
     action, _ = model.predict(obs, deterministic=True)
     assert env.action_space.contains(action if task != "mirror" else int(action))
+    model.save(tmp_path / "model.zip")
+    loaded = PPO.load(tmp_path / "model.zip", device="cpu")
+    assert isinstance(loaded.policy.features_extractor, EyesExtractor)
+    np.testing.assert_array_equal(loaded.predict(obs, deterministic=True)[0], action)
     env.close()
 
 
