@@ -20,10 +20,13 @@ The social tasks (:data:`~mimo_social.train.tasks.MULTI_TASKS`) are PettingZoo m
     through :func:`~mimo_social.train.envs.make_env`: the one-agent path with the task's default
     scripted partner.
 
-Evaluation (every ``--eval-every`` steps and at the end) runs ``--eval-episodes`` deterministic
-episodes on a separate env in which every learning agent acts with its own policy (scripted
-partners keep their script). It gives per-agent returns and success rates (``is_success`` of the
-agent's info on its last step); the summary columns average them across agents.
+Evaluation (on the schedule of :class:`~mimo_social.train.runlog.Schedule`: by default within an
+evaluation budget, else every ``--eval-every`` steps; and at the end) runs ``--eval-episodes``
+episodes of the deterministic and of the stochastic policy on a separate env in which every
+learning agent acts with its own policy (scripted partners keep their script). It gives per-agent
+returns and success rates (``is_success`` of the agent's info on its last step); the summary
+columns average them across agents. SIGINT / SIGTERM stop the run between two steps and save it
+as it stands (:mod:`mimo_social.train.interrupt`).
 """
 
 from __future__ import annotations
@@ -31,14 +34,14 @@ from __future__ import annotations
 import functools
 import time
 from pathlib import Path
-from typing import Callable
 
-
-from .envs import make_env, make_parallel_env, make_scripted_env
+from .envs import make_parallel_env, make_scripted_env
 from .independent import train_independent
+from .interrupt import StopSignals, workers_ignore_sigint
 from .progress import write_config
 from .rollouts import evaluate_agents
-from .runlog import RunLog, Schedule
+from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
+from .single import finish_config, monitored_env, vector_defaults, warn
 from .tasks import TrainInputError, algo_class, check_mode, task_module
 
 __all__ = ["train_multi", "check_shared_spaces"]
@@ -62,53 +65,28 @@ def check_shared_spaces(env, task: str) -> None:
                     "Use --mode independent (one policy per agent) instead")
 
 
-def _sb3_callback(log: RunLog, schedule: Schedule, slot_agents: list[str], per_env_step: int,
-                  save_checkpoint: Callable[[int], None]):
-    """SB3 callback of the shared and scripted modes: episodes by slot, evaluations, checkpoints.
-    ``per_env_step``: SB3 timesteps per environment step (the number of agent slots a world)."""
-    from stable_baselines3.common.callbacks import BaseCallback
-
-    class MultiAgentLog(BaseCallback):
-        def _on_step(self) -> bool:
-            n = self.num_timesteps // per_env_step
-            for i, info in enumerate(self.locals.get("infos", ())):
-                ep = info.get("episode")
-                if ep is not None:
-                    log.episode(n, slot_agents[i % len(slot_agents)], float(ep["r"]), int(ep["l"]),
-                                info.get("is_success"))
-            if log.bar is not None:
-                log.bar.update(n - log.bar.n)
-            if schedule.checkpoint_due(n):
-                save_checkpoint(n)
-            if schedule.eval_due(n):
-                log.evaluate(n)
-            return True
-
-        def _on_training_end(self) -> None:  # after the last update
-            n = self.num_timesteps // per_env_step
-            if log.bar is not None:
-                log.bar.update(n - log.bar.n)
-            if schedule.final_checkpoint_due(n):
-                save_checkpoint(n)
-            log.evaluate(n)
-
-    return MultiAgentLog()
-
-
 # -- training ------------------------------------------------------------------------------------
 def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode: str | None,
-                eval_every: int, eval_episodes: int, checkpoint_every: int, progress: bool,
-                env_kwargs: dict, algo_kwargs: dict, n_envs: int = 1, n_cpus: int = 0,
-                verbose: int = 0, config: dict) -> dict:
-    """The multi-agent part of :func:`mimo_social.train.runner.train` (arguments checked there)."""
+                eval_every: int | None, eval_episodes: int, checkpoint_every: int,
+                progress: bool, env_kwargs: dict, algo_kwargs: dict, n_envs: int = 1,
+                n_cpus: int = 0, verbose: int = 0, config: dict,
+                worker_timeout: float = 600.0) -> dict:
+    """The multi-agent part of :func:`mimo_social.train.runner.train` (arguments checked there).
+    ``eval_every=None``: the budgeted schedule. ``n_envs``: worlds (shared mode; ``n_cpus``
+    worker processes for them) or envs of the one learner (scripted mode, a spawned worker each
+    when more than one); the independent mode steps one world."""
     mode = check_mode(task, mode)
-    if mode != "shared" and (n_envs != 1 or n_cpus != 0):
-        raise TrainInputError(f"--n-envs/--n-cpus are for --mode shared; got n_envs={n_envs}, "
-                              f"n_cpus={n_cpus} with --mode {mode}")
+    if mode == "independent" and (n_envs != 1 or n_cpus != 0):
+        raise TrainInputError(f"--mode independent steps one world: n_envs={n_envs}, "
+                              f"n_cpus={n_cpus} are for --mode shared (worlds) and --mode "
+                              "scripted (envs)")
+    if mode == "scripted" and n_cpus != 0:
+        raise TrainInputError(f"--n-cpus is for --mode shared; --mode scripted runs one worker "
+                              f"process per env when n_envs > 1 (got n_cpus={n_cpus})")
     cls = algo_class(algo)
     module = task_module(task)
     config.update({"env_module": module.__name__, "mode": mode, "n_envs": n_envs,
-                   "n_cpus": n_cpus})
+                   "n_cpus": n_cpus, "worker_timeout": float(worker_timeout)})
     eval_env = (make_scripted_env if mode == "scripted" else make_parallel_env)(task, **env_kwargs)
     if mode == "shared":
         try:
@@ -123,7 +101,11 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
             and "buffer_size" not in config.get("algo_kwargs_given", ())):
         # SB3 counts every agent's transition: room for all of them (train's default is steps)
         algo_kwargs["buffer_size"] = min(1_000_000, steps * len(agents))
-    config.pop("algo_kwargs_given", None)
+    given = config.pop("algo_kwargs_given", None)
+    if mode == "scripted":
+        algo_kwargs = vector_defaults(algo_kwargs, set(algo_kwargs if given is None else given),
+                                      int(n_envs), algo)
+        config["algo_kwargs"] = algo_kwargs
     if mode == "independent":
         config["models"] = {a: f"model_{a}.zip" for a in agents}
     else:
@@ -134,68 +116,102 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
         from tqdm import tqdm
         bar = tqdm(total=steps, unit="step", desc=f"{out.name}", dynamic_ncols=True)
     eval_seed = 10_000 + seed
-    schedule = Schedule(eval_every, checkpoint_every, steps)
+    schedule = Schedule(eval_every, checkpoint_every, steps, episodes=eval_episodes,
+                        episode_steps=episode_limit(eval_env))
+    stop = StopSignals()
     t0 = time.perf_counter()
     try:
-        if mode == "independent":
-            models, done = train_independent(cls, algo_kwargs, task, env_kwargs, steps, seed, out,
-                                             eval_env, eval_episodes, eval_seed, schedule, bar,
-                                             t0, verbose)
-            rows = done.rows
-        else:
-            model, log, venv = _train_one_policy(cls, algo_kwargs, module, task, mode, env_kwargs,
-                                                 steps, seed, out, eval_env, eval_episodes,
-                                                 eval_seed, schedule, bar, t0, verbose, n_envs,
-                                                 n_cpus)
-            rows = log.rows
+        with stop:
+            if mode == "independent":
+                models, done = train_independent(cls, algo_kwargs, task, env_kwargs, steps, seed,
+                                                 out, eval_env, eval_episodes, eval_seed,
+                                                 schedule, bar, t0, verbose, stop=stop,
+                                                 config=config)
+                log = done.log
+            else:
+                model, log, venv = _train_one_policy(cls, algo, algo_kwargs, module, task, mode,
+                                                     env_kwargs, steps, seed, out, eval_env,
+                                                     eval_seed, schedule, bar, t0, verbose,
+                                                     n_envs, n_cpus, worker_timeout, stop,
+                                                     config)
     finally:
         eval_env.close()
         if bar is not None:
             bar.close()
+    rows = log.rows
     wall = time.perf_counter() - t0
     timesteps = rows[-1]["timesteps"]
-    config.update({"wall_time_s": round(wall, 1), "timesteps_done": int(timesteps)})
-    write_config(out, config)
+    write_config(out, finish_config(config, wall, timesteps, stop, log.eval_steps))
     models_out = ({a: str(out / f"model_{a}.zip") for a in agents} if mode == "independent"
                   else {a: str(out / "model.zip") for a in agents})
     return {"out": str(out), "model": models_out[agents[0]], "models": models_out,
             "mode": mode, "agents": agents, "wall_time_s": wall, "timesteps": int(timesteps),
-            "last_eval": rows[-1], "rows": rows}
+            "last_eval": rows[-1], "rows": rows, "interrupted": stop.requested,
+            "signal": stop.signum, "steps_planned": config.get("steps_planned", steps)}
 
 
-def _train_one_policy(cls, algo_kwargs, module, task, mode, env_kwargs, steps, seed, out, eval_env,
-                      eval_episodes, eval_seed, schedule, bar, t0, verbose, n_envs, n_cpus):
+def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, steps, seed, out,
+                      eval_env, eval_seed, schedule, bar, t0, verbose, n_envs, n_cpus,
+                      worker_timeout, stop, config):
     """shared (one policy, one VecEnv slot per agent) and scripted (one learner) modes."""
-    from stable_baselines3.common.vec_env import DummyVecEnv, VecMonitor
+    from stable_baselines3.common.vec_env import VecMonitor
 
     agents = list(eval_env.possible_agents)
     if mode == "shared":
-        from .vector import sb3_vec_env
+        from supersuit.vector.sb3_vector_wrapper import SB3VecEnvWrapper
+
+        from .vector import SeededVecEnv, SpawnConcatVecEnv, sb3_vec_env
         env_fn = functools.partial(module.parallel_env, **env_kwargs)
-        venv = VecMonitor(sb3_vec_env(env_fn, n_envs=n_envs, n_cpus=n_cpus))
+        if n_cpus == 0:
+            venv = sb3_vec_env(env_fn, n_envs=n_envs, n_cpus=0)
+        else:
+            with workers_ignore_sigint():
+                venv = SeededVecEnv(SB3VecEnvWrapper(SpawnConcatVecEnv(
+                    env_fn, n_envs, n_cpus, "spawn", timeout_s=worker_timeout)))
+        venv = VecMonitor(venv)
         per_env_step = len(agents)
     else:
-        from stable_baselines3.common.monitor import Monitor
-        venv = DummyVecEnv([lambda: Monitor(make_env(task, **env_kwargs))])
+        from .workers import one_learner_vec_env
+        venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs)),
+                                   int(n_envs), worker_timeout)
         per_env_step = 1
     try:
         model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose, **algo_kwargs)
+        planned, note = rounding_note(model, algo, steps, per_env_step)
+        if note:
+            warn(note)
+        schedule.first = first_update(model, per_env_step)
+        if bar is not None:
+            bar.total = planned
+        config.update({"steps": steps, "steps_planned": planned, **schedule.describe()})
+        write_config(out, config)
 
-        def evaluate():
-            return evaluate_agents({a: model for a in agents}, eval_env, eval_episodes, eval_seed)
+        def evaluate(episodes, deterministic):
+            return evaluate_agents({a: model for a in agents}, eval_env, episodes, eval_seed,
+                                   deterministic)
 
         def checkpoint(n):
             (out / "checkpoints").mkdir(exist_ok=True)
             model.save(out / "checkpoints" / f"model_{n}_steps.zip")
 
-        log = RunLog(out, agents, evaluate, lambda: model.save(out / "best_model.zip"), t0, bar)
+        log = RunLog(out, agents, evaluate, lambda: model.save(out / "best_model.zip"), t0, bar,
+                     schedule, eval_seed)
         try:
-            cb = _sb3_callback(log, schedule, agents, per_env_step, checkpoint)
-            model.learn(total_timesteps=steps * per_env_step, callback=cb)
+            cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop)
+            try:
+                model.learn(total_timesteps=steps * per_env_step, callback=cb)
+            except Exception:
+                if not stop.requested:   # (a worker killed by the same signal)
+                    raise
+            n = int(model.num_timesteps) // per_env_step   # after the last update
+            model.save(out / "model.zip")
+            if schedule.final_checkpoint_due(n) and not stop.requested:
+                checkpoint(n)
+            if bar is not None:
+                bar.update(n - bar.n)
+            log.evaluate(n, 1 if stop.requested else schedule.final_episodes())
         finally:
             log.close()
-        model.save(out / "model.zip")
     finally:
         venv.close()
     return model, log, venv
-

@@ -37,6 +37,10 @@ def _steps_axis(ax) -> None:
     ax.set_xlabel("environment steps")
     ax.xaxis.set_major_formatter(FuncFormatter(short))
 
+def _interrupted(config: dict) -> str:
+    return ", interrupted" if config.get("interrupted") else ""
+
+
 def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path:
     """``learning_curve.png`` of one run (from its ``progress.csv`` and ``episodes.csv``)."""
     import matplotlib
@@ -50,7 +54,8 @@ def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path
     agents = progress_agents(p)
     if agents:
         return _plot_agents(run, path, p, config, agents)
-    has_success = np.isfinite(p["eval_success_rate"]).any()
+    has_success = (np.isfinite(p["eval_success_rate"]).any()
+                   or np.isfinite(p.get("eval_success_rate_stochastic", [np.nan])).any())
     fig, axes = plt.subplots(1, 2 if has_success else 1, figsize=(11 if has_success else 6.5, 4),
                              squeeze=False)
     ax = axes[0, 0]
@@ -63,17 +68,25 @@ def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path
             ax.plot(x, y, ".", ms=2, color="0.6", alpha=0.5, label="training episodes")
     t, m, s = p["timesteps"], p["eval_return_mean"], p["eval_return_std"]
     color = COLORS.get(config.get("algo"), "tab:green")
-    ax.plot(t, m, "-o", ms=3, color=color, label="evaluation (mean)")
+    sampled = "eval_return_mean_stochastic" in p
+    ax.plot(t, m, "-o", ms=3, color=color, label="evaluation, mean action (mean)")
     ax.fill_between(t, m - s, m + s, color=color, alpha=0.2, lw=0)
+    if sampled:
+        ax.plot(t, p["eval_return_mean_stochastic"], "--s", ms=3, color="black", alpha=0.7,
+                label="evaluation, sampled actions (mean)")
     _steps_axis(ax)
     ax.set_ylabel("episode return")
     ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
-                 f"(seed {config.get('seed', '?')})")
+                 f"(seed {config.get('seed', '?')})" + _interrupted(config))
     ax.legend(loc="best", fontsize=8)
     ax.grid(alpha=0.3)
     if has_success:
         ax = axes[0, 1]
-        ax.plot(t, 100 * p["eval_success_rate"], "-o", ms=3, color=color)
+        ax.plot(t, 100 * p["eval_success_rate"], "-o", ms=3, color=color, label="mean action")
+        if sampled:
+            ax.plot(t, 100 * p["eval_success_rate_stochastic"], "--s", ms=3, color="black",
+                    alpha=0.7, label="sampled actions")
+            ax.legend(loc="best", fontsize=8)
         ax.set_ylim(-5, 105)
         _steps_axis(ax)
         ax.set_ylabel("evaluation success rate (%)")
@@ -110,11 +123,15 @@ def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> P
     for a in agents:
         ls, mk = styles[a]
         ax.plot(t, p[f"eval_return_mean_{a}"], ls=ls, marker=mk, ms=4, color=colors[a],
-                label=f"{a} (evaluation)")
+                label=f"{a} (evaluation, mean action)")
+        if f"eval_return_mean_{a}_stochastic" in p:
+            ax.plot(t, p[f"eval_return_mean_{a}_stochastic"], ls=ls, marker="x", ms=4,
+                    color=colors[a], alpha=0.45, label=f"{a} (sampled actions)")
     _steps_axis(ax)
     ax.set_ylabel("episode return")
     ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
-                 f"{config.get('mode', '')} (seed {config.get('seed', '?')})")
+                 f"{config.get('mode', '')} (seed {config.get('seed', '?')})"
+                 + _interrupted(config))
     ax.legend(loc="best", fontsize=8)
     ax.grid(alpha=0.3)
     if has_success:
@@ -122,7 +139,10 @@ def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> P
         for a in agents:
             ls, mk = styles[a]
             ax.plot(t, 100 * p[f"eval_success_rate_{a}"], ls=ls, marker=mk, ms=4, color=colors[a],
-                    label=a)
+                    label=f"{a} (mean action)")
+            if f"eval_success_rate_{a}_stochastic" in p:
+                ax.plot(t, 100 * p[f"eval_success_rate_{a}_stochastic"], ls=ls, marker="x",
+                        ms=4, color=colors[a], alpha=0.45, label=f"{a} (sampled actions)")
         ax.set_ylim(-5, 105)
         _steps_axis(ax)
         ax.set_ylabel("evaluation success rate (%)")
@@ -143,15 +163,19 @@ def _wall_unit(seconds: float) -> tuple[str, float]:
     return "h", 3600.0
 
 
-def _curves(ax, runs, xkey: str, xscale: float, key: str, scale: float, color, label: str):
+def _curves(ax, runs, xkey: str, xscale: float, key: str, scale: float, color, label: str,
+            ls: str = "-"):
     """One algorithm on one axis: a thin line per seed, the mean over seeds (on the union of the
     runs' x values up to the shortest run's end) and the min-max band."""
+    runs = [(c, p) for c, p in runs if key in p]
+    if not runs:
+        return
     for _, p in runs:
-        ax.plot(p[xkey] / xscale, p[key] * scale, color=color, alpha=0.3, lw=0.8)
+        ax.plot(p[xkey] / xscale, p[key] * scale, color=color, alpha=0.3, lw=0.8, ls=ls)
     end = min(p[xkey][-1] for _, p in runs)
     grid = np.unique(np.concatenate([p[xkey][p[xkey] <= end] for _, p in runs]))
     ys = np.array([np.interp(grid, p[xkey], p[key]) for _, p in runs]) * scale
-    ax.plot(grid / xscale, np.nanmean(ys, axis=0), color=color, lw=2, label=label)
+    ax.plot(grid / xscale, np.nanmean(ys, axis=0), color=color, lw=2, label=label, ls=ls)
     ax.fill_between(grid / xscale, np.nanmin(ys, axis=0), np.nanmax(ys, axis=0), color=color,
                     alpha=0.15, lw=0)
 
@@ -177,7 +201,8 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
     if not by_algo:
         raise FileNotFoundError(f"no runs with a progress.csv below {out}")
     all_runs = [p for runs in by_algo.values() for _, p in runs]
-    has_success = any(np.isfinite(p["eval_success_rate"]).any() for p in all_runs)
+    has_success = any(np.isfinite(p[k]).any() for p in all_runs
+                      for k in ("eval_success_rate", "eval_success_rate_stochastic") if k in p)
     has_wall = all("wall_time_s" in p and np.isfinite(p["wall_time_s"]).all() for p in all_runs)
     xaxes = [("timesteps", 1.0, "environment steps")]
     if has_wall:
@@ -189,7 +214,7 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
     fig, axes = plt.subplots(len(ys), len(xaxes), figsize=(5.5 * len(xaxes), 4 * len(ys)),
                              squeeze=False)
     rows = []
-    fields = ["algo", "seed", *PROGRESS_FIELDS]
+    fields = ["algo", "seed", *(f for f in PROGRESS_FIELDS if any(f in p for p in all_runs))]
     for p in all_runs:
         fields += [k for k in p if k not in fields]
     for algo, runs in sorted(by_algo.items()):
@@ -197,7 +222,9 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
         for i, (key, scale, _) in enumerate(ys):
             for j, (xkey, xscale, _) in enumerate(xaxes):
                 _curves(axes[i, j], runs, xkey, xscale, key, scale, color,
-                        f"{algo.upper()} ({len(runs)} seeds)")
+                        f"{algo.upper()} ({len(runs)} seeds), mean action")
+                _curves(axes[i, j], runs, xkey, xscale, key + "_stochastic", scale, color,
+                        f"{algo.upper()}, sampled actions", ls="--")
         for config, p in runs:
             for k in range(len(p["timesteps"])):
                 rows.append({"algo": algo, "seed": config["seed"],
@@ -211,8 +238,8 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
         what = "evaluation return" if key == "eval_return_mean" else "evaluation success rate"
         for j, (_, _, xlabel) in enumerate(xaxes):
             ax = axes[i, j]
-            ax.set_title(f"{what} (mean over seeds, min-max band)" if (i, j) == (0, 0)
-                         else what, fontsize=10)
+            ax.set_title(f"{what} (mean over seeds, min-max band; dashed: sampled actions)"
+                         if (i, j) == (0, 0) else what, fontsize=9)
             ax.set_xlabel(xlabel)
             if xlabel == "environment steps":
                 _steps_axis(ax)

@@ -56,12 +56,15 @@ def run_gym_episode(model, env, seed: int | None, deterministic: bool = True, on
 
 
 def evaluate_policy(model, env, episodes: int, seed: int, deterministic: bool = True,
-                    on_step=None) -> dict:
+                    on_step=None, on_episode=None) -> dict:
     """``episodes`` episodes of one learner (seeds ``seed, seed+1, ...``): returns, lengths,
-    their means and the success rate (NaN when the task reports none)."""
+    their means and the success rate (NaN when the task reports none). ``on_episode()`` after
+    each episode (e.g. a progress bar's update)."""
     returns, lengths, successes = [], [], []
     for k in range(episodes):
         r, n, s = run_gym_episode(model, env, seed + k, deterministic, on_step)
+        if on_episode is not None:
+            on_episode()
         returns.append(r)
         lengths.append(n)
         if s is not None:
@@ -94,7 +97,7 @@ def run_episode(policies: Mapping[str, Any], env, seed: int | None, deterministi
 
 
 def evaluate_agents(policies: Mapping[str, Any], env, episodes: int, seed: int,
-                    deterministic: bool = True, on_step=None) -> dict:
+                    deterministic: bool = True, on_step=None, on_episode=None) -> dict:
     """``episodes`` episodes (seeds ``seed, seed+1, ...``): per-agent and across-agent numbers.
 
     ``res["agents"][agent]`` has ``returns, lengths, return_mean, return_std, length_mean,
@@ -108,6 +111,8 @@ def evaluate_agents(policies: Mapping[str, Any], env, episodes: int, seed: int,
             per[a]["lengths"].append(n)
             if s is not None:
                 per[a]["successes"].append(s)
+        if on_episode is not None:
+            on_episode()
     res_agents = {}
     for a, d in per.items():
         res_agents[a] = {"returns": d["returns"], "lengths": d["lengths"],

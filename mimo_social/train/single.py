@@ -1,136 +1,131 @@
 """One learner: a one-agent task, or a social task's learner with its partner scripted.
 
 Stable-Baselines3 on the task's Gymnasium env with flattened observations
-(:func:`~mimo_social.train.envs.make_env`), one env, CPU; an SB3 callback evaluates every
-``eval_every`` steps, checkpoints every ``checkpoint_every`` steps, logs every training episode to
+(:func:`~mimo_social.train.envs.make_env`), CPU, ``n_envs`` envs (one: in this process; more: one
+spawned worker process each, :mod:`mimo_social.train.workers`). An SB3 callback
+(:func:`~mimo_social.train.runlog.sb3_callback`) evaluates the deterministic and the stochastic
+policy on the :class:`~mimo_social.train.runlog.Schedule` (by default within an evaluation
+budget), checkpoints every ``checkpoint_every`` steps, logs every training episode to
 ``episodes.csv`` and rewrites ``progress.csv`` and ``learning_curve.png`` after each evaluation.
+SIGINT / SIGTERM stop the run between two steps: it is saved as it stands
+(:mod:`mimo_social.train.interrupt`; ``config.json`` says ``"interrupted": true``).
 """
 
 from __future__ import annotations
 
-import csv
-import math
+import functools
+import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from .envs import make_env
-from .plots import plot_learning_curve
-from .progress import write_config, write_progress
+from .interrupt import StopSignals
+from .progress import write_config
 from .rollouts import evaluate_policy
+from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
 
-__all__ = ["train_single"]
-
-
-def _callbacks(out: Path, eval_env, eval_every: int, eval_episodes: int, eval_seed: int,
-               checkpoint_every: int, total: int, progress: bool, t_start: float):
-    from stable_baselines3.common.callbacks import BaseCallback
-
-    class Periodic(BaseCallback):
-        """Periodic evaluation, checkpoints, per-episode log, the CSVs, the PNG and a progress bar."""
-
-        def __init__(self):
-            super().__init__()
-            self.rows: list[dict] = []
-            self.next_eval = eval_every
-            self.next_ckpt = checkpoint_every if checkpoint_every > 0 else math.inf
-            self.best = -math.inf
-            self.train_returns: list[float] = []
-            self.bar = None
-            self.episodes_file = open(out / "episodes.csv", "w", newline="")
-            self.episodes = csv.writer(self.episodes_file)
-            self.episodes.writerow(["timesteps", "return", "length", "success"])
-
-        def _on_training_start(self):
-            if progress:
-                from tqdm import tqdm
-                self.bar = tqdm(total=total, unit="step", desc=f"{out.name}", dynamic_ncols=True)
-
-        def _on_step(self) -> bool:
-            n = self.num_timesteps
-            for info in self.locals.get("infos", ()):
-                ep = info.get("episode")
-                if ep is not None:
-                    success = info.get("is_success")
-                    self.train_returns.append(float(ep["r"]))
-                    self.episodes.writerow([n, f"{ep['r']:.6g}", int(ep["l"]),
-                                            "" if success is None else int(bool(success))])
-            if self.bar is not None:
-                self.bar.update(n - self.bar.n)
-            if total > n >= self.next_ckpt:  # the last ones follow the last update
-                self.checkpoint(n)
-                while self.next_ckpt <= n:
-                    self.next_ckpt += checkpoint_every
-            if total > n >= self.next_eval:
-                self.evaluate()
-                while self.next_eval <= n:
-                    self.next_eval += eval_every
-            return True
-
-        def checkpoint(self, n):
-            (out / "checkpoints").mkdir(exist_ok=True)
-            self.model.save(out / "checkpoints" / f"model_{n}_steps.zip")
-
-        def evaluate(self):
-            n = self.num_timesteps
-            res = evaluate_policy(self.model, eval_env, eval_episodes, eval_seed)
-            row = {"timesteps": n, "wall_time_s": round(time.perf_counter() - t_start, 2),
-                   "eval_return_mean": res["return_mean"], "eval_return_std": res["return_std"],
-                   "eval_length_mean": res["length_mean"],
-                   "eval_success_rate": res["success_rate"],
-                   "train_return_mean": (float(np.mean(self.train_returns))
-                                         if self.train_returns else float("nan")),
-                   "train_episodes": len(self.train_returns)}
-            self.train_returns = []
-            self.rows.append(row)
-            if res["return_mean"] > self.best:
-                self.best = res["return_mean"]
-                self.model.save(out / "best_model.zip")
-            write_progress(out / "progress.csv", self.rows)
-            self.episodes_file.flush()
-            plot_learning_curve(out)
-            if self.bar is not None:
-                post = {"eval_return": f"{res['return_mean']:.3g}"}
-                if not math.isnan(res["success_rate"]):
-                    post["success"] = f"{res['success_rate']:.0%}"
-                self.bar.set_postfix(post)
-
-        def _on_training_end(self):  # after the model's last update: what model.zip holds
-            if self.next_ckpt <= self.num_timesteps:
-                self.checkpoint(self.num_timesteps)
-            if self.bar is not None:
-                self.bar.update(self.num_timesteps - self.bar.n)
-            self.evaluate()
-            if self.bar is not None:
-                self.bar.close()
-            self.episodes_file.close()
-
-    return Periodic()
+__all__ = ["train_single", "monitored_env", "vector_defaults", "warn"]
 
 
-def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every: int,
+def monitored_env(task: str, env_kwargs: dict):
+    """``make_env(task, **env_kwargs)`` with Gymnasium's ``RecordEpisodeStatistics`` (the
+    ``info["episode"]`` SB3 reads; not SB3's Monitor, so that a worker process does not import
+    torch); module-level: picklable for the workers."""
+    from gymnasium.wrappers import RecordEpisodeStatistics
+    return RecordEpisodeStatistics(make_env(task, **env_kwargs))
+
+
+def warn(text: str) -> None:
+    """A line on stderr that a run's user must see."""
+    print(f"mimo-social train: note: {text}", file=sys.stderr, flush=True)
+
+
+def vector_defaults(algo_kwargs: dict, given, n_envs: int, algo: str) -> dict:
+    """SB3 keyword arguments for ``n_envs`` envs, those not given keeping the one-env learning:
+    PPO's rollout stays 2048 steps (``n_steps = 2048 // n_envs``), SAC keeps one gradient step
+    per env step (``gradient_steps=-1``)."""
+    kw = dict(algo_kwargs)
+    if n_envs > 1 and algo == "ppo" and "n_steps" not in given:
+        kw["n_steps"] = max(64, 2048 // n_envs)
+    if n_envs > 1 and algo == "sac" and "gradient_steps" not in given:
+        kw["gradient_steps"] = -1
+    return kw
+
+
+def finish_config(config: dict, wall: float, timesteps: int, stop: StopSignals,
+                  eval_steps: int) -> dict:
+    config.update({"wall_time_s": round(wall, 1), "timesteps_done": int(timesteps),
+                   "eval_steps_done": int(eval_steps), "interrupted": stop.requested})
+    if stop.requested:
+        config["signal"] = stop.signum
+    return config
+
+
+def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every: int | None,
                  eval_episodes: int, checkpoint_every: int, progress: bool, env_kwargs: dict,
-                 algo_kwargs: dict, verbose: int, config: dict) -> dict:
+                 algo_kwargs: dict, verbose: int, config: dict, n_envs: int = 1,
+                 worker_timeout: float = 600.0) -> dict:
     """The one-learner part of :func:`mimo_social.train.runner.train` (arguments checked
-    there); ``cls`` is the SB3 algorithm class."""
-    from stable_baselines3.common.monitor import Monitor
-    from stable_baselines3.common.vec_env import DummyVecEnv
+    there); ``cls`` is the SB3 algorithm class. ``eval_every=None``: the budgeted schedule."""
+    from .workers import one_learner_vec_env
 
-    write_config(out, config)
-    venv = DummyVecEnv([lambda: Monitor(make_env(task, **env_kwargs))])
+    algo = str(config.get("algo", cls.__name__)).lower()
+    given = config.pop("algo_kwargs_given", None)
+    given = set(algo_kwargs) if given is None else set(given)
+    algo_kwargs = vector_defaults(algo_kwargs, given, int(n_envs), algo)
+    config.update({"algo_kwargs": algo_kwargs, "n_envs": int(n_envs),
+                   "worker_timeout": float(worker_timeout)})
     eval_env = make_env(task, **env_kwargs)
-    model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose, **algo_kwargs)
-    t0 = time.perf_counter()
-    cb = _callbacks(out, eval_env, eval_every, eval_episodes, 10_000 + seed, checkpoint_every,
-                    steps, progress, t0)
-    model.learn(total_timesteps=steps, callback=cb)
-    wall = time.perf_counter() - t0
-    model.save(out / "model.zip")
-    config.update({"wall_time_s": round(wall, 1), "timesteps_done": int(model.num_timesteps)})
-    write_config(out, config)
-    venv.close()
-    eval_env.close()
-    last = cb.rows[-1]
+    venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs)),
+                               int(n_envs), worker_timeout)
+    stop = StopSignals()
+    try:
+        model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose, **algo_kwargs)
+        planned, note = rounding_note(model, algo, steps)
+        if note:
+            warn(note)
+        schedule = Schedule(eval_every, checkpoint_every, steps, episodes=eval_episodes,
+                            episode_steps=episode_limit(eval_env), first=first_update(model))
+        config.update({"steps": steps, "steps_planned": planned, **schedule.describe()})
+        write_config(out, config)
+        bar = None
+        if progress:
+            from tqdm import tqdm
+            bar = tqdm(total=planned, unit="step", desc=f"{out.name}", dynamic_ncols=True)
+        eval_seed = 10_000 + seed
+        log = RunLog(out, None,
+                     lambda k, det: evaluate_policy(model, eval_env, k, eval_seed, det),
+                     lambda: model.save(out / "best_model.zip"), time.perf_counter(), bar,
+                     schedule, eval_seed)
+
+        def checkpoint(n):
+            (out / "checkpoints").mkdir(exist_ok=True)
+            model.save(out / "checkpoints" / f"model_{n}_steps.zip")
+
+        t0 = log.t_start
+        try:
+            with stop:
+                cb = sb3_callback(log, schedule, None, 1, checkpoint, stop)
+                try:
+                    model.learn(total_timesteps=steps, callback=cb)
+                except Exception:
+                    if not stop.requested:   # (a worker killed by the same signal)
+                        raise
+                n = int(model.num_timesteps)   # after the model's last update
+                model.save(out / "model.zip")
+                if schedule.final_checkpoint_due(n) and not stop.requested:
+                    checkpoint(n)
+                if bar is not None:
+                    bar.update(n - bar.n)
+                log.evaluate(n, 1 if stop.requested else schedule.final_episodes())
+        finally:
+            log.close()
+        wall = time.perf_counter() - t0
+        write_config(out, finish_config(config, wall, model.num_timesteps, stop, log.eval_steps))
+    finally:
+        venv.close()
+        eval_env.close()
+    last = log.rows[-1]
     return {"out": str(out), "model": str(out / "model.zip"), "wall_time_s": wall,
-            "timesteps": int(model.num_timesteps), "last_eval": last, "rows": cb.rows}
+            "timesteps": int(model.num_timesteps), "last_eval": last, "rows": log.rows,
+            "interrupted": stop.requested, "signal": stop.signum, "steps_planned": planned}
