@@ -9,8 +9,9 @@
 
 ``mimo-social eval DIR --episodes 10 [--record run.rrd] [--video run.mp4 | --frames DIR]``
     Reloads ``DIR/model.zip`` (``--model best`` or a path for another), runs the episodes with the
-    deterministic policy (``--stochastic`` samples), prints the mean return, success rate and
-    length and writes ``DIR/eval_results.json`` (:mod:`mimo_social.train.evaluation`).
+    deterministic policy (the mean action) and the stochastic one (sampled actions; only one:
+    ``--deterministic`` / ``--stochastic``), prints the mean return, success rate and length of
+    each and writes ``DIR/eval_results.json`` (:mod:`mimo_social.train.evaluation`).
 
 ``mimo-social compare --task standup --algos ppo,sac --seeds 3 --steps 50000 --out runs/cmp``
     Trains every algorithm with seeds 0..n-1 (``--jobs`` processes at a time) into
@@ -31,7 +32,7 @@ from ..train import (ALGOS, ALL_TASKS, MULTI_TASKS, TASKS, TrainInputError, Vide
                      compare, evaluate, train)
 from ..train.comparison import parse_steps_per_algo
 from ._args import (env_kwargs, input_dir, json_object, non_negative_int, output_dir, output_file,
-                    positive_int, seed)
+                    positive_float, positive_int, seed)
 
 __all__ = ["add_parser"]
 
@@ -61,9 +62,10 @@ def _common(p, steps_required: bool = True):
     p.add_argument("--steps", type=positive_int, required=steps_required,
                    help="environment steps to train for")
     p.add_argument("--eval-every", type=positive_int, default=None,
-                   help="steps between evaluations (default: steps / 20)")
+                   help="steps between evaluations (default: a schedule that spends at most "
+                   "10%% of the training steps on evaluation, none before the first update)")
     p.add_argument("--eval-episodes", type=positive_int, default=5,
-                   help="episodes per evaluation")
+                   help="episodes per evaluation, of each policy (deterministic and sampled)")
     p.add_argument("--checkpoint-every", type=non_negative_int, default=None,
                    help="steps between checkpoints (default: steps / 5; 0: none)")
     p.add_argument("--env-kwargs", type=env_kwargs, default={},
@@ -72,7 +74,8 @@ def _common(p, steps_required: bool = True):
                    help="JSON keyword arguments for the SB3 algorithm (default: SB3's defaults)")
     p.add_argument("--normalize-obs", action="store_true",
                    help="normalise every observation input by running statistics inside the "
-                   "policy (mimo_social.train.obs_norm.RunningNorm; saved in the model): for eye images")
+                   "policy (mimo_social.train.obs_norm.RunningNorm; saved in the model): for eye "
+                   "images")
 
 
 #: train options of --engine rllib only, with their defaults
@@ -123,6 +126,27 @@ def _train_rllib(args) -> dict:
                        normalize_obs=args.normalize_obs, **opts)
 
 
+def _sb3_train_kwargs(args) -> dict:
+    """Options of the sb3 engine given on the command line (their defaults are train's)."""
+    kw = {}
+    if args.n_envs is not None:
+        kw["n_envs"] = args.n_envs
+    if args.worker_timeout is not None:
+        kw["worker_timeout"] = args.worker_timeout
+    return kw
+
+
+def _success(last: dict, key: str) -> str:
+    """``, success 80% (mean action), 100% (sampled actions)`` of a progress row (the parts it
+    has; NaN: the task reports no success)."""
+    parts = []
+    for k, what in ((key, "mean action"), (key + "_stochastic", "sampled actions")):
+        value = last.get(k)
+        if value is not None and not math.isnan(value):
+            parts.append(f"{value:.0%} ({what})")
+    return (", success " + ", ".join(parts)) if parts else ""
+
+
 def _train_main(args) -> int:
     conflict = _engine_conflicts(args)
     if conflict:
@@ -136,25 +160,30 @@ def _train_main(args) -> int:
                         eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                         checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
                         env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs,
-                        mode=args.mode, n_envs=args.n_envs, n_cpus=args.n_cpus,
-                        normalize_obs=args.normalize_obs)
+                        mode=args.mode, n_cpus=args.n_cpus, normalize_obs=args.normalize_obs,
+                        **_sb3_train_kwargs(args))
     except TrainInputError as e:
         print(f"mimo-social train: error: {e}", file=sys.stderr)
         return 2
     last = res["last_eval"]
-    success = last["eval_success_rate"]
     mode = f" ({res['mode']})" if res.get("mode") else ""
     engine = " with RLlib" if args.engine == "rllib" else ""
-    print(f"trained {args.algo.upper()}{engine} on {args.task}{mode} for {res['timesteps']} steps in "
-          f"{res['wall_time_s']:.0f} s; last evaluation: return {last['eval_return_mean']:.3g}"
-          + ("" if math.isnan(success) else f", success {success:.0%}"))
+    stopped = " (interrupted)" if res.get("interrupted") else ""
+    print(f"trained {args.algo.upper()}{engine} on {args.task}{mode} for {res['timesteps']} steps "
+          f"in {res['wall_time_s']:.0f} s{stopped}; last evaluation: return "
+          f"{last['eval_return_mean']:.3g}" + _success(last, "eval_success_rate"))
     for a in res.get("agents", ()):
-        s = last[f"eval_success_rate_{a}"]
         print(f"  {a}: return {last[f'eval_return_mean_{a}']:.3g}"
-              + ("" if math.isnan(s) else f", success {s:.0%}"))
+              + _success(last, f"eval_success_rate_{a}"))
     models = sorted({Path(m).name for m in res.get("models", {"": res["model"]}).values()})
     print(f"wrote {res['out']}/" + ("{" + ", ".join(models) + "}" if len(models) > 1 else models[0])
           + ", progress.csv, learning_curve.png")
+    if res.get("interrupted"):
+        from ..train.interrupt import exit_code
+        print(f"mimo-social train: stopped by signal {res['signal']}; the run is saved as it "
+              f"stood at step {res['timesteps']} (config.json: \"interrupted\": true)",
+              file=sys.stderr)
+        return exit_code(res["signal"])
     return 0
 
 
@@ -166,7 +195,23 @@ def _run_engine(run) -> str:
         return "sb3"   # (evaluate says what is missing)
 
 
+def _eval_lines(res: dict, head: str, which: str, models: dict | None) -> None:
+    success = res["success_rate"]
+    print(f"{head}: {res['episodes']} episodes, {which}: return {res['return_mean']:.4g} +- "
+          f"{res['return_std']:.3g}, length {res['length_mean']:.0f}"
+          + ("" if math.isnan(success) else f", success {success:.0%}"))
+    for a, r in res.get("agents", {}).items():
+        s = r["success_rate"]
+        print(f"  {a} ({Path(models[a]).name}): return {r['return_mean']:.4g} +- "
+              f"{r['return_std']:.3g}" + ("" if math.isnan(s) else f", success {s:.0%}"))
+
+
 def _eval_main(args) -> int:
+    if args.stochastic and args.deterministic:
+        print("mimo-social eval: error: --stochastic and --deterministic: give at most one "
+              "(neither: both policies)", file=sys.stderr)
+        return 2
+    both = not (args.stochastic or args.deterministic)
     kwargs = dict(model=args.model, seed=args.seed, deterministic=not args.stochastic,
                   record=args.record, video=args.video, frames=args.frames,
                   frame_every=args.frame_every, env_kwargs=args.env_kwargs)
@@ -175,22 +220,21 @@ def _eval_main(args) -> int:
             from ..train.rllib import require_ray
             require_ray()
             from ..train.rllib import evaluate_rllib
+            both = False
             res = evaluate_rllib(args.dir, args.episodes, **kwargs)
         else:
-            res = evaluate(args.dir, args.episodes, **kwargs)
+            res = evaluate(args.dir, args.episodes, both=both, progress=not args.no_progress,
+                           **kwargs)
     except (VideoUnavailable, FileNotFoundError, TrainInputError) as e:
         print(f"mimo-social eval: error: {e}", file=sys.stderr)
         return 2
-    success = res["success_rate"]
     mode = f" {res['mode']}" if res.get("mode") else ""
-    print(f"{res['task']} {res['algo'].upper()}{mode} {Path(res['model']).name}: "
-          f"{res['episodes']} episodes, return {res['return_mean']:.4g} +- "
-          f"{res['return_std']:.3g}, length {res['length_mean']:.0f}"
-          + ("" if math.isnan(success) else f", success {success:.0%}"))
-    for a, r in res.get("agents", {}).items():
-        s = r["success_rate"]
-        print(f"  {a} ({Path(res['models'][a]).name}): return {r['return_mean']:.4g} +- "
-              f"{r['return_std']:.3g}" + ("" if math.isnan(s) else f", success {s:.0%}"))
+    head = f"{res['task']} {res['algo'].upper()}{mode} {Path(res['model']).name}"
+    _eval_lines(res, head, "mean action (deterministic)" if res["deterministic"]
+                else "sampled actions (stochastic)", res.get("models"))
+    if both:
+        _eval_lines({"episodes": res["episodes"], **res["stochastic"]}, head,
+                    "sampled actions (stochastic)", res.get("models"))
     for key in ("record", "video", "frames"):
         if key in res:
             print(f"wrote {res[key]}")
@@ -280,8 +324,13 @@ def add_parser(subparsers) -> None:
     p.add_argument("--seed", type=seed, default=0)
     p.add_argument("--out", required=True, type=output_dir, help="output directory")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.add_argument("--n-envs", type=positive_int, default=1, help="--mode shared: worlds stepped "
-                   "together (one VecEnv slot per agent of each)")
+    p.add_argument("--n-envs", type=positive_int, default=None, help="envs stepped together: "
+                   "one learner (one-agent tasks, --mode scripted): one spawned worker process "
+                   "each (1: in this process); --mode shared: worlds (one VecEnv slot per agent "
+                   "of each). Default: the CPU cores (at most 16); --mode independent: 1")
+    p.add_argument("--worker-timeout", type=positive_float, default=None, metavar="SECONDS",
+                   help="an env worker process that does not answer within this time is an "
+                   "error naming it (default 600)")
     p.add_argument("--n-cpus", type=non_negative_int, default=0, help="--mode shared: worker "
                    "processes for "
                    "the worlds (0: all in this process)")
@@ -308,7 +357,11 @@ def add_parser(subparsers) -> None:
     p.add_argument("--model", default="final", help="final (model.zip), best (best_model.zip) "
                    "or a path to a .zip")
     p.add_argument("--seed", type=seed, default=0, help="seed of the first episode")
-    p.add_argument("--stochastic", action="store_true", help="sample actions from the policy")
+    p.add_argument("--stochastic", action="store_true", help="only the stochastic policy "
+                   "(sampled actions; default: the deterministic and the stochastic policy)")
+    p.add_argument("--deterministic", action="store_true", help="only the deterministic "
+                   "policy (the mean action)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--record", default=None, type=output_file,
                    help="write a Rerun recording (.rrd)")
     p.add_argument("--video", default=None, type=output_file, help="write an MP4 video (needs "

@@ -12,7 +12,9 @@ catalogue's Gymnasium id; for a social task its learner, the partner scripted):
   after every env reset with a generator seeded by the episode's seed); skipped, with a note,
   where the task has none;
 * each trained run directory (``mimo-social train``): its final ``model.zip`` (or
-  ``best_model.zip``), deterministic, on the flat observations it was trained on.
+  ``best_model.zip``), deterministic, on the flat observations it was trained on; and the same
+  episodes again with its actions sampled (``res["policies"][i]["stochastic"]``, the table's
+  last column), torch seeded with each episode's seed.
 
 Every episode runs in the core's episode loop (:func:`mimo_social.core.episodes.run_episode`).
 
@@ -86,9 +88,15 @@ class _Scripted:
 
 
 class _Trained(ModelPolicy):
-    """A trained run's policy, deterministic, on the flat observations of :func:`make_env`."""
+    """A trained run's policy, deterministic (or sampling, torch seeded with the episode's
+    seed), on the flat observations of :func:`make_env`."""
 
     kind, wrapped = "trained", True
+
+    def reset(self, env, agent: str, rng: np.random.Generator) -> None:
+        if not self.deterministic:
+            import torch
+            torch.manual_seed(int(rng.bit_generator.seed_seq.entropy))
 
     def __init__(self, run: Path, config: dict, model: str):
         path = {"final": run / "model.zip", "best": run / "best_model.zip"}.get(model, Path(model))
@@ -192,9 +200,10 @@ def baselines(task: str, episodes: int = 30, seed: int = 0, runs: Sequence[str |
             policies.append(p)
     from tqdm import tqdm
     results = []
+    trained = sum(p.kind == "trained" for p in policies)
     try:
-        with tqdm(total=episodes * len(policies), unit="episode", disable=not progress,
-                  dynamic_ncols=True) as bar:
+        with tqdm(total=episodes * (len(policies) + trained), unit="episode",
+                  disable=not progress, dynamic_ncols=True) as bar:
             for policy in policies:
                 bar.set_description(policy.name)
                 eps = []
@@ -202,6 +211,18 @@ def baselines(task: str, episodes: int = 30, seed: int = 0, runs: Sequence[str |
                     eps.append(_episode(policy, env, base, seed + k))
                     bar.update(1)
                 results.append(_summary(policy, eps))
+                if policy.kind == "trained":   # the same episodes, actions sampled
+                    bar.set_description(f"{policy.name}, sampled")
+                    policy.deterministic = False
+                    eps = []
+                    for k in range(episodes):
+                        eps.append(_episode(policy, env, base, seed + k))
+                        bar.update(1)
+                    policy.deterministic = True
+                    sampled = _summary(policy, eps)
+                    results[-1]["stochastic"] = {k: v for k, v in sampled.items()
+                                                 if k not in ("policy", "kind", "run", "model",
+                                                              "algo")}
     finally:
         env.close()
     return {"task": task, "episodes": episodes, "seeds": [seed, seed + episodes - 1],
@@ -229,12 +250,18 @@ def markdown_table(res: dict) -> str:
              f"= {res['dt']:g} s, at most {res['max_steps']} steps"
              + (f"; env kwargs {res['env_kwargs']}" if res["env_kwargs"] else ""),
              "",
-             "| policy | episodes | success | return | length | steps to success |",
-             "|---|---|---|---|---|---|"]
+             "| policy | episodes | success | return | length | steps to success "
+             "| success, sampled actions |",
+             "|---|---|---|---|---|---|---|"]
     for r in res["policies"]:
+        sampled = _fmt_success(r["stochastic"]) if "stochastic" in r else "-"
         lines.append(f"| {r['policy']} | {r['episodes']} | {_fmt_success(r)} | "
                      f"{r['return_mean']:.4g} +- {r['return_std']:.3g} | {r['length_mean']:.0f} | "
-                     f"{_fmt_steps(r)} |")
+                     f"{_fmt_steps(r)} | {sampled} |")
+    if any("stochastic" in r for r in res["policies"]):
+        lines += ["", "trained policies: success, return, length and steps to success of the "
+                  "mean action (deterministic); the last column samples the actions "
+                  "(stochastic, as in training; torch seeded with each episode's seed)"]
     if res["notes"]:
         lines.append("")
         lines += [f"note: {n}" for n in res["notes"]]

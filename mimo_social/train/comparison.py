@@ -114,8 +114,13 @@ def compare(task: str, algos=ALGOS, seeds: int = 3, steps: int | Mapping[str, in
             import multiprocessing as mp
             from concurrent.futures import ProcessPoolExecutor
             for kw in runs:
-                kw["progress"] = False
-            with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as ex:
+                kw["progress"] = False   # (one bar over the runs instead)
+            from tqdm import tqdm
+            with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as ex, \
+                    tqdm(total=len(runs), unit="run", desc=f"compare {task}",
+                         disable=not train_kwargs.get("progress", True),
+                         dynamic_ncols=True) as bar:
                 for path, secs in ex.map(_train_quiet, runs):
-                    print(f"done {path} in {secs:.0f} s", flush=True)
+                    bar.write(f"done {path} in {secs:.0f} s")
+                    bar.update(1)
     return plot_compare(out, task)

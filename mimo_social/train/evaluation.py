@@ -2,7 +2,10 @@
 
 ``evaluate(run, episodes=10)`` reloads ``run/model.zip`` (``model="best"`` or a path for another;
 a multi-agent run: every agent's model), runs the episodes with the deterministic policy
-(``deterministic=False`` samples), and writes ``run/eval_results.json``. ``record`` writes a Rerun
+(``deterministic=False`` samples), and writes ``run/eval_results.json``. ``both=True`` also runs
+the same episodes with the stochastic policy (sampled actions, torch seeded with ``seed``): its
+numbers under ``res["stochastic"]`` (recordings, videos and frames are of the first policy
+only). ``progress`` shows a progress bar over the episodes. ``record`` writes a Rerun
 recording of all episodes; ``video`` an MP4 of ``env.render()`` frames, which needs ``imageio``
 with its ffmpeg plugin or an ``ffmpeg`` program (:class:`VideoUnavailable` says so if neither is
 there: ``frames`` writes the frames as PNG files instead).
@@ -113,11 +116,42 @@ class EvalOutputs:
             self._close_video()
 
 
+class _Bar:
+    """A tqdm bar over ``total`` episodes (or nothing), as ``on_episode``."""
+
+    def __init__(self, total: int, enabled: bool, desc: str):
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+            self.bar = tqdm(total=total, unit="episode", desc=desc, dynamic_ncols=True)
+
+    def __call__(self) -> None:
+        if self.bar is not None:
+            self.bar.update(1)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _sampled(run_episodes: Callable[[], dict], seed: int) -> dict:
+    """The stochastic policy's numbers (torch's random numbers forked, seeded with ``seed``)."""
+    import torch
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(seed)
+        res = run_episodes()
+    keep = ("returns", "lengths", "return_mean", "return_std", "length_mean", "success_rate",
+            "agents")
+    return {k: res[k] for k in keep if k in res}
+
+
 def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed: int = 0,
              deterministic: bool = True, record: str | Path | None = None,
              video: str | Path | None = None, frames: str | Path | None = None,
-             frame_every: int = 1, env_kwargs: Mapping[str, Any] | None = None) -> dict:
-    """Reload a trained policy from a ``train`` directory and run ``episodes`` episodes."""
+             frame_every: int = 1, env_kwargs: Mapping[str, Any] | None = None,
+             both: bool = False, progress: bool = False) -> dict:
+    """Reload a trained policy from a ``train`` directory and run ``episodes`` episodes
+    (``both``: with the deterministic and with the stochastic policy; module docstring)."""
     import torch
     torch.set_num_threads(1)
     run = Path(run)
@@ -128,7 +162,8 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     if config.get("mode") is not None:
         return _evaluate_multi(run, config, episodes, model=model, seed=seed,
                               deterministic=deterministic, record=record, video=video,
-                              frames=frames, frame_every=frame_every, env_kwargs=env_kwargs)
+                              frames=frames, frame_every=frame_every, env_kwargs=env_kwargs,
+                              both=both, progress=progress)
     path = {"final": run / "model.zip", "best": run / "best_model.zip"}.get(model, Path(model))
     if not path.exists():
         raise FileNotFoundError(f"model {path} not found (--model final, best or a .zip path)")
@@ -148,9 +183,18 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
             outputs.on_step({agent: np.asarray(action)}, {agent: float(reward)})
 
     t0 = time.perf_counter()
+    bar = _Bar(episodes * (2 if both else 1), progress, f"eval {run.name}")
     try:
-        res = evaluate_policy(policy, env, episodes, seed, deterministic, on_step)
+        res = evaluate_policy(policy, env, episodes, seed, deterministic, on_step, bar)
+        if both:
+            plain = make_env(config["task"], **kw)
+            try:
+                res["stochastic"] = _sampled(lambda: evaluate_policy(
+                    policy, plain, episodes, seed, False, on_episode=bar), seed)
+            finally:
+                plain.close()
     finally:
+        bar.close()
         outputs.close()
         env.close()
     res.update({"task": config["task"], "algo": config["algo"], "model": str(path),
@@ -200,7 +244,8 @@ def _load_policies(run: Path, config: dict, model: str) -> tuple[dict, dict]:
 
 
 def evaluate_with_outputs(policies: Mapping[str, Any], env, inner, episodes: int, seed: int,
-                          deterministic: bool, record, video, frames, frame_every: int) -> dict:
+                          deterministic: bool, record, video, frames, frame_every: int,
+                          on_episode=None) -> dict:
     """Run :func:`evaluate_agents` on ``env`` (its MimoParallelEnv: ``inner``) while recording,
     filming or saving frames as asked; close both; the results with ``wall_time_s`` and the
     ``record`` / ``video`` / ``frames`` paths given. The multi-agent evaluation of either
@@ -216,7 +261,7 @@ def evaluate_with_outputs(policies: Mapping[str, Any], env, inner, episodes: int
 
     t0 = time.perf_counter()
     try:
-        res = evaluate_agents(policies, env, episodes, seed, deterministic, on_step)
+        res = evaluate_agents(policies, env, episodes, seed, deterministic, on_step, on_episode)
     finally:
         outputs.close()
         env.close()
@@ -229,7 +274,8 @@ def evaluate_with_outputs(policies: Mapping[str, Any], env, inner, episodes: int
 
 def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed: int,
                    deterministic: bool, record, video, frames, frame_every: int,
-                   env_kwargs: Mapping[str, Any] | None) -> dict:
+                   env_kwargs: Mapping[str, Any] | None, both: bool = False,
+                   progress: bool = False) -> dict:
     """The multi-agent part of :func:`evaluate`."""
     policies, paths = _load_policies(run, config, model)
     kw = dict(config.get("env_kwargs", {}))
@@ -237,8 +283,19 @@ def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed:
     want_frames = video is not None or frames is not None
     make = make_scripted_env if config["mode"] == "scripted" else make_parallel_env
     env = make(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
-    res = evaluate_with_outputs(policies, env, env.unwrapped, episodes, seed, deterministic,
-                                record, video, frames, frame_every)
+    bar = _Bar(episodes * (2 if both else 1), progress, f"eval {run.name}")
+    try:
+        res = evaluate_with_outputs(policies, env, env.unwrapped, episodes, seed, deterministic,
+                                    record, video, frames, frame_every, bar)
+        if both:
+            plain = make(config["task"], **kw)
+            try:
+                res["stochastic"] = _sampled(lambda: evaluate_agents(
+                    policies, plain, episodes, seed, False, on_episode=bar), seed)
+            finally:
+                plain.close()
+    finally:
+        bar.close()
     res.update({"task": config["task"], "algo": config["algo"], "mode": config["mode"],
                 "model": paths[next(iter(paths))], "models": paths, "episodes": episodes,
                 "deterministic": deterministic, "seed": seed})
