@@ -71,11 +71,12 @@ def _common(p, steps_required: bool = True):
     p.add_argument("--env-kwargs", type=env_kwargs, default={},
                    help="JSON keyword arguments for the env, e.g. '{\"max_steps\": 200}'")
     p.add_argument("--algo-kwargs", type=json_object, default={},
-                   help="JSON keyword arguments for the SB3 algorithm (default: SB3's defaults)")
-    p.add_argument("--normalize-obs", action="store_true",
-                   help="normalise every observation input by running statistics inside the "
-                   "policy (mimo_social.train.obs_norm.RunningNorm; saved in the model): for eye "
-                   "images")
+                   help="JSON keyword arguments for the SB3 algorithm, over the hyperparameters "
+                   "shipped for the task (docs/hyperparameters.md); every key is checked before "
+                   "anything runs")
+    p.add_argument("--normalize-obs", action=argparse.BooleanOptionalAction, default=None,
+                   help="normalise the (non-image) observation inputs by running statistics "
+                   "inside the policy (saved in the model); default: the task's shipped setting")
 
 
 #: train options of --engine rllib only, with their defaults
@@ -123,7 +124,7 @@ def _train_rllib(args) -> dict:
                        eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                        checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
                        env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs,
-                       normalize_obs=args.normalize_obs, **opts)
+                       normalize_obs=bool(args.normalize_obs), **opts)
 
 
 def _sb3_train_kwargs(args) -> dict:
@@ -133,6 +134,10 @@ def _sb3_train_kwargs(args) -> dict:
         kw["n_envs"] = args.n_envs
     if args.worker_timeout is not None:
         kw["worker_timeout"] = args.worker_timeout
+    if getattr(args, "flat_obs", False):
+        kw["flat_obs"] = True
+    if getattr(args, "frame_stack", None) is not None:
+        kw["frame_stack"] = args.frame_stack
     return kw
 
 
@@ -295,7 +300,8 @@ def _compare_rllib(args, algos, steps):
                          plot_only=args.plot_only, mode=args.mode, eval_every=args.eval_every,
                          eval_episodes=args.eval_episodes,
                          checkpoint_every=args.checkpoint_every, env_kwargs=args.env_kwargs,
-                         algo_kwargs=args.algo_kwargs, normalize_obs=args.normalize_obs, **opts)
+                         algo_kwargs=args.algo_kwargs, normalize_obs=bool(args.normalize_obs),
+                         **opts)
 
 
 def _compare_run(args, algos):
@@ -327,7 +333,13 @@ def add_parser(subparsers) -> None:
     p.add_argument("--n-envs", type=positive_int, default=None, help="envs stepped together: "
                    "one learner (one-agent tasks, --mode scripted): one spawned worker process "
                    "each (1: in this process); --mode shared: worlds (one VecEnv slot per agent "
-                   "of each). Default: the CPU cores (at most 16); --mode independent: 1")
+                   "of each). Default: one learner: the CPU cores (at most 16); --mode shared "
+                   "and independent: 1")
+    p.add_argument("--flat-obs", action="store_true", help="a learner with eyes sees one flat "
+                   "vector (its images flattened, an MLP) instead of its images through the "
+                   "CNN (docs/training_vision.md)")
+    p.add_argument("--frame-stack", type=positive_int, default=None, help="frames of each eye "
+                   "image the CNN sees at once (default 1): memory of the last k steps")
     p.add_argument("--worker-timeout", type=positive_float, default=None, metavar="SECONDS",
                    help="an env worker process that does not answer within this time is an "
                    "error naming it (default 600)")

@@ -55,7 +55,7 @@ from ..util.checks import number_array
 __all__ = ["ParallelWrapper", "FlattenParallel", "NumericInfos", "INFO_KINDS", "FlatActionWrapper",
            "FlatObservationWrapper", "ExpressionActionWrapper", "is_expression_only",
            "flat_action_space", "flat_observation_space", "ObsFlattener", "ActionDecoder",
-           "DictObservationWrapper", "image_keys", "is_image_box", "VECTOR_KEY"]
+           "DictObservationWrapper", "ImageDict", "image_keys", "is_image_box", "VECTOR_KEY"]
 
 LOGIT_LOW, LOGIT_HIGH = -1.0, 1.0
 
@@ -143,22 +143,22 @@ def image_keys(space: spaces.Space) -> tuple[str, ...]:
     return tuple(k for k, sub in space.spaces.items() if is_image_box(sub))
 
 
-class DictObservationWrapper(gym.Wrapper):
-    """A Gymnasium env's ``Dict`` observation with images as the ``Dict`` SB3's
-    ``MultiInputPolicy`` takes (see the module docstring): image keys channel-first ``uint8``
-    ``(C * frame_stack, H, W)``, the rest one float32 Box under :data:`VECTOR_KEY`.
+class ImageDict:
+    """One agent's ``Dict`` observation with images as the ``Dict`` SB3's ``MultiInputPolicy``
+    takes (see the module docstring): image keys channel-first ``uint8`` ``(C * frame_stack,
+    H, W)``, the rest one float32 Box under :data:`VECTOR_KEY`; ``space`` is that Dict.
+    ``self(obs, first)``: the observation (``first``: an episode's first, which fills every
+    stacked slot with its frame; later ones drop the oldest frame, the newest goes last).
 
     ``frame_stack`` (>= 1): how many frames of each image key are stacked along the channels,
-    oldest first; ``reset`` fills every slot with its frame. ``C * frame_stack`` may not exceed
-    ``min(H, W)``: SB3 takes the smallest axis of an image for its channels.
+    oldest first. ``C * frame_stack`` may not exceed ``min(H, W)``: SB3 takes the smallest axis
+    of an image for its channels.
     """
 
-    def __init__(self, env: gym.Env, frame_stack: int = 1):
-        super().__init__(env)
-        space = env.observation_space
+    def __init__(self, space: spaces.Space, frame_stack: int = 1):
         self.image_keys = image_keys(space)
         if not self.image_keys:
-            raise TypeError(f"DictObservationWrapper needs a Dict observation with an image "
+            raise TypeError(f"an image Dict needs a Dict observation with an image "
                             f"(a uint8 Box (H, W) or (H, W, C<=4), bounds 0..255), got {space}")
         if (isinstance(frame_stack, bool) or not isinstance(frame_stack, (int, np.integer))
                 or frame_stack < 1):
@@ -186,10 +186,10 @@ class DictObservationWrapper(gym.Wrapper):
             out[VECTOR_KEY] = self._vector.space
         else:
             self._vector = None
-        self.observation_space = spaces.Dict(out)
+        self.space = spaces.Dict(out)
         self._frames = {key: np.zeros(out[key].shape, np.uint8) for key in self.image_keys}
 
-    def _observe(self, obs: Mapping[str, Any], first: bool) -> dict[str, np.ndarray]:
+    def __call__(self, obs: Mapping[str, Any], first: bool) -> dict[str, np.ndarray]:
         out = {}
         for key, c in self._channels.items():
             img = np.asarray(obs[key], dtype=np.uint8)
@@ -205,13 +205,25 @@ class DictObservationWrapper(gym.Wrapper):
             out[VECTOR_KEY] = self._vector(obs)
         return out
 
+
+class DictObservationWrapper(gym.Wrapper):
+    """A Gymnasium env's ``Dict`` observation with images as :class:`ImageDict` gives it (the
+    ``Dict`` SB3's ``MultiInputPolicy`` takes), ``frame_stack`` frames of each image."""
+
+    def __init__(self, env: gym.Env, frame_stack: int = 1):
+        super().__init__(env)
+        self._images = ImageDict(env.observation_space, frame_stack)
+        self.image_keys = self._images.image_keys
+        self.frame_stack = self._images.frame_stack
+        self.observation_space = self._images.space
+
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         obs, info = self.env.reset(seed=seed, options=options)
-        return self._observe(obs, True), info
+        return self._images(obs, True), info
 
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
-        return self._observe(obs, False), reward, terminated, truncated, info
+        return self._images(obs, False), reward, terminated, truncated, info
 
 
 # -- actions ------------------------------------------------------------------------------------
@@ -356,12 +368,19 @@ class ParallelWrapper(ParallelEnv):
 
 
 class FlattenParallel(ParallelWrapper):
-    """Box observations and Box actions for every agent of a ParallelEnv (see module docstring)."""
+    """Box observations and Box actions for every agent of a ParallelEnv (see module docstring).
 
-    def __init__(self, env: ParallelEnv):
+    ``keep_images``: an agent whose observation has images gets the :class:`ImageDict` of it
+    instead (images channel-first, ``frame_stack`` frames, the rest one flat ``"vector"``: what
+    SB3's ``MultiInputPolicy`` takes); agents without images keep the flat Box."""
+
+    def __init__(self, env: ParallelEnv, keep_images: bool = False, frame_stack: int = 1):
         super().__init__(env)
         self.possible_agents = list(env.possible_agents)
-        self._obs = {a: ObsFlattener(env.observation_space(a)) for a in self.possible_agents}
+        self._obs = {a: (ImageDict(env.observation_space(a), frame_stack)
+                         if keep_images and image_keys(env.observation_space(a))
+                         else ObsFlattener(env.observation_space(a)))
+                     for a in self.possible_agents}
         self._act = {a: ActionDecoder(env.action_space(a)) for a in self.possible_agents}
         self._obs_spaces = {a: f.space for a, f in self._obs.items()}
         self._act_spaces = {a: d.space for a, d in self._act.items()}
@@ -380,12 +399,16 @@ class FlattenParallel(ParallelWrapper):
             raise KeyError(f"unknown agent {agent!r}; agents of this env: "
                            f"{self.possible_agents}") from None
 
-    def _flat_obs(self, obs: Mapping[str, Any]) -> dict:
-        return {a: (self._obs[a](o) if a in self._obs else o) for a, o in obs.items()}
+    def _flat_obs(self, obs: Mapping[str, Any], first: bool = False) -> dict:
+        out = {}
+        for a, o in obs.items():
+            f = self._obs.get(a)
+            out[a] = o if f is None else f(o, first) if isinstance(f, ImageDict) else f(o)
+        return out
 
     def reset(self, seed: int | None = None, options: dict | None = None):
         obs, infos = self.env.reset(seed=seed, options=options)
-        return self._flat_obs(obs), infos
+        return self._flat_obs(obs, first=True), infos
 
     def step(self, actions: Mapping[str, Any]):
         if not isinstance(actions, Mapping):

@@ -36,7 +36,7 @@ import numpy as np
 from ..core.episodes import run_episode
 from ..envs.catalog import entry
 from ..partners.base import zero_action
-from .envs import make_env
+from .envs import make_env, run_observation
 from .rollouts import ModelPolicy
 from .tasks import TrainInputError, algo_class, check_task
 
@@ -89,7 +89,8 @@ class _Scripted:
 
 class _Trained(ModelPolicy):
     """A trained run's policy, deterministic (or sampling, torch seeded with the episode's
-    seed), on the flat observations of :func:`make_env`."""
+    seed), on the observations of :func:`make_env` it was trained on (flat, or images and a
+    vector)."""
 
     kind, wrapped = "trained", True
 
@@ -182,7 +183,12 @@ def baselines(task: str, episodes: int = 30, seed: int = 0, runs: Sequence[str |
     runs = [str(r) for r in runs]
     configs = [_load_run(r, task) for r in runs]
     kw, notes = _env_kwargs(configs, runs, env_kwargs)
-    env = make_env(task, **kw)
+    layouts = [run_observation(c) for c in configs]
+    if any(x != layouts[0] for x in layouts[1:]):
+        raise TrainInputError("the runs were trained on different observation layouts ("
+                              + "; ".join(f"{r}: {x}" for r, x in zip(runs, layouts))
+                              + "); compare runs of one layout at a time")
+    env = make_env(task, **(layouts[0] if layouts else {"flat": True}), **kw)
     base = env.unwrapped
     policies: list = [_Random(base.action_space), _Zero(base.action_space)]
     if e.controller is None:

@@ -106,6 +106,9 @@ def compare(task: str, algos=ALGOS, seeds: int = 3, steps: int | Mapping[str, in
     runs = [dict(task=task, algo=a, steps=steps[a], seed=s, out=str(out / f"{a}_seed{s}"),
                  algo_kwargs=kwargs[a], **train_kwargs) for a in algos for s in range(int(seeds))]
     if not plot_only:
+        from .hyperparams import resolve
+        for a in algos:   # every algorithm's keyword arguments checked before any run starts
+            resolve(task, a, kwargs[a], mode=mode, steps=steps[a])
         out.mkdir(parents=True, exist_ok=True)
         if jobs <= 1:
             for kw in runs:

@@ -42,7 +42,7 @@ from torch import nn
 
 from .obs_norm import RunningNorm
 
-__all__ = ["ImageEncoder", "EyesExtractor", "policy_spec", "image_space_keys"]
+__all__ = ["ImageEncoder", "EyesExtractor", "policy_spec", "policy_for", "image_space_keys"]
 
 #: the side (px) at or below which no further stride-2 convolution is added
 MAX_FINAL_SIDE = 8
@@ -174,3 +174,26 @@ def policy_spec(observation_space: spaces.Space, **extractor_kwargs: Any) -> tup
         raise TypeError(f"extractor keyword arguments {sorted(extractor_kwargs)} given for an "
                         "observation without images (MlpPolicy has no image extractor)")
     return "MlpPolicy", {}
+
+
+def policy_for(observation_space: spaces.Space, algo_kwargs: dict,
+               normalize_obs: bool = False) -> tuple[str, dict]:
+    """What the trainers build: the SB3 policy name and the algorithm's keyword arguments for
+    an observation space. Images: :func:`policy_spec`'s ``MultiInputPolicy`` with the CNN
+    (``normalize_obs``: running statistics over the ``"vector"`` part); otherwise
+    ``MlpPolicy`` (``normalize_obs``: :class:`~mimo_social.train.obs_norm.RunningNorm` over the
+    whole input). The ``policy_kwargs`` of ``algo_kwargs`` (the shipped hyperparameters and the
+    command line's) are merged over these."""
+    kwargs = dict(algo_kwargs)
+    own = dict(kwargs.pop("policy_kwargs", None) or {})
+    if image_space_keys(observation_space):
+        policy, base = policy_spec(observation_space,
+                                   **({"normalize_vector": True} if normalize_obs else {}))
+    else:
+        policy, base = policy_spec(observation_space)
+        if normalize_obs:
+            base = {"features_extractor_class": RunningNorm}
+    merged = {**base, **own}
+    if merged:
+        kwargs["policy_kwargs"] = merged
+    return policy, kwargs

@@ -30,13 +30,13 @@ from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
 from ..core.wrappers import (DictObservationWrapper, ExpressionActionWrapper, FlatActionWrapper,
-                             FlatObservationWrapper, FlattenParallel, image_keys,
-                             is_expression_only)
+                             FlatObservationWrapper, FlattenParallel, ImageDict, ObsFlattener,
+                             image_keys, is_expression_only)
 from ..envs.catalog import entry, register_envs
 from .tasks import check_task, task_module
 
-__all__ = ["make_env", "make_parallel_env", "make_scripted_env", "make_sb3_single",
-           "with_render", "world_vec_env", "call_world", "vec_worker"]
+__all__ = ["run_observation", "PolicyInput", "make_env", "make_parallel_env", "make_scripted_env",
+           "make_sb3_single", "with_render", "world_vec_env", "call_world", "vec_worker"]
 
 
 def with_render(env_kwargs: Mapping[str, Any], render_mode: str | None) -> dict:
@@ -58,14 +58,48 @@ def make_env(task: str, render_mode: str | None = None, *, flat: bool = False,
                            **with_render(env_kwargs, render_mode))
 
 
-def make_parallel_env(task: str, render_mode: str | None = None, **env_kwargs):
-    """``FlattenParallel(parallel_env(...))``: all agents, Box observations and actions."""
-    return FlattenParallel(task_module(task).parallel_env(**with_render(env_kwargs, render_mode)))
+def make_parallel_env(task: str, render_mode: str | None = None, *, flat: bool = True,
+                      frame_stack: int = 1, **env_kwargs):
+    """``FlattenParallel(parallel_env(...))``: all agents, Box actions; Box observations, or
+    (``flat=False``) for agents with eyes the image ``Dict`` of :class:`ImageDict` with
+    ``frame_stack`` frames."""
+    return FlattenParallel(task_module(task).parallel_env(**with_render(env_kwargs, render_mode)),
+                           keep_images=not flat, frame_stack=frame_stack)
 
 
-def make_scripted_env(task: str, render_mode: str | None = None, **env_kwargs):
-    """``FlattenParallel(scripted_env(...))``: the learner only (its partner scripted)."""
-    return FlattenParallel(task_module(task).scripted_env(**with_render(env_kwargs, render_mode)))
+def make_scripted_env(task: str, render_mode: str | None = None, *, flat: bool = False,
+                      frame_stack: int = 1, **env_kwargs):
+    """``FlattenParallel(scripted_env(...))``: the learner only (its partner scripted), with the
+    observations of :func:`make_env` (the image ``Dict`` when it has eyes, unless ``flat``)."""
+    return FlattenParallel(task_module(task).scripted_env(**with_render(env_kwargs, render_mode)),
+                           keep_images=not flat, frame_stack=frame_stack)
+
+
+def run_observation(config: Mapping[str, Any]) -> dict:
+    """The observation layout a run was trained on (``make_env``'s ``flat`` and
+    ``frame_stack``), from its ``config.json``; runs written before it was recorded were flat."""
+    obs = dict(config.get("observation") or {})
+    return {"flat": bool(obs.get("flat", True)), "frame_stack": int(obs.get("frame_stack", 1))}
+
+
+class PolicyInput:
+    """What a run's policy observes, made from one agent's observation as the env gives it:
+    the flat vector (:class:`ObsFlattener`), or for a run trained on images the
+    :class:`ImageDict` (``frame_stack`` frames). ``self(obs, first)``; ``first``: an episode's
+    first observation. ``space``: the policy's observation space."""
+
+    def __init__(self, config: Mapping[str, Any], space: spaces.Space):
+        layout = run_observation(config)
+        self._images = None
+        if not layout["flat"] and image_keys(space):
+            self._images = ImageDict(space, layout["frame_stack"])
+            self.space = self._images.space
+        else:
+            self._flat = ObsFlattener(space)
+            self.space = self._flat.space
+
+    def __call__(self, obs, first: bool):
+        return self._images(obs, first) if self._images is not None else self._flat(obs)
 
 
 def make_sb3_single(env_id_or_env, *, flat: bool = False, frame_stack: int = 1,

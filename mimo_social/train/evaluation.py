@@ -13,6 +13,8 @@ there: ``frames`` writes the frames as PNG files instead).
 
 from __future__ import annotations
 
+import functools
+
 import json
 import shutil
 import subprocess
@@ -22,7 +24,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .envs import make_env, make_parallel_env, make_scripted_env
+from .envs import make_env, make_parallel_env, make_scripted_env, run_observation
 from .rollouts import evaluate_agents, evaluate_policy
 from .tasks import algo_class
 
@@ -171,7 +173,8 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     kw = dict(config.get("env_kwargs", {}))
     kw.update(env_kwargs or {})
     want_frames = video is not None or frames is not None
-    env = make_env(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
+    obs = run_observation(config)     # the layout the run was trained on
+    env = make_env(config["task"], render_mode="rgb_array" if want_frames else None, **obs, **kw)
     penv = env.unwrapped.parallel
     outputs = EvalOutputs(env, penv, record, video, frames, frame_every)
     agent = penv.possible_agents[0]
@@ -187,7 +190,7 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     try:
         res = evaluate_policy(policy, env, episodes, seed, deterministic, on_step, bar)
         if both:
-            plain = make_env(config["task"], **kw)
+            plain = make_env(config["task"], **obs, **kw)
             try:
                 res["stochastic"] = _sampled(lambda: evaluate_policy(
                     policy, plain, episodes, seed, False, on_episode=bar), seed)
@@ -281,7 +284,9 @@ def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed:
     kw = dict(config.get("env_kwargs", {}))
     kw.update(env_kwargs or {})
     want_frames = video is not None or frames is not None
-    make = make_scripted_env if config["mode"] == "scripted" else make_parallel_env
+    make = functools.partial(
+        make_scripted_env if config["mode"] == "scripted" else make_parallel_env,
+        **(run_observation(config) if config["mode"] == "scripted" else {}))
     env = make(config["task"], render_mode="rgb_array" if want_frames else None, **kw)
     bar = _Bar(episodes * (2 if both else 1), progress, f"eval {run.name}")
     try:

@@ -82,7 +82,10 @@ def train_independent(cls, algo_kwargs, task, env_kwargs, steps, seed, out, eval
     from stable_baselines3.common.monitor import Monitor
     from stable_baselines3.common.vec_env import DummyVecEnv
 
-    env = make_parallel_env(task, **env_kwargs)
+    from .encoders import policy_for
+
+    normalize_obs = bool((config or {}).get("normalize_obs"))
+    env = make_parallel_env(task, **env_kwargs)   # flat observations (one space per agent)
     agents = list(env.possible_agents)
     models: dict[str, Any] = {}
     log = RunLog(out, agents,
@@ -96,8 +99,8 @@ def train_independent(cls, algo_kwargs, task, env_kwargs, steps, seed, out, eval
         for k, a in enumerate(agents):  # built in order: each seeds the global RNGs (SB3)
             view = hub.view(a)
             venv = DummyVecEnv([lambda v=view: Monitor(v)])
-            models[a] = cls("MlpPolicy", venv, seed=seed + k, device="cpu", verbose=verbose,
-                            **algo_kwargs)
+            policy, kw = policy_for(venv.observation_space, algo_kwargs, normalize_obs)
+            models[a] = cls(policy, venv, seed=seed + k, device="cpu", verbose=verbose, **kw)
         first = models[agents[0]]
         schedule.first = first_update(first)
         if config is not None:

@@ -83,11 +83,17 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
     if mode == "scripted" and n_cpus != 0:
         raise TrainInputError(f"--n-cpus is for --mode shared; --mode scripted runs one worker "
                               f"process per env when n_envs > 1 (got n_cpus={n_cpus})")
+    from .hyperparams import to_json
+
     cls = algo_class(algo)
     module = task_module(task)
     config.update({"env_module": module.__name__, "mode": mode, "n_envs": n_envs,
                    "n_cpus": n_cpus, "worker_timeout": float(worker_timeout)})
-    eval_env = (make_scripted_env if mode == "scripted" else make_parallel_env)(task, **env_kwargs)
+    # scripted: the learner's observations as make_env gives them (images for the CNN); shared
+    # and independent: flat (the runner says so in config["observation"])
+    observation = dict(config.get("observation", {"flat": mode != "scripted"}))
+    eval_env = (make_scripted_env if mode == "scripted" else make_parallel_env)(
+        task, **observation, **env_kwargs)
     if mode == "shared":
         try:
             check_shared_spaces(eval_env, task)
@@ -105,7 +111,7 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
     if mode == "scripted":
         algo_kwargs = vector_defaults(algo_kwargs, set(algo_kwargs if given is None else given),
                                       int(n_envs), algo)
-        config["algo_kwargs"] = algo_kwargs
+    config["algo_kwargs"] = to_json(algo_kwargs)
     if mode == "independent":
         config["models"] = {a: f"model_{a}.zip" for a in agents}
     else:
@@ -156,6 +162,8 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
     """shared (one policy, one VecEnv slot per agent) and scripted (one learner) modes."""
     from stable_baselines3.common.vec_env import VecMonitor
 
+    from .encoders import policy_for
+
     agents = list(eval_env.possible_agents)
     if mode == "shared":
         from supersuit.vector.sb3_vector_wrapper import SB3VecEnvWrapper
@@ -172,11 +180,15 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
         per_env_step = len(agents)
     else:
         from .workers import one_learner_vec_env
-        venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs)),
+        venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs),
+                                                     config.get("observation")),
                                    int(n_envs), worker_timeout)
         per_env_step = 1
     try:
-        model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose, **algo_kwargs)
+        policy, kw = policy_for(venv.observation_space, algo_kwargs,
+                                bool(config.get("normalize_obs")))
+        config["policy"] = policy
+        model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
         planned, note = rounding_note(model, algo, steps, per_env_step)
         if note:
             warn(note)

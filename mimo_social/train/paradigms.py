@@ -75,14 +75,22 @@ class _Zero:
         return self.action
 
 
+def _shapes(space):
+    """A space's shape, or a Dict's key -> shape (what a policy's input must match)."""
+    if hasattr(space, "spaces") and isinstance(space.spaces, Mapping):
+        return {k: _shapes(v) for k, v in space.spaces.items()}
+    return space.shape
+
+
 class _Trained:
-    """A trained run's policy (SB3), deterministic, on the flat observation it was trained on
-    (:class:`~mimo_social.core.wrappers.FlattenParallel`'s: the parts in order, images in
-    [0, 1]); its flat action decoded onto the learner's action space."""
+    """A trained run's policy (SB3), deterministic, on the observation it was trained on
+    (:class:`~mimo_social.train.envs.PolicyInput`: flat, or images and a vector for a run that
+    saw through the CNN); its flat action decoded onto the learner's action space."""
 
     def __init__(self, run: Path, config: Mapping[str, Any], model: str, obs_space, act_space,
                  deterministic: bool = True):
-        from ..core.wrappers import ActionDecoder, ObsFlattener
+        from ..core.wrappers import ActionDecoder
+        from .envs import PolicyInput
         from .tasks import algo_class
         path = {"final": run / "model.zip", "best": run / "best_model.zip"}[model]
         if not path.exists():
@@ -91,24 +99,28 @@ class _Trained:
         import torch
         torch.set_num_threads(1)
         self.model = algo_class(config["algo"]).load(str(path), device="cpu")
-        self.flatten, self.decode = ObsFlattener(obs_space), ActionDecoder(act_space)
-        if self.model.observation_space.shape != self.flatten.space.shape:
+        self.observe, self.decode = PolicyInput(config, obs_space), ActionDecoder(act_space)
+        self._first = True
+        if _shapes(self.model.observation_space) != _shapes(self.observe.space):
             raise TrainInputError(f"run {run}: its policy observes "
-                                  f"{self.model.observation_space.shape} floats, the env gives "
-                                  f"{self.flatten.space.shape}: evaluate with the env settings "
-                                  "it was trained with (--env-kwargs)")
+                                  f"{_shapes(self.model.observation_space)}, the env gives "
+                                  f"{_shapes(self.observe.space)}: evaluate with the env "
+                                  "settings it was trained with (--env-kwargs)")
         self.deterministic = bool(deterministic)
         self.name = (f"{run.name} ({config['algo'].upper()}"
                      + ("" if self.deterministic else ", sampled") + ")")
         self.run = str(run)
 
     def reset(self, env, agent, rng) -> None:
+        self._first = True
         if not self.deterministic:   # the sampled actions: seeded per episode
             import torch
             torch.manual_seed(int(rng.integers(2**31)))
 
     def act(self, env, agent, obs):
-        action = self.model.predict(self.flatten(obs), deterministic=self.deterministic)[0]
+        seen = self.observe(obs, self._first)
+        self._first = False
+        action = self.model.predict(seen, deterministic=self.deterministic)[0]
         return self.decode(action, agent)
 
 

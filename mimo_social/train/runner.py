@@ -5,20 +5,22 @@ run's ``config.json``, then hands over to :func:`~mimo_social.train.single.train
 learner: a one-agent task) or :func:`~mimo_social.train.multi.train_multi` (a social task in
 ``--mode shared | independent | scripted``).
 
-Stable-Baselines3 with its default hyperparameters (as in the paper: PPO with two hidden layers of
-64, SAC with two of 256), CPU, ``torch`` on one thread. One change to SAC's defaults: the replay
-buffer holds ``min(1e6, steps)`` transitions (it could never hold more; SB3 would allocate room
-for a million of these large observations). ``algo_kwargs`` and ``env_kwargs`` override. A run
-writes to ``out``:
+Stable-Baselines3, CPU, ``torch`` on one thread, with the hyperparameters shipped for the task
+and algorithm (:mod:`mimo_social.train.hyperparams`, docs/hyperparameters.md: SB3's defaults
+unless a measurement here says otherwise; SAC's replay buffer capped at the run's steps), which
+``algo_kwargs`` override key by key (every key checked before anything runs). A learner with eyes
+sees its images through a CNN (:mod:`mimo_social.train.encoders`, docs/training_vision.md).
+Evaluations follow a budget (at most ~10 % of the training steps, none before the first update;
+docs/training.md) and run the deterministic and the sampled policy. A run writes to ``out``:
 
-* ``config.json``: task, algorithm, seed, steps and the keyword arguments (what ``eval`` reads);
+* ``config.json``: task, algorithm, seed, steps, the observation layout and the keyword arguments
+  with their provenance (what ``eval`` reads);
 * ``model.zip`` (the final policy) and ``best_model.zip`` (best mean evaluation return);
 * ``checkpoints/model_<steps>_steps.zip`` every ``checkpoint_every`` steps;
-* ``progress.csv``: one row per evaluation (every ``eval_every`` steps and at the end):
-  ``timesteps, wall_time_s, eval_return_mean, eval_return_std, eval_length_mean,
-  eval_success_rate, train_return_mean, train_episodes`` (the evaluation runs ``eval_episodes``
-  deterministic episodes on a separate env, the same seeded episodes every time; the train
-  columns summarise the training episodes since the last row);
+* ``progress.csv``: one row per evaluation (:data:`~mimo_social.train.progress.PROGRESS_FIELDS`:
+  the deterministic policy's ``eval_*`` columns and the sampled policy's ``eval_*_stochastic``,
+  on a separate env, the same seeded episodes every time; the train columns summarise the
+  training episodes since the last row);
 * ``episodes.csv``: every training episode (``timesteps, return, length, success``; multi-agent
   runs: ``timesteps, agent, return, length, success``, one row per agent and episode);
 * ``learning_curve.png``: evaluation return (mean and std) and training returns against steps,
@@ -48,51 +50,80 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           checkpoint_every: int | None = None, progress: bool = True,
           env_kwargs: Mapping[str, Any] | None = None,
           algo_kwargs: Mapping[str, Any] | None = None, verbose: int = 0,
-          mode: str | None = None, n_envs: int = 1, n_cpus: int = 0,
-          normalize_obs: bool = False) -> dict:
+          mode: str | None = None, n_envs: int | None = None, n_cpus: int = 0,
+          normalize_obs: bool | None = None, flat_obs: bool = False, frame_stack: int = 1,
+          worker_timeout: float = 600.0) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
-    time). See the module docstring for what it writes. ``mode`` (``shared``, ``independent``,
-    ``scripted``; default ``shared``), ``n_envs`` and ``n_cpus`` (shared mode: worlds and worker
-    processes) are for the multi-agent tasks (:mod:`mimo_social.train.multi`). ``normalize_obs``
-    puts :class:`~mimo_social.train.obs_norm.RunningNorm` in front of the policy."""
+    time). See the module docstring for what it writes.
+
+    ``mode`` (``shared``, ``independent``, ``scripted``; default ``shared``) is for the
+    multi-agent tasks (:mod:`mimo_social.train.multi`). ``n_envs``: envs stepped for the
+    learner (one learner and ``scripted``: a spawned worker each when more than one; default:
+    the cores this process may use) or worlds (``shared``, with ``n_cpus`` worker processes;
+    default 1). ``eval_every=None``: the budgeted evaluation schedule
+    (:class:`~mimo_social.train.runlog.Schedule`). ``algo_kwargs`` override the shipped
+    hyperparameters (:mod:`mimo_social.train.hyperparams`; every key checked before anything
+    runs). ``normalize_obs`` (None: the task's shipped ``[run]`` default) puts running input
+    statistics in front of the policy. A learner with eyes gets the CNN
+    (:mod:`mimo_social.train.encoders`) unless ``flat_obs``; ``frame_stack`` frames of each
+    image. ``worker_timeout``: seconds a worker may take to answer before the run fails."""
+    from .hyperparams import resolve, run_options, to_json, to_sb3
+
     mode = check_mode(task, mode)
     if mode is not None:
         task_module(task)  # a clear error before anything is written
-    if mode is None and (n_envs != 1 or n_cpus != 0):
-        raise TrainInputError(f"n_envs={n_envs}, n_cpus={n_cpus}: several worlds are for the "
-                              f"multi-agent tasks in --mode shared; {task!r} trains on one env")
-    import torch
-
+    if mode is None and n_cpus != 0:
+        raise TrainInputError(f"n_cpus={n_cpus}: worker processes for worlds are for the "
+                              f"multi-agent tasks in --mode shared; {task!r} takes --n-envs "
+                              "(one spawned worker per env)")
     env_id = check_task(task)
     cls = algo_class(algo)
     steps, seed = int(steps), int(seed)
     if steps < 1:
         raise TrainInputError(f"steps={steps}; allowed: a positive integer")
-    eval_every = int(eval_every) if eval_every else max(steps // 20, 1)
+    if isinstance(frame_stack, bool) or not isinstance(frame_stack, int) or frame_stack < 1:
+        raise TrainInputError(f"frame_stack={frame_stack!r}; allowed: an integer >= 1")
+    if frame_stack > 1 and (flat_obs or mode in ("shared", "independent")):
+        raise TrainInputError(f"frame_stack={frame_stack} stacks eye images for the CNN: not "
+                              "with flat observations (--flat-obs, or --mode shared / "
+                              "independent, whose observations are flat)")
+    # the shipped hyperparameters under the command line's, every key checked: before anything
+    resolved, provenance = resolve(task, algo, algo_kwargs, mode=mode, steps=steps)
+    if normalize_obs is None:
+        normalize_obs = bool(run_options(task, mode).get("normalize_obs", False))
+    if n_envs is None:
+        if mode in ("shared", "independent"):
+            n_envs = 1
+        else:
+            from .workers import default_n_envs
+            n_envs = default_n_envs()
+    import torch
+
+    eval_every = int(eval_every) if eval_every else None
     checkpoint_every = int(checkpoint_every) if checkpoint_every is not None else max(steps // 5, 1)
     torch.set_num_threads(1)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     env_kwargs = dict(env_kwargs or {})
-    kwargs = dict(algo_kwargs or {})
-    if algo == "sac":
-        kwargs.setdefault("buffer_size", min(1_000_000, steps))
-    if normalize_obs:  # running input statistics inside the policy (saved in model.zip)
-        from .obs_norm import RunningNorm
-        kwargs["policy_kwargs"] = {**kwargs.get("policy_kwargs", {}),
-                                   "features_extractor_class": RunningNorm}
+    kwargs = to_sb3(algo, resolved)
+    # the learner's observations: flat for the shared and independent modes (one flat space
+    # per agent); otherwise the image Dict and the CNN when it has eyes, unless flat_obs
+    flat = bool(flat_obs) or mode in ("shared", "independent")
     config = {"task": task, "env_id": env_id, "algo": algo, "steps": steps,
               "seed": seed, "normalize_obs": bool(normalize_obs),
-              "env_kwargs": env_kwargs, "algo_kwargs": kwargs, "eval_every": eval_every,
-              "eval_episodes": eval_episodes, "checkpoint_every": checkpoint_every}
+              "observation": {"flat": flat, "frame_stack": int(frame_stack)},
+              "env_kwargs": env_kwargs, "algo_kwargs": to_json(resolved),
+              "algo_kwargs_provenance": provenance, "eval_every": eval_every,
+              "eval_episodes": eval_episodes, "checkpoint_every": checkpoint_every,
+              "algo_kwargs_given": sorted(algo_kwargs or {})}
     if mode is not None:
-        config["algo_kwargs_given"] = sorted(algo_kwargs or {})
         return train_multi(task, algo, steps, seed, out, mode=mode, eval_every=eval_every,
                            eval_episodes=eval_episodes, checkpoint_every=checkpoint_every,
                            progress=progress, env_kwargs=env_kwargs, algo_kwargs=kwargs,
                            n_envs=int(n_envs), n_cpus=int(n_cpus), verbose=verbose,
-                           config=config)
+                           config=config, worker_timeout=float(worker_timeout))
     return train_single(cls, task, steps, seed, out, eval_every=eval_every,
                         eval_episodes=eval_episodes, checkpoint_every=checkpoint_every,
                         progress=progress, env_kwargs=env_kwargs, algo_kwargs=kwargs,
-                        verbose=verbose, config=config)
+                        verbose=verbose, config=config, n_envs=int(n_envs),
+                        worker_timeout=float(worker_timeout))

@@ -1,8 +1,9 @@
 """One learner: a one-agent task, or a social task's learner with its partner scripted.
 
-Stable-Baselines3 on the task's Gymnasium env with flattened observations
-(:func:`~mimo_social.train.envs.make_env`), CPU, ``n_envs`` envs (one: in this process; more: one
-spawned worker process each, :mod:`mimo_social.train.workers`). An SB3 callback
+Stable-Baselines3 on the task's Gymnasium env (:func:`~mimo_social.train.envs.make_env`: flat
+observations, or images and a vector for a learner with eyes, through the CNN of
+:func:`~mimo_social.train.encoders.policy_for`), CPU, ``n_envs`` envs (one: in this process;
+more: one spawned worker process each, :mod:`mimo_social.train.workers`). An SB3 callback
 (:func:`~mimo_social.train.runlog.sb3_callback`) evaluates the deterministic and the stochastic
 policy on the :class:`~mimo_social.train.runlog.Schedule` (by default within an evaluation
 budget), checkpoints every ``checkpoint_every`` steps, logs every training episode to
@@ -27,12 +28,13 @@ from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note
 __all__ = ["train_single", "monitored_env", "vector_defaults", "warn"]
 
 
-def monitored_env(task: str, env_kwargs: dict):
-    """``make_env(task, **env_kwargs)`` with Gymnasium's ``RecordEpisodeStatistics`` (the
-    ``info["episode"]`` SB3 reads; not SB3's Monitor, so that a worker process does not import
-    torch); module-level: picklable for the workers."""
+def monitored_env(task: str, env_kwargs: dict, observation: dict | None = None):
+    """``make_env(task, **observation, **env_kwargs)`` with Gymnasium's
+    ``RecordEpisodeStatistics`` (the ``info["episode"]`` SB3 reads; not SB3's Monitor, so that a
+    worker process does not import torch); module-level: picklable for the workers.
+    ``observation``: ``flat`` and ``frame_stack`` of :func:`make_env`."""
     from gymnasium.wrappers import RecordEpisodeStatistics
-    return RecordEpisodeStatistics(make_env(task, **env_kwargs))
+    return RecordEpisodeStatistics(make_env(task, **(observation or {}), **env_kwargs))
 
 
 def warn(text: str) -> None:
@@ -67,20 +69,26 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
                  worker_timeout: float = 600.0) -> dict:
     """The one-learner part of :func:`mimo_social.train.runner.train` (arguments checked
     there); ``cls`` is the SB3 algorithm class. ``eval_every=None``: the budgeted schedule."""
+    from .encoders import policy_for     # (torch: not imported by the workers, which import
+    from .hyperparams import to_json     # this module for monitored_env)
     from .workers import one_learner_vec_env
 
     algo = str(config.get("algo", cls.__name__)).lower()
     given = config.pop("algo_kwargs_given", None)
     given = set(algo_kwargs) if given is None else set(given)
     algo_kwargs = vector_defaults(algo_kwargs, given, int(n_envs), algo)
-    config.update({"algo_kwargs": algo_kwargs, "n_envs": int(n_envs),
+    config.update({"algo_kwargs": to_json(algo_kwargs), "n_envs": int(n_envs),
                    "worker_timeout": float(worker_timeout)})
-    eval_env = make_env(task, **env_kwargs)
-    venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs)),
-                               int(n_envs), worker_timeout)
+    observation = dict(config.get("observation", {}))
+    eval_env = make_env(task, **observation, **env_kwargs)
+    venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs),
+                                                 observation), int(n_envs), worker_timeout)
     stop = StopSignals()
     try:
-        model = cls("MlpPolicy", venv, seed=seed, device="cpu", verbose=verbose, **algo_kwargs)
+        policy, kw = policy_for(venv.observation_space, algo_kwargs,
+                                bool(config.get("normalize_obs")))
+        config["policy"] = policy
+        model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
         planned, note = rounding_note(model, algo, steps)
         if note:
             warn(note)

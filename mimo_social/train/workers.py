@@ -50,6 +50,14 @@ def check_timeout(timeout_s) -> float:
     return float(timeout_s)
 
 
+def stack_obs(obs: tuple):
+    """The workers' observations as one batch: an array, or for ``Dict`` observations (images
+    and a vector) a dict key -> array, as SB3's VecEnvs give them."""
+    if isinstance(obs[0], dict):
+        return {k: np.stack([o[k] for o in obs]) for k in obs[0]}
+    return np.stack(obs)
+
+
 class TimedSubprocVecEnv(SubprocVecEnv):
     """SB3's ``SubprocVecEnv`` (spawned workers) whose every wait for a worker ends after
     ``timeout_s`` seconds with a RuntimeError naming the worker (module docstring)."""
@@ -103,7 +111,7 @@ class TimedSubprocVecEnv(SubprocVecEnv):
         results = [self.recv(k) for k in range(len(self.remotes))]
         self.waiting = False
         obs, rews, dones, infos, self.reset_infos = zip(*results)
-        return np.stack(obs), np.stack(rews), np.stack(dones), infos
+        return stack_obs(obs), np.stack(rews), np.stack(dones), infos
 
     def reset(self):
         for k, remote in enumerate(self.remotes):
@@ -112,7 +120,7 @@ class TimedSubprocVecEnv(SubprocVecEnv):
         obs, self.reset_infos = zip(*results)
         self._reset_seeds()
         self._reset_options()
-        return np.stack(obs)
+        return stack_obs(obs)
 
     def kill(self) -> None:
         """End every worker without asking (one that is stuck or dead)."""

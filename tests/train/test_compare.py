@@ -93,8 +93,15 @@ def test_each_algorithm_gets_its_own_steps_and_keyword_arguments(tmp_path, capsy
     configs = {a: json.loads((tmp_path / f"{a}_seed0" / "config.json").read_text())
                for a in ("ppo", "sac")}
     assert configs["ppo"]["steps"] == 128 and configs["sac"]["steps"] == 64
-    assert configs["ppo"]["algo_kwargs"] == TINY_PPO
-    assert configs["sac"]["algo_kwargs"] == {**TINY_SAC, "buffer_size": 64}
+    # the given keys over the shipped hyperparameters, each with its provenance
+    for a, given in (("ppo", TINY_PPO), ("sac", TINY_SAC)):
+        used = configs[a]["algo_kwargs"]
+        assert {k: used[k] for k in given} == given
+        assert all(configs[a]["algo_kwargs_provenance"][k] == "command line" for k in given)
+        assert all(v.startswith("shipped:") for k, v in
+                   configs[a]["algo_kwargs_provenance"].items() if k not in given
+                   and not k.startswith("policy_kwargs"))
+    assert configs["sac"]["algo_kwargs"]["buffer_size"] == 64     # capped at the run's steps
     assert read_progress(tmp_path / "sac_seed0" / "progress.csv")["timesteps"][-1] == 64
     # the command line: --steps-per-algo over --steps, per-algorithm --algo-kwargs
     (tmp_path / "compare.png").unlink()

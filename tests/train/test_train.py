@@ -11,6 +11,7 @@ import torch
 
 from mimo_social import cli
 from mimo_social.train import compare, evaluate, read_progress, train
+from mimo_social.train.tasks import TrainInputError
 
 torch.set_num_threads(1)
 
@@ -41,7 +42,9 @@ def test_train_writes_model_csv_png_and_checkpoints(run):
     assert episodes and all(int(e["length"]) <= 60 for e in episodes)
     config = json.loads((out / "config.json").read_text())
     assert config["task"] == "reach" and config["algo"] == "ppo" and config["timesteps_done"] >= 256
-    assert config["env_kwargs"] == SHORT and config["algo_kwargs"] == FAST_PPO
+    assert config["env_kwargs"] == SHORT
+    assert {k: config["algo_kwargs"][k] for k in FAST_PPO} == FAST_PPO     # over the shipped
+    assert config["algo_kwargs"]["gamma"] == 0.99 and config["policy"] == "MlpPolicy"
     assert (out / "learning_curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert res["last_eval"]["timesteps"] == 256
 
@@ -124,3 +127,22 @@ def test_a_run_saved_before_the_layout_still_loads_and_runs(tmp_path, capsys):
     assert all(n <= 30 for n in res["lengths"]) and np.isfinite(res["return_mean"])
     assert cli.main(["eval", str(run), "--episodes", "1"]) == 0
     assert "reach PPO model.zip: 1 episodes" in capsys.readouterr().out
+
+
+def test_a_bad_algo_kwarg_is_refused_before_anything_is_written(tmp_path):
+    out = tmp_path / "never"
+    with pytest.raises(TrainInputError, match=r"n_step.*did you mean.*n_steps"):
+        train("reach", "ppo", 64, 0, out, algo_kwargs={"n_step": 64}, progress=False)
+    with pytest.raises(TrainInputError, match=r"gamma"):
+        train("reach", "ppo", 64, 0, out, algo_kwargs={"gamma": 2.0}, progress=False)
+    assert not out.exists()
+
+
+def test_frame_stacking_needs_the_image_observations(tmp_path):
+    with pytest.raises(TrainInputError, match="frame_stack=2"):
+        train("mirror", "ppo", 64, 0, tmp_path / "a", mode="scripted", flat_obs=True,
+              frame_stack=2, progress=False)
+    with pytest.raises(TrainInputError, match="frame_stack=2"):
+        train("mirror", "ppo", 64, 0, tmp_path / "b", mode="shared", frame_stack=2,
+              progress=False)
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()

@@ -364,13 +364,34 @@ def test_scripted_mode_trains_and_evaluates_on_the_same_observations():
     assert a[1] == b[1]["infant_0"]
 
 
+def test_a_face_only_learner_sees_through_the_cnn_by_default(tmp_path):
+    """Mirror with its scripted partner, default observations: the learner's eyes go through
+    the convolutional encoder, in training and when its run is evaluated again."""
+    out = tmp_path / "mirror_cnn"
+    train_mod.train("mirror", "ppo", 128, 0, out, mode="scripted", eval_every=128,
+                    eval_episodes=1, checkpoint_every=0, progress=False, n_envs=1,
+                    env_kwargs={"max_steps": 16},
+                    algo_kwargs={"n_steps": 64, "batch_size": 32, "n_epochs": 1})
+    config = json.loads((out / "config.json").read_text())
+    assert config["policy"] == "MultiInputPolicy"
+    assert config["observation"] == {"flat": False, "frame_stack": 1}
+    from stable_baselines3 import PPO
+    from torch import nn
+    from mimo_social.train.encoders import EyesExtractor
+    extractor = PPO.load(str(out / "model.zip"), device="cpu").policy.features_extractor
+    assert isinstance(extractor, EyesExtractor)
+    assert any(isinstance(m, nn.Conv2d) for m in extractor.modules())
+    res = train_mod.evaluate(out, episodes=1, both=True)
+    assert res["episodes"] == 1 and "stochastic" in res
+
+
 def test_a_face_only_learner_trains_and_evaluates_with_a_discrete_expression(tmp_path):
-    """Mirror with its scripted partner: the learner's only action is its face, a Discrete(7)
-    in training and in evaluation alike."""
+    """Mirror with its scripted partner, flat observations: the learner's only action is its
+    face, a Discrete(7) in training and in evaluation alike."""
     out = tmp_path / "mirror"
     train_mod.train("mirror", "ppo", 128, 0, out, mode="scripted", eval_every=128,
-                    eval_episodes=1, checkpoint_every=0, progress=False,
-                    env_kwargs={"max_steps": 16}, normalize_obs=True,
+                    eval_episodes=1, checkpoint_every=0, progress=False, flat_obs=True,
+                    env_kwargs={"max_steps": 16}, normalize_obs=True, n_envs=1,
                     algo_kwargs={"n_steps": 64, "batch_size": 32, "n_epochs": 1})
     res = train_mod.evaluate(out, episodes=1)
     assert res["episodes"] == 1
@@ -380,7 +401,7 @@ def test_a_face_only_learner_trains_and_evaluates_with_a_discrete_expression(tmp
     norm = PPO.load(str(out / "model.zip"), device="cpu").policy.features_extractor
     assert isinstance(norm, RunningNorm) and float(norm.count) >= 128
     assert float(norm.var.max()) > 0 and float(norm.mean.abs().max()) > 0.1
-    flat = make_scripted_env("mirror", max_steps=16)
+    flat = make_scripted_env("mirror", max_steps=16, flat=True)
     assert flat.action_space("infant_0").n == 7
 
 
