@@ -110,7 +110,7 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
     given = config.pop("algo_kwargs_given", None)
     if mode == "scripted":
         algo_kwargs = vector_defaults(algo_kwargs, set(algo_kwargs if given is None else given),
-                                      int(n_envs), algo)
+                                      int(n_envs), algo, config.get("algo_kwargs_provenance"))
     config["algo_kwargs"] = to_json(algo_kwargs)
     if mode == "independent":
         config["models"] = {a: f"model_{a}.zip" for a in agents}

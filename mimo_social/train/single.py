@@ -42,15 +42,23 @@ def warn(text: str) -> None:
     print(f"mimo-social train: note: {text}", file=sys.stderr, flush=True)
 
 
-def vector_defaults(algo_kwargs: dict, given, n_envs: int, algo: str) -> dict:
+def vector_defaults(algo_kwargs: dict, given, n_envs: int, algo: str,
+                    provenance: dict | None = None) -> dict:
     """SB3 keyword arguments for ``n_envs`` envs, those not given keeping the one-env learning:
-    PPO's rollout stays 2048 steps (``n_steps = 2048 // n_envs``), SAC keeps one gradient step
-    per env step (``gradient_steps=-1``)."""
+    PPO's rollout stays the shipped ``n_steps`` in all (``n_steps // n_envs`` per env), SAC
+    keeps one gradient step per env step (``gradient_steps=-1``). ``provenance`` (key -> where
+    the value comes from, config.json's) says what was changed."""
     kw = dict(algo_kwargs)
     if n_envs > 1 and algo == "ppo" and "n_steps" not in given:
-        kw["n_steps"] = max(64, 2048 // n_envs)
+        kw["n_steps"] = max(64, int(kw.get("n_steps", 2048)) // n_envs)
+        if provenance is not None:
+            provenance["n_steps"] = (f"{provenance.get('n_steps', 'SB3 default')}, divided by "
+                                     f"n_envs={n_envs} (the same rollout in all)")
     if n_envs > 1 and algo == "sac" and "gradient_steps" not in given:
         kw["gradient_steps"] = -1
+        if provenance is not None:
+            provenance["gradient_steps"] = (f"-1 for n_envs={n_envs} (one gradient step per env "
+                                            "step, as with one env)")
     return kw
 
 
@@ -76,7 +84,8 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
     algo = str(config.get("algo", cls.__name__)).lower()
     given = config.pop("algo_kwargs_given", None)
     given = set(algo_kwargs) if given is None else set(given)
-    algo_kwargs = vector_defaults(algo_kwargs, given, int(n_envs), algo)
+    algo_kwargs = vector_defaults(algo_kwargs, given, int(n_envs), algo,
+                                  config.get("algo_kwargs_provenance"))
     config.update({"algo_kwargs": to_json(algo_kwargs), "n_envs": int(n_envs),
                    "worker_timeout": float(worker_timeout)})
     observation = dict(config.get("observation", {}))
