@@ -54,11 +54,19 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return parser
 
 
+def _bar(args: argparse.Namespace, what: str):
+    """The bodies to calibrate, with a progress bar (one step a body: each takes minutes)."""
+    from tqdm import tqdm
+    versions = list(cal.hand_versions(args.hands))
+    return tqdm(versions, desc=f"calibrate {what}", unit="body", file=sys.stderr,
+                dynamic_ncols=True)
+
+
 def run(args: argparse.Namespace) -> int:
     out = sys.stdout
     if args.parameter == "fmax":
         worst = 0.0
-        for hands in cal.hand_versions(args.hands):
+        for hands in _bar(args, "fmax"):
             res = cal.calibrate_fmax(hands, args.iterations, args.steps)
             print(f"\nfmax, {hands} body ({args.iterations} iterations, {args.steps} steps a "
                   "phase, joints held at 0 deg or their nearest limit):", file=out)
@@ -74,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     if args.parameter == "speed":
         print(f"{'body':14s} {'physics only':>22s} {'physics + muscles':>22s} "
               f"{'muscle model':>28s}", file=out)
-        for hands in cal.hand_versions(args.hands):
+        for hands in _bar(args, "speed"):
             r = cal.measure_speed(hands, args.seconds)
             print(f"{hands:14s} {r['physics_real_per_sim']:11.4f} real s/sim s "
                   f"{r['muscle_real_per_sim']:11.4f} real s/sim s "
@@ -82,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
                   file=out)
         return 0
     # vmax
-    for hands in cal.hand_versions(args.hands):
+    for hands in _bar(args, "vmax"):
         res = cal.calibrate_vmax(hands, args.episodes, args.seconds, seed=args.seed,
                                  scale_to_reference=not args.no_scale)
         print(f"\nvmax, {hands} body ({args.episodes} episodes of {args.seconds:g} s):", file=out)
