@@ -6,6 +6,7 @@
     mimo-social bench recording    the Rerun recording's cost and size     (cli/bench_recording.py)
     mimo-social bench development  build time per age, delays, acuity      (cli/bench_development.py)
     mimo-social bench engines      SB3 vs RLlib training throughput        (cli/bench_engines.py)
+    mimo-social bench training     PPO's steps/s against the env alone     (cli/bench_training.py)
     mimo-social bench soak         growth of memory, threads, open files   (cli/bench_soak.py)
 
 Each module has ``NAME``, ``HELP``, ``add_parser(subparsers, name, **kw)`` and ``run(args)``.
@@ -24,14 +25,15 @@ import functools
 import sys
 
 from . import bench_development, bench_engines, bench_floor, bench_recording, bench_sim
-from . import bench_soak, bench_vision
+from . import bench_soak, bench_training, bench_vision
 
 __all__ = ["MEASUREMENTS", "OLD_NAMES", "add_parser", "old_form"]
 
 #: measurement -> its module, in the order of the help
 MEASUREMENTS = {module.NAME: module for module in (bench_sim, bench_floor, bench_vision,
                                                    bench_recording, bench_development,
-                                                   bench_engines, bench_soak)}
+                                                   bench_engines, bench_training,
+                                                   bench_soak)}
 #: old top-level command -> its measurement (kept for one release, not listed in the help)
 OLD_NAMES = {"bench-vision": "vision", "bench-recording": "recording",
              "bench-development": "development", "bench-engines": "engines", "soak": "soak"}

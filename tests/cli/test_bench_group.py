@@ -10,7 +10,7 @@ import pytest
 from mimo_social import cli
 from mimo_social.cli import bench
 
-NEW = ["sim", "floor", "vision", "recording", "development", "engines", "soak"]
+NEW = ["sim", "floor", "vision", "recording", "development", "engines", "training", "soak"]
 #: old command line -> the same command under its new name (every argument has a default but
 #: engines' --out)
 OLD = {
