@@ -6,6 +6,8 @@
     ``learning_curve.png`` to ``--out`` (:mod:`mimo_social.train.runner`). A social task takes
     ``--mode shared | independent | scripted`` (docs/training_multi.md).
     ``--algo-kwargs '{"n_steps": 512}'`` and ``--env-kwargs '{"max_steps": 200}'`` override.
+    ``--algo recurrent_ppo``: sb3-contrib's RecurrentPPO (an LSTM policy: memory);
+    ``--normalize-reward``: SB3's VecNormalize on the rewards, saved as ``vecnormalize.pkl``.
 
 ``mimo-social eval DIR --episodes 10 [--record run.rrd] [--video run.mp4 | --frames DIR]``
     Reloads ``DIR/model.zip`` (``--model best`` or a path for another), runs the episodes with the
@@ -111,6 +113,11 @@ def _engine_conflicts(args) -> str | None:
     if bad:
         return (f"{', '.join(bad)}: for --engine sb3; with --engine rllib use --num-env-runners "
                 "and --num-envs-per-runner")
+    bad = [f for f, k, d in (("--normalize-reward", "normalize_reward", False),
+                             ("--algo recurrent_ppo", "algo", None))
+           if given(k, d) and (k != "algo" or args.algo == "recurrent_ppo")]
+    if bad:
+        return f"{', '.join(bad)}: for --engine sb3 (the default engine)"
     return None
 
 
@@ -138,6 +145,8 @@ def _sb3_train_kwargs(args) -> dict:
         kw["flat_obs"] = True
     if getattr(args, "frame_stack", None) is not None:
         kw["frame_stack"] = args.frame_stack
+    if getattr(args, "normalize_reward", False):
+        kw["normalize_reward"] = True
     return kw
 
 
@@ -319,14 +328,16 @@ def _compare_run(args, algos):
 
 
 def add_parser(subparsers) -> None:
-    p = subparsers.add_parser("train", help="train PPO or SAC on a one-agent or social task",
+    p = subparsers.add_parser("train", help="train PPO, SAC or RecurrentPPO on a one-agent or "
+                              "social task",
                               description="Train a Stable-Baselines3 policy (default "
                               "hyperparameters) with periodic evaluation, checkpoints and a "
                               "learning curve (CSV and PNG); --engine rllib trains with RLlib "
                               "on Ray (a local Ray, or a cluster with --address).")
     _common(p)
     p.add_argument("--algo", required=True, choices=(*ALGOS, "appo"),
-                   help="ppo, sac; appo with --engine rllib")
+                   help="ppo, sac, recurrent_ppo (sb3-contrib's RecurrentPPO: an LSTM policy, "
+                   "memory across steps); appo with --engine rllib")
     p.add_argument("--seed", type=seed, default=0)
     p.add_argument("--out", required=True, type=output_dir, help="output directory")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -340,6 +351,10 @@ def add_parser(subparsers) -> None:
                    "CNN (docs/training_vision.md)")
     p.add_argument("--frame-stack", type=positive_int, default=None, help="frames of each eye "
                    "image the CNN sees at once (default 1): memory of the last k steps")
+    p.add_argument("--normalize-reward", action="store_true", help="scale the rewards the "
+                   "learner sees by a running estimate of the return's spread (SB3's "
+                   "VecNormalize, saved as vecnormalize.pkl next to each model; evaluations "
+                   "report the env's own returns); not with --mode independent")
     p.add_argument("--worker-timeout", type=positive_float, default=None, metavar="SECONDS",
                    help="an env worker process that does not answer within this time is an "
                    "error naming it (default 600)")
@@ -395,8 +410,8 @@ def add_parser(subparsers) -> None:
     p.add_argument("--steps-per-algo", default=None, metavar="ALGO=STEPS,...",
                    help="a step budget per algorithm over --steps, e.g. ppo=100000,sac=20000 "
                    "(SAC costs far more per step than PPO)")
-    p.add_argument("--algos", default="ppo,sac", help="comma-separated: ppo,sac (--engine "
-                   "rllib: ppo,appo,sac)")
+    p.add_argument("--algos", default="ppo,sac", help="comma-separated: ppo,sac,recurrent_ppo "
+                   "(--engine rllib: ppo,appo,sac)")
     p.add_argument("--seeds", type=positive_int, default=3, help="seeds 0 .. n-1 per algorithm")
     p.add_argument("--out", required=True, type=output_dir,
                    help="output directory (one sub-directory a run)")

@@ -37,7 +37,7 @@ from ..core.episodes import run_episode
 from ..envs.catalog import entry
 from ..partners.base import zero_action
 from .envs import make_env, run_observation
-from .rollouts import ModelPolicy
+from .rollouts import ModelPolicy, load_vecnormalize, vecnormalize_path
 from .tasks import TrainInputError, algo_class, check_task
 
 __all__ = ["baselines", "markdown_table", "write_json"]
@@ -95,6 +95,7 @@ class _Trained(ModelPolicy):
     kind, wrapped = "trained", True
 
     def reset(self, env, agent: str, rng: np.random.Generator) -> None:
+        super().reset(env, agent, rng)   # (a recurrent model: a fresh state)
         if not self.deterministic:
             import torch
             torch.manual_seed(int(rng.bit_generator.seed_seq.entropy))
@@ -103,7 +104,8 @@ class _Trained(ModelPolicy):
         path = {"final": run / "model.zip", "best": run / "best_model.zip"}.get(model, Path(model))
         if not path.exists():
             raise FileNotFoundError(f"model {path} not found (model: final, best or a .zip path)")
-        super().__init__(algo_class(config["algo"]).load(str(path), device="cpu"))
+        super().__init__(algo_class(config["algo"]).load(str(path), device="cpu"),
+                         normalize=load_vecnormalize(vecnormalize_path(path)))
         self.name = f"{run.name} ({config['algo'].upper()})"
         self.run, self.path, self.algo = str(run), str(path), config["algo"]
 

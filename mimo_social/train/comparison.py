@@ -20,7 +20,8 @@ from typing import Any, Mapping
 
 from .plots import plot_compare
 from .runner import train
-from .tasks import ALGOS, TrainInputError, check_algo, check_mode, check_task, task_module
+from .tasks import (ALGOS, COMPARED_ALGOS, TrainInputError, check_algo, check_mode, check_task,
+                    task_module)
 
 __all__ = ["compare", "parse_steps_per_algo", "value_per_algo", "kwargs_keyed_by_algo"]
 
@@ -81,7 +82,8 @@ def parse_steps_per_algo(text: str) -> dict[str, int]:
     return out
 
 
-def compare(task: str, algos=ALGOS, seeds: int = 3, steps: int | Mapping[str, int] = 50_000,
+def compare(task: str, algos=COMPARED_ALGOS, seeds: int = 3,
+            steps: int | Mapping[str, int] = 50_000,
             out: str | Path = "runs/compare", *, jobs: int = 1, plot_only: bool = False,
             mode: str | None = None, algo_kwargs: Mapping[str, Any] | None = None,
             **train_kwargs) -> Path:

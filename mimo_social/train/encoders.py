@@ -42,7 +42,8 @@ from torch import nn
 
 from .obs_norm import RunningNorm
 
-__all__ = ["ImageEncoder", "EyesExtractor", "policy_spec", "policy_for", "image_space_keys"]
+__all__ = ["ImageEncoder", "EyesExtractor", "policy_spec", "policy_for", "image_space_keys",
+           "RECURRENT_POLICIES"]
 
 #: the side (px) at or below which no further stride-2 convolution is added
 MAX_FINAL_SIDE = 8
@@ -176,14 +177,20 @@ def policy_spec(observation_space: spaces.Space, **extractor_kwargs: Any) -> tup
     return "MlpPolicy", {}
 
 
+#: the recurrent (LSTM) policy of sb3-contrib's RecurrentPPO for each of SB3's policy names
+RECURRENT_POLICIES = {"MlpPolicy": "MlpLstmPolicy", "MultiInputPolicy": "MultiInputLstmPolicy"}
+
+
 def policy_for(observation_space: spaces.Space, algo_kwargs: dict,
-               normalize_obs: bool = False) -> tuple[str, dict]:
+               normalize_obs: bool = False, recurrent: bool = False) -> tuple[str, dict]:
     """What the trainers build: the SB3 policy name and the algorithm's keyword arguments for
     an observation space. Images: :func:`policy_spec`'s ``MultiInputPolicy`` with the CNN
     (``normalize_obs``: running statistics over the ``"vector"`` part); otherwise
     ``MlpPolicy`` (``normalize_obs``: :class:`~mimo_social.train.obs_norm.RunningNorm` over the
-    whole input). The ``policy_kwargs`` of ``algo_kwargs`` (the shipped hyperparameters and the
-    command line's) are merged over these."""
+    whole input). ``recurrent`` (``--algo recurrent_ppo``): the LSTM policies of sb3-contrib,
+    ``MultiInputLstmPolicy`` (the same CNN in front of the LSTM) and ``MlpLstmPolicy``. The
+    ``policy_kwargs`` of ``algo_kwargs`` (the shipped hyperparameters and the command line's)
+    are merged over these."""
     kwargs = dict(algo_kwargs)
     own = dict(kwargs.pop("policy_kwargs", None) or {})
     if image_space_keys(observation_space):
@@ -196,4 +203,4 @@ def policy_for(observation_space: spaces.Space, algo_kwargs: dict,
     merged = {**base, **own}
     if merged:
         kwargs["policy_kwargs"] = merged
-    return policy, kwargs
+    return (RECURRENT_POLICIES[policy] if recurrent else policy), kwargs

@@ -9,6 +9,13 @@ only). ``progress`` shows a progress bar over the episodes. ``record`` writes a 
 recording of all episodes; ``video`` an MP4 of ``env.render()`` frames, which needs ``imageio``
 with its ffmpeg plugin or an ``ffmpeg`` program (:class:`VideoUnavailable` says so if neither is
 there: ``frames`` writes the frames as PNG files instead).
+
+A recurrent policy (``--algo recurrent_ppo``) carries its LSTM state across the steps of an
+episode and starts each episode afresh (:class:`~mimo_social.train.rollouts.PolicyState`). A run
+trained with ``--normalize-reward`` has ``vecnormalize.pkl`` next to ``model.zip``
+(``best_vecnormalize.pkl``, ``checkpoints/vecnormalize_<n>_steps.pkl``): it is loaded with the
+model (``res["vecnormalize"]``) and applied to the observations where it normalised them; the
+returns reported are the env's own, never normalised.
 """
 
 from __future__ import annotations
@@ -25,7 +32,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from .envs import make_env, make_parallel_env, make_scripted_env, run_observation
-from .rollouts import evaluate_agents, evaluate_policy
+from .rollouts import evaluate_agents, evaluate_policy, load_vecnormalize, vecnormalize_path
 from .tasks import algo_class
 
 __all__ = ["evaluate", "EvalOutputs", "VideoUnavailable"]
@@ -170,6 +177,8 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     if not path.exists():
         raise FileNotFoundError(f"model {path} not found (--model final, best or a .zip path)")
     policy = algo_class(config["algo"]).load(str(path), device="cpu")
+    stats = vecnormalize_path(path)
+    normalize = load_vecnormalize(stats)
     kw = dict(config.get("env_kwargs", {}))
     kw.update(env_kwargs or {})
     want_frames = video is not None or frames is not None
@@ -188,12 +197,14 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     t0 = time.perf_counter()
     bar = _Bar(episodes * (2 if both else 1), progress, f"eval {run.name}")
     try:
-        res = evaluate_policy(policy, env, episodes, seed, deterministic, on_step, bar)
+        res = evaluate_policy(policy, env, episodes, seed, deterministic, on_step, bar,
+                              normalize)
         if both:
             plain = make_env(config["task"], **obs, **kw)
             try:
                 res["stochastic"] = _sampled(lambda: evaluate_policy(
-                    policy, plain, episodes, seed, False, on_episode=bar), seed)
+                    policy, plain, episodes, seed, False, on_episode=bar,
+                    normalize=normalize), seed)
             finally:
                 plain.close()
     finally:
@@ -201,6 +212,7 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
         outputs.close()
         env.close()
     res.update({"task": config["task"], "algo": config["algo"], "model": str(path),
+                "vecnormalize": str(stats) if stats.is_file() else None,
                 "episodes": episodes, "deterministic": deterministic, "seed": seed,
                 "wall_time_s": round(time.perf_counter() - t0, 2)})
     if record is not None:
@@ -248,7 +260,7 @@ def _load_policies(run: Path, config: dict, model: str) -> tuple[dict, dict]:
 
 def evaluate_with_outputs(policies: Mapping[str, Any], env, inner, episodes: int, seed: int,
                           deterministic: bool, record, video, frames, frame_every: int,
-                          on_episode=None) -> dict:
+                          on_episode=None, normalize: Mapping[str, Any] | None = None) -> dict:
     """Run :func:`evaluate_agents` on ``env`` (its MimoParallelEnv: ``inner``) while recording,
     filming or saving frames as asked; close both; the results with ``wall_time_s`` and the
     ``record`` / ``video`` / ``frames`` paths given. The multi-agent evaluation of either
@@ -264,7 +276,8 @@ def evaluate_with_outputs(policies: Mapping[str, Any], env, inner, episodes: int
 
     t0 = time.perf_counter()
     try:
-        res = evaluate_agents(policies, env, episodes, seed, deterministic, on_step, on_episode)
+        res = evaluate_agents(policies, env, episodes, seed, deterministic, on_step, on_episode,
+                              normalize)
     finally:
         outputs.close()
         env.close()
@@ -281,6 +294,8 @@ def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed:
                    progress: bool = False) -> dict:
     """The multi-agent part of :func:`evaluate`."""
     policies, paths = _load_policies(run, config, model)
+    stats = {a: vecnormalize_path(p) for a, p in paths.items()}
+    normalize = {a: load_vecnormalize(p) for a, p in stats.items()}
     kw = dict(config.get("env_kwargs", {}))
     kw.update(env_kwargs or {})
     want_frames = video is not None or frames is not None
@@ -291,18 +306,21 @@ def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed:
     bar = _Bar(episodes * (2 if both else 1), progress, f"eval {run.name}")
     try:
         res = evaluate_with_outputs(policies, env, env.unwrapped, episodes, seed, deterministic,
-                                    record, video, frames, frame_every, bar)
+                                    record, video, frames, frame_every, bar, normalize)
         if both:
             plain = make(config["task"], **kw)
             try:
                 res["stochastic"] = _sampled(lambda: evaluate_agents(
-                    policies, plain, episodes, seed, False, on_episode=bar), seed)
+                    policies, plain, episodes, seed, False, on_episode=bar,
+                    normalize=normalize), seed)
             finally:
                 plain.close()
     finally:
         bar.close()
     res.update({"task": config["task"], "algo": config["algo"], "mode": config["mode"],
-                "model": paths[next(iter(paths))], "models": paths, "episodes": episodes,
+                "model": paths[next(iter(paths))], "models": paths,
+                "vecnormalize": next((str(p) for p in stats.values() if p.is_file()), None),
+                "episodes": episodes,
                 "deterministic": deterministic, "seed": seed})
     (run / "eval_results.json").write_text(json.dumps(res, indent=2, default=float))
     return res

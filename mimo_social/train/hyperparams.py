@@ -2,15 +2,18 @@
 
 The values ship as TOML files in ``mimo_social/train/hyperparams/``: ``default.toml`` (SB3's
 defaults, written out) and one ``<task>.toml`` per task, each with an ``[<algo>]`` table
-(``ppo``, ``sac``), optional per-mode tables ``[<algo>.<mode>]`` (``shared``, ``independent``,
-``scripted``) and an optional ``[run]`` table of ``train`` options (``normalize_obs``). Every value
-carries its provenance as a TOML comment (docs/hyperparameters.md lists them all).
+(``ppo``, ``sac``, ``recurrent_ppo``), optional per-mode tables ``[<algo>.<mode>]`` (``shared``,
+``independent``, ``scripted``) and an optional ``[run]`` table of ``train`` options
+(``normalize_obs``). Every value carries its provenance as a TOML comment
+(docs/hyperparameters.md lists them all).
 
 * :func:`load`: the shipped values of a task, algorithm and mode (default <- task <- mode);
 * :func:`resolve`: the values a run uses: the shipped ones overridden by the caller's
   (``--algo-kwargs``), with where each came from; checked by :func:`validate`;
 * :func:`validate`: unknown keys (against the SB3 class's and its policy's signatures, with a
-  "did you mean") and values that are cheap to check raise :class:`TrainInputError`;
+  "did you mean"; ``recurrent_ppo``: ``RecurrentPPO`` and its ``MlpLstmPolicy``, so
+  ``lstm_hidden_size``, ``n_lstm_layers``, ``shared_lstm``, ``enable_critic_lstm``,
+  ``lstm_kwargs``) and values that are cheap to check raise :class:`TrainInputError`;
 * :func:`to_sb3` / :func:`to_json`: TOML/JSON-friendly values (``"tanh"``, ``"lin_3e-4"``) to SB3
   objects (``torch.nn.Tanh``, a linear schedule) and back (for ``config.json``);
 * :func:`run_options`, :func:`markdown_table`.
@@ -34,6 +37,7 @@ from ..envs.catalog import CATALOG
 from .tasks import ALGOS, MODES, TrainInputError, algo_class, check_algo
 
 __all__ = ["DIRECTORY", "RUNNER_KEYS", "ACTIVATIONS", "OPTIMIZERS", "COMMAND_LINE", "CHECKS",
+           "POLICIES", "TITLES",
            "LinearSchedule", "shipped_files", "load", "resolve", "validate", "allowed_keys",
            "allowed_policy_keys", "to_sb3", "to_json", "run_options", "notes",
            "markdown_table"]
@@ -53,9 +57,14 @@ OPTIMIZERS = {"adam": "Adam", "adamw": "AdamW", "rmsprop": "RMSprop", "sgd": "SG
 #: provenance of a value given by the caller
 COMMAND_LINE = "command line"
 #: the keys that may be a schedule (a number, "lin_<start>", or a callable), per algorithm
-SCHEDULES = {"ppo": ("learning_rate", "clip_range", "clip_range_vf"), "sac": ("learning_rate",)}
+SCHEDULES = {"ppo": ("learning_rate", "clip_range", "clip_range_vf"), "sac": ("learning_rate",),
+             "recurrent_ppo": ("learning_rate", "clip_range", "clip_range_vf")}
 #: the sub-network keys of a dict net_arch
-NET_ARCH_KEYS = {"ppo": ("pi", "vf"), "sac": ("pi", "qf")}
+NET_ARCH_KEYS = {"ppo": ("pi", "vf"), "sac": ("pi", "qf"), "recurrent_ppo": ("pi", "vf")}
+#: the policy whose ``__init__`` says which ``policy_kwargs`` keys an algorithm takes
+POLICIES = {"ppo": "MlpPolicy", "sac": "MlpPolicy", "recurrent_ppo": "MlpLstmPolicy"}
+#: an algorithm's name in docs/hyperparameters.md's table
+TITLES = {"ppo": "PPO", "sac": "SAC", "recurrent_ppo": "RecurrentPPO"}
 _LIN = re.compile(r"^lin_(.+)$")
 _TABLES = (*ALGOS, "run")
 _RUN_OPTIONS = {"normalize_obs": bool}
@@ -292,12 +301,13 @@ def _gradient_steps(v) -> str | None:
 _COMMON = {"learning_rate": _schedule, "gamma": _UNIT, "batch_size": _POS_INT, "use_sde": _BOOL,
            "sde_sample_freq": _check(lambda v: _is_int(v) and v >= -1, "an integer >= -1"),
            "stats_window_size": _POS_INT, "tensorboard_log": _STR, "policy_kwargs": _DICT}
+_PPO = {**_COMMON, "n_steps": _POS_INT, "n_epochs": _POS_INT, "gae_lambda": _UNIT,
+        "clip_range": _schedule, "clip_range_vf": _optional(_schedule),
+        "normalize_advantage": _BOOL, "ent_coef": _NONNEG_NUM, "vf_coef": _NONNEG_NUM,
+        "max_grad_norm": _POS_NUM, "target_kl": _optional(_POS_NUM)}
 CHECKS = {
-    "ppo": {**_COMMON, "n_steps": _POS_INT, "n_epochs": _POS_INT, "gae_lambda": _UNIT,
-            "clip_range": _schedule, "clip_range_vf": _optional(_schedule),
-            "normalize_advantage": _BOOL, "ent_coef": _NONNEG_NUM, "vf_coef": _NONNEG_NUM,
-            "max_grad_norm": _POS_NUM, "target_kl": _optional(_POS_NUM),
-            "rollout_buffer_class": _CLASS, "rollout_buffer_kwargs": _DICT},
+    "ppo": {**_PPO, "rollout_buffer_class": _CLASS, "rollout_buffer_kwargs": _DICT},
+    "recurrent_ppo": dict(_PPO),
     "sac": {**_COMMON, "buffer_size": _POS_INT, "learning_starts": _NONNEG_INT,
             "tau": _UNIT_OPEN0, "train_freq": _train_freq, "gradient_steps": _gradient_steps,
             "replay_buffer_class": _CLASS, "replay_buffer_kwargs": _DICT,
@@ -332,7 +342,8 @@ def _named_class(names: Mapping[str, str], base: str):
 
 
 def _policy_checks(algo: str) -> dict:
-    return {"net_arch": _net_arch(algo),
+    return {"lstm_hidden_size": _POS_INT, "n_lstm_layers": _POS_INT, "shared_lstm": _BOOL,
+            "enable_critic_lstm": _BOOL, "lstm_kwargs": _DICT, "net_arch": _net_arch(algo),
             "activation_fn": _named_class(ACTIVATIONS, "torch.nn.Module"),
             "optimizer_class": _named_class(OPTIMIZERS, "torch.optim.Optimizer"),
             "optimizer_kwargs": _DICT, "ortho_init": _BOOL, "use_sde": _BOOL,
@@ -355,9 +366,9 @@ def allowed_keys(algo: str) -> list[str]:
 
 
 def allowed_policy_keys(algo: str) -> list[str]:
-    """The keys of ``policy_kwargs``: the ``MlpPolicy`` class's ``__init__`` arguments minus
-    those SB3 passes itself."""
-    policy = algo_class(algo).policy_aliases["MlpPolicy"]
+    """The keys of ``policy_kwargs``: the ``MlpPolicy`` class's (``recurrent_ppo``:
+    ``MlpLstmPolicy``'s) ``__init__`` arguments minus those SB3 passes itself."""
+    policy = algo_class(algo).policy_aliases[POLICIES[check_algo(algo)]]
     return _parameters(policy.__init__,
                        ("self", "observation_space", "action_space", "lr_schedule"))
 
@@ -398,7 +409,7 @@ def validate(algo: str, kwargs: Mapping[str, Any],
             raise TrainInputError(f"{where}: {key!r} is set by train itself "
                                   f"({RUNNER_KEYS[key]})")
         if key not in allowed:
-            others = [algo_class(a).__name__ for a in ALGOS
+            others = [algo_class(a).__name__ for a in _installed(ALGOS)
                       if a != algo and key in allowed_keys(a)]
             note = f" (an argument of {', '.join(others)}, not of {name})" if others else ""
             raise _unknown(key, allowed, f"{name} argument", where, note)
@@ -412,11 +423,34 @@ def validate(algo: str, kwargs: Mapping[str, Any],
     for key, value in policy.items():
         where = _where(provenance, f"policy_kwargs.{key}")
         if key not in allowed_policy:
-            raise _unknown(key, allowed_policy, f"{name} policy_kwargs key", where)
+            others = [algo_class(a).__name__ for a in _installed(ALGOS)
+                      if a != algo and key in allowed_policy_keys(a)]
+            note = (f" (a policy_kwargs key of {', '.join(others)}, not of {name})" if others
+                    else "")
+            raise _unknown(key, allowed_policy, f"{name} policy_kwargs key", where, note)
         problem = pchecks.get(key, lambda v: None)(value)
         if problem:
             raise TrainInputError(f"{where}: policy_kwargs {key}={value!r} not allowed for "
                                   f"{name}; allowed: {problem}")
+    if policy.get("shared_lstm") and policy.get("enable_critic_lstm", True):
+        where = _where(provenance, "policy_kwargs.shared_lstm")
+        raise TrainInputError(f"{where}: policy_kwargs shared_lstm=True with enable_critic_lstm="
+                              f"{policy.get('enable_critic_lstm', True)!r} not allowed for "
+                              f"{name}; allowed: the critic shares the actor's LSTM "
+                              "(shared_lstm=true, enable_critic_lstm=false), has its own "
+                              "(enable_critic_lstm=true, the default) or none (both false)")
+
+
+def _installed(algos) -> list[str]:
+    """The algorithms whose classes import here (sb3-contrib may be missing)."""
+    out = []
+    for a in algos:
+        try:
+            algo_class(a)
+        except TrainInputError:
+            continue
+        out.append(a)
+    return out
 
 
 # ---------------------------------------------------------------- conversions
@@ -528,12 +562,14 @@ def _rows(table: str, values: Mapping[str, Any], comments: Mapping) -> list[tupl
 
 
 def markdown_table() -> str:
-    """The shipped values as Markdown: ``default.toml`` (key, PPO, SAC, provenance), then every
+    """The shipped values as Markdown: ``default.toml`` (key, one column per algorithm,
+    provenance), then every
     task file's changes and what was measured. Regenerate docs/hyperparameters.md's tables with
     ``python -c "from mimo_social.train.hyperparams import markdown_table as m; print(m())"``."""
     intro, comments = notes("default.toml")
     data = _file("default.toml")
-    lines = ["| key | PPO | SAC | provenance |", "|---|---|---|---|"]
+    lines = [f"| key | {' | '.join(TITLES[a] for a in ALGOS)} | provenance |",
+             "|---" * (len(ALGOS) + 2) + "|"]
     cells: dict[str, dict] = {}
     for algo in ALGOS:
         for key, value, note in _rows(algo, data.get(algo, {}), comments):

@@ -99,7 +99,8 @@ def train_independent(cls, algo_kwargs, task, env_kwargs, steps, seed, out, eval
         for k, a in enumerate(agents):  # built in order: each seeds the global RNGs (SB3)
             view = hub.view(a)
             venv = DummyVecEnv([lambda v=view: Monitor(v)])
-            policy, kw = policy_for(venv.observation_space, algo_kwargs, normalize_obs)
+            policy, kw = policy_for(venv.observation_space, algo_kwargs, normalize_obs,
+                                    str((config or {}).get("algo")) == "recurrent_ppo")
             models[a] = cls(policy, venv, seed=seed + k, device="cpu", verbose=verbose, **kw)
         first = models[agents[0]]
         schedule.first = first_update(first)

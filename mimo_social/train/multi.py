@@ -27,6 +27,11 @@ learning agent acts with its own policy (scripted partners keep their script). I
 returns and success rates (``is_success`` of the agent's info on its last step); the summary
 columns average them across agents. SIGINT / SIGTERM stop the run between two steps and save it
 as it stands (:mod:`mimo_social.train.interrupt`).
+
+``--algo recurrent_ppo`` (an LSTM policy) works in every mode: ``shared`` keeps one LSTM state
+per agent slot, the evaluations one per agent. ``--normalize-reward`` (SB3's ``VecNormalize`` on
+the rewards, saved next to each model) is for ``shared`` and ``scripted`` (the one VecEnv of the
+one policy); ``independent`` refuses it (the runner says so before anything runs).
 """
 
 from __future__ import annotations
@@ -41,8 +46,9 @@ from .interrupt import StopSignals, workers_ignore_sigint
 from .progress import write_config
 from .rollouts import evaluate_agents
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
-from .single import finish_config, monitored_env, vector_defaults, warn
-from .tasks import TrainInputError, algo_class, check_mode, task_module
+from .single import (finish_config, model_saver, monitored_env, reward_normalizer,
+                     vector_defaults, warn)
+from .tasks import RECURRENT_ALGOS, TrainInputError, algo_class, check_mode, task_module
 
 __all__ = ["train_multi", "check_shared_spaces"]
 
@@ -185,10 +191,12 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
                                    int(n_envs), worker_timeout)
         per_env_step = 1
     try:
+        venv, normalizer = reward_normalizer(venv, config, algo_kwargs)
         policy, kw = policy_for(venv.observation_space, algo_kwargs,
-                                bool(config.get("normalize_obs")))
+                                bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS)
         config["policy"] = policy
         model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
+        save = model_saver(model, normalizer)
         planned, note = rounding_note(model, algo, steps, per_env_step)
         if note:
             warn(note)
@@ -204,9 +212,9 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
 
         def checkpoint(n):
             (out / "checkpoints").mkdir(exist_ok=True)
-            model.save(out / "checkpoints" / f"model_{n}_steps.zip")
+            save(out / "checkpoints" / f"model_{n}_steps.zip")
 
-        log = RunLog(out, agents, evaluate, lambda: model.save(out / "best_model.zip"), t0, bar,
+        log = RunLog(out, agents, evaluate, lambda: save(out / "best_model.zip"), t0, bar,
                      schedule, eval_seed)
         try:
             cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop)
@@ -216,7 +224,7 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
                 if not stop.requested:   # (a worker killed by the same signal)
                     raise
             n = int(model.num_timesteps) // per_env_step   # after the last update
-            model.save(out / "model.zip")
+            save(out / "model.zip")
             if schedule.final_checkpoint_due(n) and not stop.requested:
                 checkpoint(n)
             if bar is not None:

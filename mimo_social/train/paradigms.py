@@ -99,6 +99,8 @@ class _Trained:
         import torch
         torch.set_num_threads(1)
         self.model = algo_class(config["algo"]).load(str(path), device="cpu")
+        from .rollouts import PolicyState, load_vecnormalize, vecnormalize_path
+        self.memory = PolicyState(self.model, load_vecnormalize(vecnormalize_path(path)))
         self.observe, self.decode = PolicyInput(config, obs_space), ActionDecoder(act_space)
         self._first = True
         if _shapes(self.model.observation_space) != _shapes(self.observe.space):
@@ -113,6 +115,7 @@ class _Trained:
 
     def reset(self, env, agent, rng) -> None:
         self._first = True
+        self.memory.reset()   # (a recurrent model: a fresh state each episode)
         if not self.deterministic:   # the sampled actions: seeded per episode
             import torch
             torch.manual_seed(int(rng.integers(2**31)))
@@ -120,7 +123,7 @@ class _Trained:
     def act(self, env, agent, obs):
         seen = self.observe(obs, self._first)
         self._first = False
-        action = self.model.predict(seen, deterministic=self.deterministic)[0]
+        action = self.memory.predict(seen, self.deterministic)
         return self.decode(action, agent)
 
 

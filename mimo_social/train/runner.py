@@ -10,6 +10,8 @@ and algorithm (:mod:`mimo_social.train.hyperparams`, docs/hyperparameters.md: SB
 unless a measurement here says otherwise; SAC's replay buffer capped at the run's steps), which
 ``algo_kwargs`` override key by key (every key checked before anything runs). A learner with eyes
 sees its images through a CNN (:mod:`mimo_social.train.encoders`, docs/training_vision.md).
+``--algo recurrent_ppo`` (sb3-contrib's RecurrentPPO) gives the policy memory: an LSTM after the
+MLP inputs or after the CNN (docs/training.md, "Memory").
 Evaluations follow a budget (at most ~10 % of the training steps, none before the first update;
 docs/training.md) and run the deterministic and the sampled policy. A run writes to ``out``:
 
@@ -17,6 +19,10 @@ docs/training.md) and run the deterministic and the sampled policy. A run writes
   with their provenance (what ``eval`` reads);
 * ``model.zip`` (the final policy) and ``best_model.zip`` (best mean evaluation return);
 * ``checkpoints/model_<steps>_steps.zip`` every ``checkpoint_every`` steps;
+* with ``normalize_reward``: SB3's ``VecNormalize`` statistics next to each model
+  (``vecnormalize.pkl``, ``best_vecnormalize.pkl``,
+  ``checkpoints/vecnormalize_<steps>_steps.pkl``; the rewards the learner sees are scaled,
+  every number written is the env's own);
 * ``progress.csv``: one row per evaluation (:data:`~mimo_social.train.progress.PROGRESS_FIELDS`:
   the deterministic policy's ``eval_*`` columns and the sampled policy's ``eval_*_stochastic``,
   on a separate env, the same seeded episodes every time; the train columns summarise the
@@ -52,7 +58,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           algo_kwargs: Mapping[str, Any] | None = None, verbose: int = 0,
           mode: str | None = None, n_envs: int | None = None, n_cpus: int = 0,
           normalize_obs: bool | None = None, flat_obs: bool = False, frame_stack: int = 1,
-          worker_timeout: float = 600.0) -> dict:
+          worker_timeout: float = 600.0, normalize_reward: bool = False) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
     time). See the module docstring for what it writes.
 
@@ -66,7 +72,11 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     runs). ``normalize_obs`` (None: the task's shipped ``[run]`` default) puts running input
     statistics in front of the policy. A learner with eyes gets the CNN
     (:mod:`mimo_social.train.encoders`) unless ``flat_obs``; ``frame_stack`` frames of each
-    image. ``worker_timeout``: seconds a worker may take to answer before the run fails."""
+    image. ``worker_timeout``: seconds a worker may take to answer before the run fails.
+    ``normalize_reward``: the learner's rewards scaled by SB3's ``VecNormalize`` (a running
+    estimate of the discounted return's spread, with the algorithm's ``gamma``; observations
+    untouched: ``normalize_obs`` does that inside the policy), its statistics saved next to
+    every model (one learner, ``scripted`` and ``shared``; not ``independent``)."""
     from .hyperparams import resolve, run_options, to_json, to_sb3
 
     mode = check_mode(task, mode)
@@ -83,6 +93,12 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
         raise TrainInputError(f"steps={steps}; allowed: a positive integer")
     if isinstance(frame_stack, bool) or not isinstance(frame_stack, int) or frame_stack < 1:
         raise TrainInputError(f"frame_stack={frame_stack!r}; allowed: an integer >= 1")
+    if not isinstance(normalize_reward, bool):
+        raise TrainInputError(f"normalize_reward={normalize_reward!r}; allowed: True or False")
+    if normalize_reward and mode == "independent":
+        raise TrainInputError("--normalize-reward is for one learner (a one-agent task, --mode "
+                              "scripted) and --mode shared; --mode independent trains one model "
+                              "per agent on views of one world: leave it out there")
     if frame_stack > 1 and (flat_obs or mode in ("shared", "independent")):
         raise TrainInputError(f"frame_stack={frame_stack} stacks eye images for the CNN: not "
                               "with flat observations (--flat-obs, or --mode shared / "
@@ -111,6 +127,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     flat = bool(flat_obs) or mode in ("shared", "independent")
     config = {"task": task, "env_id": env_id, "algo": algo, "steps": steps,
               "seed": seed, "normalize_obs": bool(normalize_obs),
+              "normalize_reward": bool(normalize_reward),
               "observation": {"flat": flat, "frame_stack": int(frame_stack)},
               "env_kwargs": env_kwargs, "algo_kwargs": to_json(resolved),
               "algo_kwargs_provenance": provenance, "eval_every": eval_every,

@@ -10,6 +10,9 @@ budget), checkpoints every ``checkpoint_every`` steps, logs every training episo
 ``episodes.csv`` and rewrites ``progress.csv`` and ``learning_curve.png`` after each evaluation.
 SIGINT / SIGTERM stop the run between two steps: it is saved as it stands
 (:mod:`mimo_social.train.interrupt`; ``config.json`` says ``"interrupted": true``).
+``--normalize-reward``: the learner's envs in SB3's ``VecNormalize`` (rewards only,
+:func:`reward_normalizer`), its statistics saved next to every model (:func:`model_saver`); the
+episodes logged and the evaluations (a separate, unwrapped env) are the env's own returns.
 """
 
 from __future__ import annotations
@@ -22,10 +25,11 @@ from pathlib import Path
 from .envs import make_env
 from .interrupt import StopSignals
 from .progress import write_config
-from .rollouts import evaluate_policy
+from .rollouts import evaluate_policy, vecnormalize_path
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
 
-__all__ = ["train_single", "monitored_env", "vector_defaults", "warn"]
+__all__ = ["train_single", "monitored_env", "vector_defaults", "warn", "reward_normalizer",
+           "model_saver"]
 
 
 def monitored_env(task: str, env_kwargs: dict, observation: dict | None = None):
@@ -49,8 +53,9 @@ def vector_defaults(algo_kwargs: dict, given, n_envs: int, algo: str,
     keeps one gradient step per env step (``gradient_steps=-1``). ``provenance`` (key -> where
     the value comes from, config.json's) says what was changed."""
     kw = dict(algo_kwargs)
-    if n_envs > 1 and algo == "ppo" and "n_steps" not in given:
-        kw["n_steps"] = max(64, int(kw.get("n_steps", 2048)) // n_envs)
+    if n_envs > 1 and algo in ("ppo", "recurrent_ppo") and "n_steps" not in given:
+        default = 128 if algo == "recurrent_ppo" else 2048
+        kw["n_steps"] = max(64, int(kw.get("n_steps", default)) // n_envs)
         if provenance is not None:
             provenance["n_steps"] = (f"{provenance.get('n_steps', 'SB3 default')}, divided by "
                                      f"n_envs={n_envs} (the same rollout in all)")
@@ -60,6 +65,34 @@ def vector_defaults(algo_kwargs: dict, given, n_envs: int, algo: str,
             provenance["gradient_steps"] = (f"-1 for n_envs={n_envs} (one gradient step per env "
                                             "step, as with one env)")
     return kw
+
+
+def reward_normalizer(venv, config: dict, algo_kwargs: dict):
+    """``(venv, normalizer)``: with ``config["normalize_reward"]``, ``venv`` in SB3's
+    ``VecNormalize`` (``norm_obs=False, norm_reward=True``, the algorithm's ``gamma``; written
+    to ``config["vecnormalize"]``) and that wrapper; otherwise ``(venv, None)``. The wrapper
+    changes only the rewards the learner sees: the episodes its callback logs come from the
+    monitors below it."""
+    if not config.get("normalize_reward"):
+        return venv, None
+    from stable_baselines3.common.vec_env import VecNormalize
+    gamma = float(algo_kwargs.get("gamma", 0.99))
+    vec = VecNormalize(venv, training=True, norm_obs=False, norm_reward=True, gamma=gamma)
+    config["vecnormalize"] = {"file": "vecnormalize.pkl", "norm_obs": False,
+                              "norm_reward": True, "gamma": gamma,
+                              "clip_reward": float(vec.clip_reward),
+                              "epsilon": float(vec.epsilon)}
+    return vec, vec
+
+
+def model_saver(model, normalizer=None):
+    """``save(path)``: ``model.save(path)`` and, with a ``normalizer`` (a ``VecNormalize``), its
+    statistics next to it (:func:`~mimo_social.train.rollouts.vecnormalize_path`)."""
+    def save(path) -> None:
+        model.save(path)
+        if normalizer is not None:
+            normalizer.save(str(vecnormalize_path(path)))
+    return save
 
 
 def finish_config(config: dict, wall: float, timesteps: int, stop: StopSignals,
@@ -79,6 +112,7 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
     there); ``cls`` is the SB3 algorithm class. ``eval_every=None``: the budgeted schedule."""
     from .encoders import policy_for     # (torch: not imported by the workers, which import
     from .hyperparams import to_json     # this module for monitored_env)
+    from .tasks import RECURRENT_ALGOS
     from .workers import one_learner_vec_env
 
     algo = str(config.get("algo", cls.__name__)).lower()
@@ -94,10 +128,12 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
                                                  observation), int(n_envs), worker_timeout)
     stop = StopSignals()
     try:
+        venv, normalizer = reward_normalizer(venv, config, algo_kwargs)
         policy, kw = policy_for(venv.observation_space, algo_kwargs,
-                                bool(config.get("normalize_obs")))
+                                bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS)
         config["policy"] = policy
         model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
+        save = model_saver(model, normalizer)
         planned, note = rounding_note(model, algo, steps)
         if note:
             warn(note)
@@ -112,12 +148,12 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         eval_seed = 10_000 + seed
         log = RunLog(out, None,
                      lambda k, det: evaluate_policy(model, eval_env, k, eval_seed, det),
-                     lambda: model.save(out / "best_model.zip"), time.perf_counter(), bar,
+                     lambda: save(out / "best_model.zip"), time.perf_counter(), bar,
                      schedule, eval_seed)
 
         def checkpoint(n):
             (out / "checkpoints").mkdir(exist_ok=True)
-            model.save(out / "checkpoints" / f"model_{n}_steps.zip")
+            save(out / "checkpoints" / f"model_{n}_steps.zip")
 
         t0 = log.t_start
         try:
@@ -129,7 +165,7 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
                     if not stop.requested:   # (a worker killed by the same signal)
                         raise
                 n = int(model.num_timesteps)   # after the model's last update
-                model.save(out / "model.zip")
+                save(out / "model.zip")
                 if schedule.final_checkpoint_due(n) and not stop.requested:
                     checkpoint(n)
                 if bar is not None:

@@ -4,7 +4,9 @@ catalogue (:mod:`mimo_social.envs.catalog`), and the error they raise for anythi
 * :data:`TASKS`: the one-agent tasks (catalogue kind ``"one-agent"``), task -> Gymnasium id;
 * :data:`MULTI_TASKS`: the social tasks (``entry.social``), task -> PettingZoo module name
   (each module has ``parallel_env`` and ``scripted_env``);
-* :data:`ALGOS`: ``ppo``, ``sac``; :data:`MODES`: how a social task learns (``shared``,
+* :data:`ALGOS`: ``ppo``, ``sac`` (Stable-Baselines3) and ``recurrent_ppo`` (sb3-contrib's
+  ``RecurrentPPO``: an LSTM policy); :data:`RECURRENT_ALGOS`: those with memory;
+  :data:`MODES`: how a social task learns (``shared``,
   ``independent``, ``scripted``; default ``shared``).
 """
 
@@ -12,14 +14,19 @@ from __future__ import annotations
 
 from ..envs.catalog import CATALOG, entry
 
-__all__ = ["TASKS", "MULTI_TASKS", "ALL_TASKS", "ALGOS", "MODES", "DEFAULT_MODE",
+__all__ = ["TASKS", "MULTI_TASKS", "ALL_TASKS", "ALGOS", "RECURRENT_ALGOS", "COMPARED_ALGOS",
+           "MODES", "DEFAULT_MODE",
            "TrainInputError", "check_task", "check_algo", "check_mode", "task_module",
            "algo_class"]
 
 TASKS = {e.name: e.gym_id for e in CATALOG if e.kind == "one-agent"}
 MULTI_TASKS = {e.name: e.module.__name__ for e in CATALOG if e.social}
 ALL_TASKS = (*TASKS, *MULTI_TASKS)
-ALGOS = ("ppo", "sac")
+ALGOS = ("ppo", "sac", "recurrent_ppo")
+#: the algorithms whose policy keeps a state across an episode's steps (an LSTM)
+RECURRENT_ALGOS = ("recurrent_ppo",)
+#: what ``compare`` trains when not told which algorithms
+COMPARED_ALGOS = ("ppo", "sac")
 MODES = ("shared", "independent", "scripted")
 DEFAULT_MODE = "shared"
 
@@ -47,9 +54,18 @@ def check_algo(algo: str) -> str:
 
 
 def algo_class(algo: str):
-    """The SB3 class of an algorithm name."""
+    """The SB3 class of an algorithm name (``recurrent_ppo``: sb3-contrib's ``RecurrentPPO``;
+    a TrainInputError saying how to install sb3-contrib if it is missing)."""
+    if check_algo(algo) == "recurrent_ppo":
+        try:
+            from sb3_contrib import RecurrentPPO
+        except ImportError:
+            raise TrainInputError("--algo recurrent_ppo needs sb3-contrib (pip install "
+                                  "'sb3-contrib>=2.4,<3', the version of stable-baselines3)"
+                                  ) from None
+        return RecurrentPPO
     from stable_baselines3 import PPO, SAC
-    return {"ppo": PPO, "sac": SAC}[check_algo(algo)]
+    return {"ppo": PPO, "sac": SAC}[algo]
 
 
 def task_module(task: str):

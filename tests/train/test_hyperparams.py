@@ -12,6 +12,7 @@ from pathlib import Path
 import gymnasium as gym
 import pytest
 import torch
+from sb3_contrib import RecurrentPPO
 from stable_baselines3 import PPO, SAC
 
 from mimo_social.envs.catalog import CATALOG
@@ -20,7 +21,7 @@ from mimo_social.train.tasks import ALGOS, MODES, MULTI_TASKS, TASKS, TrainInput
 
 torch.set_num_threads(1)
 ROOT = Path(__file__).resolve().parents[2]
-CLASSES = {"ppo": PPO, "sac": SAC}
+CLASSES = {"ppo": PPO, "sac": SAC, "recurrent_ppo": RecurrentPPO}
 
 
 def _combos():
@@ -32,7 +33,8 @@ def _combos():
 
 def _build(algo, kwargs):
     env = gym.make("Pendulum-v1")
-    return CLASSES[algo]("MlpPolicy", env, seed=0, device="cpu", **hp.to_sb3(algo, kwargs))
+    return CLASSES[algo](hp.POLICIES[algo], env, seed=0, device="cpu",
+                         **hp.to_sb3(algo, kwargs))
 
 
 def test_every_shipped_file_parses_and_every_value_has_its_provenance():
@@ -65,16 +67,24 @@ def test_values_marked_sb3_default_are_sb3_defaults():
     for algo in ALGOS:
         params = inspect.signature(CLASSES[algo].__init__).parameters
         for key, value in data[algo].items():
-            if key != "policy_kwargs" and comments[(algo, key)].startswith("SB3 default"):
+            if key != "policy_kwargs" and comments[(algo, key)].startswith(
+                    ("SB3 default", "sb3-contrib default")):
                 assert params[key].default == value, (algo, key)
                 checked += 1
-    assert checked >= 15
+        policy = inspect.signature(CLASSES[algo].policy_aliases[hp.POLICIES[algo]].__init__)
+        for key, value in data[algo].get("policy_kwargs", {}).items():
+            if key in ("lstm_hidden_size", "n_lstm_layers", "shared_lstm", "enable_critic_lstm"):
+                assert comments[(f"{algo}.policy_kwargs", key)].startswith("sb3-contrib default")
+                assert policy.parameters[key].default == value, (algo, key)
+                checked += 1
+    assert checked >= 30
 
 
 @pytest.mark.parametrize("algo", ALGOS)
 def test_the_shipped_network_is_sb3s_default_network(algo):
     shipped = _build(algo, hp.load("reach", algo)).policy
-    bare = CLASSES[algo]("MlpPolicy", gym.make("Pendulum-v1"), seed=0, device="cpu").policy
+    bare = CLASSES[algo](hp.POLICIES[algo], gym.make("Pendulum-v1"), seed=0,
+                         device="cpu").policy
     assert str(shipped) == str(bare)
 
 
@@ -183,6 +193,20 @@ def test_keys_the_runner_sets_are_refused(key):
     ("sac", {"tau": 0}, ["tau=0", "(0, 1]"]),
     ("sac", {"buffer_size": 1e6}, ["buffer_size=1000000.0", "a positive integer"]),
     ("sac", {"gradient_steps": 0}, ["gradient_steps=0", "-1"]),
+    ("recurrent_ppo", {"policy_kwargs": {"lstm_hidden_size": 0}},
+     ["lstm_hidden_size=0", "a positive integer", "RecurrentPPO"]),
+    ("recurrent_ppo", {"policy_kwargs": {"n_lstm_layers": 1.5}}, ["n_lstm_layers=1.5"]),
+    ("recurrent_ppo", {"policy_kwargs": {"enable_critic_lstm": "yes"}},
+     ["enable_critic_lstm='yes'", "true or false"]),
+    ("recurrent_ppo", {"policy_kwargs": {"shared_lstm": True}},
+     ["shared_lstm=True", "enable_critic_lstm=True", "enable_critic_lstm=false"]),
+    ("recurrent_ppo", {"policy_kwargs": {"lstm_hiden_size": 64}},
+     ["did you mean 'lstm_hidden_size'?"]),
+    ("recurrent_ppo", {"rollout_buffer_class": None},
+     ["'rollout_buffer_class' (an argument of PPO, not of RecurrentPPO)"]),
+    ("ppo", {"policy_kwargs": {"lstm_hidden_size": 64}},
+     ["'lstm_hidden_size' (a policy_kwargs key of RecurrentPPO, not of PPO)"]),
+    ("recurrent_ppo", {"n_steps": 0}, ["n_steps=0", "a positive integer"]),
 ])
 def test_bad_values_are_refused_with_the_key_the_value_and_what_is_allowed(algo, given, words):
     with pytest.raises(TrainInputError) as e:
@@ -220,7 +244,12 @@ def test_good_values_pass():
                         ("sac", {"ent_coef": "auto_0.1", "train_freq": [1, "episode"],
                                  "gradient_steps": -1, "learning_starts": 0,
                                  "policy_kwargs": {"net_arch": {"pi": [32], "qf": [64]},
-                                                   "activation_fn": torch.nn.ELU}})]:
+                                                   "activation_fn": torch.nn.ELU}}),
+                        ("recurrent_ppo", {"learning_rate": "lin_3e-4", "n_steps": 64,
+                                           "policy_kwargs": {"lstm_hidden_size": 32,
+                                                             "n_lstm_layers": 2,
+                                                             "shared_lstm": True,
+                                                             "enable_critic_lstm": False}})]:
         kwargs, _ = hp.resolve("reach", algo, given, steps=2000)
         _build(algo, kwargs)
 
