@@ -90,12 +90,18 @@ mimo-social eval runs/reach_ppo --episodes 2 --record reach.rrd --frames frames/
 mimo-social compare --task standup --algos ppo,sac --seeds 3 --steps 60000 --out runs/standup --jobs 2
 ```
 
-`train` uses Stable-Baselines3's default hyperparameters (PPO: 2 x 64 units, SAC: 2 x 256; SAC's
-replay buffer is sized `min(1e6, steps)`), one env, CPU, torch on one thread. It shows a progress
-bar, evaluates every `--eval-every` steps on a separate env (`--eval-episodes` deterministic
-episodes, the same seeded ones every time), keeps `best_model.zip`, saves checkpoints and writes
-`progress.csv`, `episodes.csv` and `learning_curve.png`. `eval` reloads `model.zip` (or
-`--model best`), prints return, success rate and length, and can record a Rerun file
+`train` uses the hyperparameters shipped for the task and algorithm
+(`mimo_social/train/hyperparams/*.toml`, docs/hyperparameters.md: Stable-Baselines3's defaults
+unless a measurement here says otherwise, each value with its provenance; `--algo-kwargs`
+overrides them key by key and every key is checked before anything runs), CPU, torch on one
+thread, as many env workers as cores (`--n-envs`). A learner with eyes sees its images through a
+CNN (docs/training_vision.md; `--flat-obs` for the flat MLP). It shows a progress bar, evaluates
+the deterministic and the sampled policy on a separate env within an evaluation budget (at most
+~10 % of the training steps, none before the first update; `--eval-every` for fixed intervals;
+docs/training.md), keeps `best_model.zip`, saves checkpoints and writes `progress.csv`,
+`episodes.csv` and `learning_curve.png`; Ctrl-C or SIGTERM saves the run as it stands. `eval`
+reloads `model.zip` (or `--model best`), prints return, success rate and length (of both
+policies), and can record a Rerun file
 (`--record`), an MP4 (`--video`, needs `imageio` + `imageio-ffmpeg` or an `ffmpeg` program: the
 command says so when neither is installed) or PNG frames (`--frames`). `compare` trains every
 algorithm with seeds 0..n-1 into `OUT/<algo>_seed<k>` and draws them together in
