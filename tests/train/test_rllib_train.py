@@ -218,8 +218,9 @@ def test_one_policy_per_agent_of_a_heterogeneous_pair(cluster, tmp_path):
 
 
 def test_vision_task_steps_in_an_env_runner(cluster, tmp_path):
-    """mirror with the learner's eyes on (16x16): the env and its GL context are made in the
-    env runner's process, whose eye images are not blank; --normalize-obs keeps its filter."""
+    """mirror with the learner's eyes on (16x16), on the flat path (``flat_obs``: the image
+    path is tests/train/test_rllib_eyes.py): the env and its GL context are made in the env
+    runner's process, whose eye images are not blank; --normalize-obs keeps its filter."""
     import ray
 
     from mimo_social.train.rllib import build_config
@@ -229,7 +230,7 @@ def test_vision_task_steps_in_an_env_runner(cluster, tmp_path):
     assert init_ray(cluster)
     try:
         algo = build_config("mirror", "scripted", "ppo", 0, num_env_runners=1, env_kwargs=eyes,
-                            algo_kwargs=TINY, normalize_obs=True).build_algo()
+                            algo_kwargs=TINY, normalize_obs=True, flat_obs=True).build_algo()
         try:
             result = algo.train()
             assert result["env_runners"]["num_env_steps_sampled_lifetime"] >= 200
@@ -265,7 +266,8 @@ def test_one_agent_task_with_sac_sampling_in_the_driver(cluster, tmp_path, capsy
     assert rc == 0, capsys.readouterr().err
     rows = _rows(out / "progress.csv")
     assert int(rows[-1]["timesteps"]) >= 100
-    assert not any(k.startswith("eval_return_mean_") for k in rows[0])
+    assert not any(k.startswith("eval_return_mean_infant") for k in rows[0])   # no agent columns
+    assert "eval_return_mean_stochastic" in rows[0]
     assert json.loads((out / "config.json").read_text())["modules"] == {"infant_0": "infant_0"}
     assert main(["eval", str(out), "--episodes", "1", "--model", "best"]) == 0
     assert "reach SAC best_checkpoint: 1 episodes" in capsys.readouterr().out

@@ -2,10 +2,10 @@
 
 ``build_config(task, mode=None, algo="ppo", seed=0, *, num_env_runners=1,
 num_envs_per_runner=1, env_kwargs=None, algo_kwargs=None, num_cpus_per_learner=1,
-num_gpus_per_learner=0, normalize_obs=False) -> AlgorithmConfig``
+num_gpus_per_learner=0, normalize_obs=False, flat_obs=False, frame_stack=1) -> AlgorithmConfig``
 
 * ``task``: any task of :data:`~mimo_social.train.tasks.ALL_TASKS`; ``mode``: ``shared`` (one
-  module ``"shared"`` for every agent; their flat spaces must be equal), ``independent`` (one
+  module ``"shared"`` for every agent; their spaces must be equal), ``independent`` (one
   module per agent, named as the agent: heterogeneous agents, i.e. different bodies, hands or
   senses, each get their own spaces), ``scripted`` (one module for the learner, the partner
   scripted), None for a one-agent task (one module named as its agent).
@@ -23,17 +23,33 @@ num_gpus_per_learner=0, normalize_obs=False) -> AlgorithmConfig``
   RLlib's own settings for these five, PPO never reached 80 % success on high five in 70k env
   steps where SB3 does in 60k; with them it does in ~51k. Putting any one of them back alone
   (RLlib's init, a shared encoder, a state-dependent log std or ``vf_clip_param=10``) still
-  learned it in 20-51k (one seed each): no single one is the cause, hence all SB3's. RLlib standardises the advantages
-  over the whole train batch, SB3 per minibatch: left as is. SAC with two ReLU layers of
-  256, lr 3e-4, batch 256, learning from step 100; APPO with RLlib's defaults and two tanh
-  layers of 64. ``algo_kwargs`` override: keys of RLlib's ``DefaultModelConfig``
-  (``fcnet_hiddens``, ``fcnet_activation``, ...) go to the model, every other key to
-  ``config.training(...)``.
+  learned it in 20-51k (one seed each): no single one is the cause, hence all SB3's.
+  RLlib standardises the advantages over the whole train batch, SB3 per minibatch: left as
+  is. SAC with two ReLU layers of 256, lr 3e-4, batch 256, learning from step 100; APPO with
+  RLlib's defaults and two tanh layers of 64. ``algo_kwargs`` override: keys of RLlib's
+  ``DefaultModelConfig`` (``fcnet_hiddens``, ``fcnet_activation``, ...) go to the model, every
+  other key to ``config.training(...)``.
 * ``num_env_runners`` (0: sample in the driver) x ``num_envs_per_runner`` envs, one CPU a
   runner; one local learner with ``num_cpus_per_learner`` / ``num_gpus_per_learner``.
+* Eyes: an agent with eyes sees the image ``Dict`` of
+  :func:`~mimo_social.train.rllib.env.learner_env` (each eye ``uint8`` channel-first
+  ``(3 * frame_stack, H, W)``, the other senses one float32 ``"vector"``) and, with PPO and
+  APPO, gets the CNN module of :mod:`~mimo_social.train.rllib.module` (``EyesPPOModule`` /
+  ``EyesAPPOModule``: a CNN per eye, the same as the SB3 path's, its features and the vector
+  into SB3's policy and value MLPs), per policy: in ``shared`` mode the one module, in
+  ``independent`` mode each agent with eyes (an agent without keeps RLlib's default module on
+  its Box), in ``scripted`` mode the learner. ``algo_kwargs`` ``image_dim`` (128 features per
+  eye) and ``share_weights`` (one CNN for same-shaped eyes, True) go to that module.
+  RLlib's default env-to-module connectors batch the Dict as it is (they flatten nothing).
+  ``flat_obs=True`` (and always ``sac``, whose RLlib module takes no image Dict) is the flat
+  path: every observation one float32 Box, eye images scaled to [0, 1] in it, RLlib's default
+  MLP. ``frame_stack``: frames of each eye stacked along the channels (needs the image path
+  and an agent with eyes).
 * ``normalize_obs``: RLlib's ``MeanStdFilter`` connector on every observation (running mean
-  and std, kept in the checkpoint), as ``--normalize-obs`` of the SB3 path; eye images are
-  already scaled to [0, 1] by the flat env either way.
+  and std, kept in the checkpoint), as ``--normalize-obs`` of the SB3 path; on the image path
+  the CNN module normalises its ``"vector"`` itself (running statistics in the module's
+  buffers, updated by the learner; the pixels are only scaled to [0, 1]), and a run whose
+  agents mix image Dicts and Boxes (``independent``, eyes on one agent) needs ``flat_obs``.
 
 ``module_ids(task, mode, agents)``: agent -> RLModule id. The envs are made in the env runners
 by :class:`~mimo_social.train.rllib.env.CatalogEnv` (the env creator of
@@ -49,11 +65,14 @@ from typing import Any, Mapping
 
 from ..tasks import TrainInputError, check_mode, check_task
 
-__all__ = ["RLLIB_ALGOS", "SHARED", "build_config", "module_ids", "flat_spaces",
-           "split_algo_kwargs", "quiet_rllib"]
+__all__ = ["RLLIB_ALGOS", "SHARED", "build_config", "module_ids", "flat_spaces", "learner_spaces",
+           "split_algo_kwargs", "quiet_rllib", "uses_images", "obs_filter", "is_flat",
+           "EYES_KEYS"]
 
 RLLIB_ALGOS = ("ppo", "appo", "sac")
 SHARED = "shared"
+#: ``algo_kwargs`` of the CNN module (:mod:`.module`), besides RLlib's model keys
+EYES_KEYS = ("image_dim", "share_weights")
 
 _DEFAULTS = {
     "ppo": ({"fcnet_hiddens": [64, 64], "fcnet_activation": "tanh",
@@ -97,21 +116,76 @@ def module_ids(task: str, mode: str | None, agents) -> dict[str, str]:
     return {a: (SHARED if mode == "shared" else a) for a in agents}
 
 
-def flat_spaces(task: str, mode: str | None, env_kwargs: Mapping[str, Any] | None = None):
-    """``(agents, {agent: (observation space, action space)})`` of the flat env a mode learns
-    on (made once here, never reset: no renderer is started). ``shared`` mode with agents whose
-    spaces differ is a TrainInputError saying to use ``independent``."""
-    from ..multi import check_shared_spaces
-    from .env import flat_env
+def is_flat(algo: str, flat_obs: bool = False) -> bool:
+    """Whether a run is on the flat path: ``flat_obs`` or SAC (module docstring)."""
+    return bool(flat_obs) or algo == "sac"
 
-    env = flat_env(task, mode, **dict(env_kwargs or {}))
+
+def learner_spaces(task: str, mode: str | None, env_kwargs: Mapping[str, Any] | None = None, *,
+                   flat: bool = False, frame_stack: int = 1):
+    """``(agents, {agent: (observation space, action space)})`` of the env a mode learns on
+    (:func:`~mimo_social.train.rllib.env.learner_env`, made once here, never reset: no renderer
+    is started). ``shared`` mode with agents whose spaces differ is a TrainInputError saying to
+    use ``independent``; so is a ``frame_stack`` the images do not allow or that has no image
+    to stack."""
+    from ..multi import check_shared_spaces
+    from .env import learner_env
+
+    if isinstance(frame_stack, bool) or not isinstance(frame_stack, int) or frame_stack < 1:
+        raise TrainInputError(f"frame_stack={frame_stack!r}; allowed: an integer >= 1")
+    if frame_stack > 1 and flat:
+        raise TrainInputError(f"frame_stack={frame_stack} stacks eye images for the CNN: not "
+                              "with flat observations (flat_obs, or SAC)")
+    try:
+        env = learner_env(task, mode, flat=flat, frame_stack=frame_stack,
+                          **dict(env_kwargs or {}))
+    except ValueError as e:
+        if frame_stack == 1:
+            raise
+        raise TrainInputError(str(e)) from None
     try:
         if mode == "shared":
             check_shared_spaces(env, task)
         agents = list(env.possible_agents)
-        return agents, {a: (env.observation_space(a), env.action_space(a)) for a in agents}
+        per_agent = {a: (env.observation_space(a), env.action_space(a)) for a in agents}
     finally:
         env.close()
+    if frame_stack > 1 and not uses_images(per_agent):
+        raise TrainInputError(f"frame_stack={frame_stack} stacks eye images, but no agent of "
+                              f"{task!r} has eyes (env_kwargs 'vision' turns them on)")
+    return agents, per_agent
+
+
+def flat_spaces(task: str, mode: str | None, env_kwargs: Mapping[str, Any] | None = None):
+    """:func:`learner_spaces` of the flat path (every observation one Box)."""
+    return learner_spaces(task, mode, env_kwargs, flat=True)
+
+
+def uses_images(per_agent: Mapping[str, tuple]) -> bool:
+    """Whether any agent of ``{agent: (observation space, action space)}`` sees an image
+    Dict (the CNN module's input)."""
+    from .module import has_images
+
+    return any(has_images(obs) for obs, _ in per_agent.values())
+
+
+def obs_filter(normalize_obs: bool, per_agent: Mapping[str, tuple]) -> bool:
+    """Whether ``normalize_obs`` puts RLlib's MeanStdFilter on the observations: on the flat
+    path (every observation a Box); image Dicts are normalised in the CNN module, and a mix of
+    the two is a TrainInputError."""
+    if not normalize_obs:
+        return False
+    from .module import has_images
+
+    images = {a for a, (obs, _) in per_agent.items() if has_images(obs)}
+    if not images:
+        return True
+    if len(images) < len(per_agent):
+        raise TrainInputError(
+            f"normalize_obs with agents that see images ({', '.join(sorted(images))}) and "
+            f"agents that do not: not supported; pass flat_obs=True (--flat-obs) to normalise "
+            "every observation as one flat Box")
+    return False
 
 
 def split_algo_kwargs(algo: str, algo_kwargs: Mapping[str, Any] | None):
@@ -119,7 +193,7 @@ def split_algo_kwargs(algo: str, algo_kwargs: Mapping[str, Any] | None):
     them (model keys to the model, the rest to ``training()``)."""
     from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
 
-    model_keys = {f.name for f in dataclasses.fields(DefaultModelConfig)}
+    model_keys = {f.name for f in dataclasses.fields(DefaultModelConfig)} | set(EYES_KEYS)
     model, training = (dict(d) for d in _DEFAULTS[algo])
     for k, v in dict(algo_kwargs or {}).items():
         (model if k in model_keys else training)[k] = v
@@ -160,14 +234,28 @@ def _module_kwargs(algo: str, model_config, act_space) -> dict:
             "catalog_class": PPOCatalog}
 
 
+def _eyes_kwargs(algo: str, model_config, eyes: Mapping[str, Any], normalize: bool) -> dict:
+    """RLModuleSpec's module class and model config for an agent that sees an image Dict."""
+    from .module import DEFAULTS, EyesAPPOModule, EyesPPOModule
+
+    cfg = {**DEFAULTS, "fcnet_hiddens": list(model_config.fcnet_hiddens),
+           "fcnet_activation": model_config.fcnet_activation,
+           "free_log_std": bool(model_config.free_log_std), **dict(eyes),
+           "normalize_vector": bool(normalize)}
+    return {"module_class": EyesAPPOModule if algo == "appo" else EyesPPOModule,
+            "model_config": cfg}
+
+
 def build_config(task: str, mode: str | None = None, algo: str = "ppo", seed: int = 0, *,
                  num_env_runners: int = 1, num_envs_per_runner: int = 1,
                  env_kwargs: Mapping[str, Any] | None = None,
                  algo_kwargs: Mapping[str, Any] | None = None,
                  num_cpus_per_learner: int = 1, num_gpus_per_learner: float = 0,
-                 normalize_obs: bool = False, spaces: tuple | None = None):
+                 normalize_obs: bool = False, flat_obs: bool = False, frame_stack: int = 1,
+                 spaces: tuple | None = None):
     """The ``AlgorithmConfig`` (new API stack, torch) of a run; see the module docstring.
-    ``spaces``: :func:`flat_spaces`'s answer, when the caller has it already."""
+    ``spaces``: :func:`learner_spaces`'s answer (of the same ``flat_obs``, ``frame_stack``),
+    when the caller has it already."""
     from ray.rllib.core.rl_module.default_model_config import DefaultModelConfig
     from ray.rllib.core.rl_module.multi_rl_module import MultiRLModuleSpec
     from ray.rllib.core.rl_module.rl_module import RLModuleSpec
@@ -182,25 +270,39 @@ def build_config(task: str, mode: str | None = None, algo: str = "ppo", seed: in
         raise TrainInputError(f"num_env_runners={num_env_runners} (allowed: >= 0), "
                               f"num_envs_per_runner={num_envs_per_runner} (allowed: >= 1)")
     env_kwargs = dict(env_kwargs or {})
-    agents, per_agent = spaces if spaces is not None else flat_spaces(task, mode, env_kwargs)
+    flat = is_flat(algo, flat_obs)
+    if spaces is None:
+        spaces = learner_spaces(task, mode, env_kwargs, flat=flat, frame_stack=frame_stack)
+    agents, per_agent = spaces
     ids = module_ids(task, mode, agents)
     model, training = split_algo_kwargs(algo, algo_kwargs)
+    eyes = {k: model.pop(k) for k in EYES_KEYS if k in model}
+    if eyes and (flat or not uses_images(per_agent)):
+        raise TrainInputError(f"algo_kwargs {', '.join(sorted(eyes))}: settings of the CNN of "
+                              "an agent with eyes, and this run has none (no eyes, or flat)")
+    use_filter = obs_filter(normalize_obs, per_agent)
     try:
         model_config = DefaultModelConfig(**model)
     except TypeError as e:
         raise TrainInputError(f"algo_kwargs: bad model setting: {e}") from None
+    from .module import has_images
+
     specs = {}
     for a in agents:
         if ids[a] not in specs:
             obs_space, act_space = per_agent[a]
+            kwargs = (_eyes_kwargs(algo, model_config, eyes, normalize_obs)
+                      if has_images(obs_space) else
+                      _module_kwargs(algo, model_config, act_space))
             specs[ids[a]] = RLModuleSpec(observation_space=obs_space, action_space=act_space,
-                                         **_module_kwargs(algo, model_config, act_space))
+                                         **kwargs)
     config = (_algo_config_class(algo)()
               .api_stack(enable_rl_module_and_learner=True,
                          enable_env_runner_and_connector_v2=True)
               .framework("torch")
               .environment(CatalogEnv,
-                           env_config={"task": task, "mode": mode, "env_kwargs": env_kwargs},
+                           env_config={"task": task, "mode": mode, "env_kwargs": env_kwargs,
+                                       "flat": flat, "frame_stack": int(frame_stack)},
                            disable_env_checking=True)
               .env_runners(num_env_runners=int(num_env_runners),
                            num_envs_per_env_runner=int(num_envs_per_runner),
@@ -215,7 +317,7 @@ def build_config(task: str, mode: str | None = None, algo: str = "ppo", seed: in
               .debugging(seed=int(seed)))
     if algo != "appo":  # (APPO's minibatches are whole fragments: keep its 50)
         config = config.env_runners(rollout_fragment_length="auto")
-    if normalize_obs:
+    if use_filter:
         from ray.rllib.connectors.env_to_module import MeanStdFilter
         config = config.env_runners(
             env_to_module_connector=lambda env, spaces=None, device=None: MeanStdFilter(

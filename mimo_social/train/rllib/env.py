@@ -7,14 +7,21 @@
 ``make_rllib_env(config)``
     The env creator registered under those names. ``config`` (RLlib's ``env_config``, an
     ``EnvContext`` in a runner) holds ``task``, ``mode`` (``shared``, ``independent``,
-    ``scripted``, or None for a one-agent task) and ``env_kwargs``. It returns a
-    :class:`MimoMultiAgentEnv` around :func:`flat_env`. :class:`CatalogEnv` is the same as a
-    class (``CatalogEnv(env_config)``): what ``build_config`` hands RLlib.
-``flat_env(task, mode, **env_kwargs)``
+    ``scripted``, or None for a one-agent task), ``env_kwargs`` and optionally ``flat`` (default
+    False) and ``frame_stack`` (default 1). It returns a :class:`MimoMultiAgentEnv` around
+    :func:`learner_env`. :class:`CatalogEnv` is the same as a class (``CatalogEnv(env_config)``):
+    what ``build_config`` hands RLlib.
+``learner_env(task, mode, *, flat=False, frame_stack=1, **env_kwargs)``
     ``FlattenParallel`` of the task's ParallelEnv: every agent (``shared``, ``independent``), the
     learner with its scripted partner (``scripted``: the module's ``scripted_env()``), or the
-    one agent of a one-agent task. Observations are one float32 Box (eye images scaled to
-    [0, 1], as in the SB3 path), actions a Box (``Discrete`` for a face-only agent).
+    one agent of a one-agent task. An agent with eyes sees the image ``Dict`` of
+    :class:`~mimo_social.core.wrappers.ImageDict` (each eye ``uint8`` channel-first
+    ``(3 * frame_stack, H, W)``, the other senses one float32 ``"vector"``: what the CNN module
+    :mod:`~mimo_social.train.rllib.module` takes) unless ``flat``; every other observation is
+    one float32 Box (with ``flat``, eye images scaled to [0, 1] in it, as the SB3 path's
+    ``--flat-obs``). Actions are a Box (``Discrete`` for a face-only agent).
+``flat_env(task, mode, **env_kwargs)``
+    :func:`learner_env` with ``flat=True``: every observation one Box.
 
 Ray starts each env runner as its own process and calls the creator there, so each env (and
 its renderer's GL context, with vision on) is made in the process that steps it. This module
@@ -32,8 +39,8 @@ from ...core.wrappers import FlattenParallel
 from ...envs.catalog import entry
 from ..tasks import ALL_TASKS, TASKS, check_mode, task_module
 
-__all__ = ["EPISODE_KEY", "CatalogEnv", "MimoMultiAgentEnv", "env_name", "flat_env", "make_rllib_env",
-           "register_rllib_envs"]
+__all__ = ["EPISODE_KEY", "CatalogEnv", "MimoMultiAgentEnv", "env_name", "flat_env",
+           "learner_env", "make_rllib_env", "register_rllib_envs"]
 
 PREFIX = "mimo_social/"
 #: the info key under which an agent's last step carries its episode's (return, length)
@@ -45,23 +52,36 @@ def env_name(task: str) -> str:
     return PREFIX + task
 
 
-def flat_env(task: str, mode: str | None = None, render_mode: str | None = None,
-             **env_kwargs) -> FlattenParallel:
-    """The flat ParallelEnv a mode learns on (see the module docstring)."""
+def learner_env(task: str, mode: str | None = None, render_mode: str | None = None, *,
+                flat: bool = False, frame_stack: int = 1, **env_kwargs) -> FlattenParallel:
+    """The ParallelEnv a mode learns on: image Dicts for agents with eyes unless ``flat`` (see
+    the module docstring)."""
     mode = check_mode(task, mode)
     kw = dict(env_kwargs)
     if render_mode is not None:
         kw["render_mode"] = render_mode
     if task in TASKS:  # one agent: its ParallelEnv (what the Gymnasium id wraps)
         e = entry(task)
-        return FlattenParallel(e.scripted_env(**{**dict(e.gym_defaults), **kw}))
-    module = task_module(task)
-    make = module.scripted_env if mode == "scripted" else module.parallel_env
-    return FlattenParallel(make(**kw))
+        par = e.scripted_env(**{**dict(e.gym_defaults), **kw})
+    else:
+        module = task_module(task)
+        make = module.scripted_env if mode == "scripted" else module.parallel_env
+        par = make(**kw)
+    try:
+        return FlattenParallel(par, keep_images=not flat, frame_stack=int(frame_stack))
+    except (TypeError, ValueError):
+        par.close()
+        raise
+
+
+def flat_env(task: str, mode: str | None = None, render_mode: str | None = None,
+             **env_kwargs) -> FlattenParallel:
+    """The ParallelEnv a mode learns on with every observation one flat Box."""
+    return learner_env(task, mode, render_mode, flat=True, **env_kwargs)
 
 
 class MimoMultiAgentEnv(MultiAgentEnv):
-    """A flat ParallelEnv as an RLlib ``MultiAgentEnv``: ``agents`` follows the live agents,
+    """A :func:`learner_env` as an RLlib ``MultiAgentEnv``: ``agents`` follows the live agents,
     ``"__all__"`` ends the episode once every agent is done, ``render()`` is the env's frame. An
     agent's info on its last step adds ``EPISODE_KEY: (return, length)`` of its episode."""
 
@@ -106,16 +126,18 @@ class MimoMultiAgentEnv(MultiAgentEnv):
         self.par_env.close()
 
 
-def _flat_from_config(config: Mapping[str, Any] | None) -> FlattenParallel:
+def _env_from_config(config: Mapping[str, Any] | None) -> FlattenParallel:
     config = dict(config or {})
-    return flat_env(config["task"], config.get("mode"), render_mode=config.get("render_mode"),
-                    **dict(config.get("env_kwargs") or {}))
+    return learner_env(config["task"], config.get("mode"), render_mode=config.get("render_mode"),
+                       flat=bool(config.get("flat", False)),
+                       frame_stack=int(config.get("frame_stack", 1)),
+                       **dict(config.get("env_kwargs") or {}))
 
 
 def make_rllib_env(config: Mapping[str, Any] | None = None) -> MimoMultiAgentEnv:
     """The env creator of the tune registry: ``config`` holds ``task``, ``mode``, ``env_kwargs``
-    (and optionally ``render_mode``)."""
-    return MimoMultiAgentEnv(_flat_from_config(config))
+    (and optionally ``flat``, ``frame_stack``, ``render_mode``)."""
+    return MimoMultiAgentEnv(_env_from_config(config))
 
 
 class CatalogEnv(MimoMultiAgentEnv):
@@ -126,7 +148,7 @@ class CatalogEnv(MimoMultiAgentEnv):
     job)."""
 
     def __init__(self, config: Mapping[str, Any] | None = None):
-        super().__init__(_flat_from_config(config))
+        super().__init__(_env_from_config(config))
 
 
 def register_rllib_envs() -> list[str]:

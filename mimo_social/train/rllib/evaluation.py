@@ -5,9 +5,10 @@ evaluations use too.
 ``evaluate_rllib(run, episodes=10, *, model="final", seed=0, deterministic=True, record=None,
 video=None, frames=None, frame_every=1, env_kwargs=None)`` reloads each agent's RLModule from
 the run's checkpoint (``final``: ``checkpoint/``, ``best``: ``best_checkpoint/``, or a path to an
-``algo.save`` folder), runs the episodes on the flat env of the run's mode in this process (no
-Ray cluster is started) and writes ``eval_results.json``, a Rerun recording, a video or frames
-as the SB3 path does (:class:`~mimo_social.train.evaluation.EvalOutputs`).
+``algo.save`` folder), runs the episodes on the env of the run's mode and observations (its
+``config.json``'s ``"observation"``: image Dicts or flat; runs without it were flat) in this
+process (no Ray cluster is started) and writes ``eval_results.json``, a Rerun recording, a
+video or frames as the SB3 path does (:class:`~mimo_social.train.evaluation.EvalOutputs`).
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from gymnasium import spaces
 
 from ..evaluation import evaluate_with_outputs
 from ..tasks import TrainInputError
-from .env import flat_env
+from .env import learner_env
 
 __all__ = ["ModulePolicy", "evaluate_rllib", "load_policies", "module_dir", "CHECKPOINTS",
            "FILTER_FILE", "filters_from_state"]
@@ -38,7 +39,8 @@ FILTER_FILE = "mimo_obs_filter.pkl"
 class ModulePolicy:
     """An RLModule with SB3's ``predict(obs, deterministic) -> (action, None)``, so that the
     project's episode runners (:func:`~mimo_social.train.rollouts.evaluate_agents`) drive it.
-    ``normalize``: a function applied to the observation first (the run's MeanStdFilter)."""
+    ``normalize``: a function applied to the observation first (the run's MeanStdFilter). An
+    image Dict observation goes in as a Dict of tensors (uint8 images, float32 vector)."""
 
     def __init__(self, module, action_space: spaces.Space, normalize=None):
         self.module, self.action_space, self.normalize = module, action_space, normalize
@@ -46,10 +48,14 @@ class ModulePolicy:
     def predict(self, obs, deterministic: bool = True):
         import torch
 
-        x = np.asarray(obs, dtype=np.float32)
-        if self.normalize is not None:
-            x = np.asarray(self.normalize(x), dtype=np.float32)
-        batch = {"obs": torch.from_numpy(x[None])}
+        if isinstance(obs, Mapping):
+            x = {k: torch.from_numpy(np.asarray(v)[None].copy()) for k, v in obs.items()}
+        else:
+            x = np.asarray(obs, dtype=np.float32)
+            if self.normalize is not None:
+                x = np.asarray(self.normalize(x), dtype=np.float32)
+            x = torch.from_numpy(x[None])
+        batch = {"obs": x}
         with torch.no_grad():
             if deterministic:
                 out = self.module.forward_inference(batch)
@@ -147,8 +153,11 @@ def evaluate_rllib(run: str | Path, episodes: int = 10, *, model: str = "final",
     kw = dict(config.get("env_kwargs", {}))
     kw.update(env_kwargs or {})
     want_frames = video is not None or frames is not None
-    env = flat_env(config["task"], config.get("mode"),
-                   render_mode="rgb_array" if want_frames else None, **kw)
+    observation = config.get("observation") or {"flat": True, "frame_stack": 1}
+    env = learner_env(config["task"], config.get("mode"),
+                      render_mode="rgb_array" if want_frames else None,
+                      flat=bool(observation.get("flat", True)),
+                      frame_stack=int(observation.get("frame_stack", 1)), **kw)
     try:
         policies = load_policies(checkpoint, config["modules"], env)
     except BaseException:

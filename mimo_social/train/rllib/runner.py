@@ -3,18 +3,21 @@
 ``train_rllib(task, algo, steps, seed, out, *, mode=None, eval_every=None, eval_episodes=5,
 checkpoint_every=None, progress=True, env_kwargs=None, algo_kwargs=None, normalize_obs=False,
 address=None, num_env_runners=1, num_envs_per_runner=1, num_cpus_per_learner=1,
-num_gpus_per_learner=0, num_cpus=None) -> dict``
+num_gpus_per_learner=0, num_cpus=None, flat_obs=False, frame_stack=1) -> dict``
 
 Joins the Ray cluster at ``address`` (``"auto"`` or ``HOST:PORT``: ``ray.init(address=...)``;
 every node needs this package and ray installed) or starts a local Ray with ``num_cpus``
 (default: one per env runner, at least 2), builds the algorithm with
 :func:`~mimo_social.train.rllib.config.build_config`, and calls ``algo.train()`` until
 ``steps`` environment steps have been sampled (an iteration samples a whole train batch, so the
-last one may overshoot). The learner runs in this process; the env runners are Ray actors, each
-making its envs (and their GL contexts) in its own process. Writes to ``out`` what the SB3 path
-writes (:mod:`mimo_social.train.runner`):
+last one may overshoot). Agents with eyes see image Dicts and learn with the CNN module
+(PPO, APPO) unless ``flat_obs`` (or SAC): see :mod:`~mimo_social.train.rllib.config`. The
+learner runs in this process; the env runners are Ray actors, each making its envs (and their
+GL contexts) in its own process. Writes to ``out`` what the SB3 path writes
+(:mod:`mimo_social.train.runner`):
 
-* ``config.json`` (``"engine": "rllib"``, the agents and ``modules``: agent -> RLModule id);
+* ``config.json`` (``"engine": "rllib"``, the agents and ``modules``: agent -> RLModule id,
+  ``"observation": {"flat", "frame_stack"}``: what ``eval`` makes its env with);
 * ``progress.csv`` with per-agent columns (one-agent tasks: the summary columns only),
   ``episodes.csv`` (every training episode of every agent) and ``learning_curve.png``: the
   evaluations are ``eval_episodes`` deterministic episodes in this process, every
@@ -32,9 +35,10 @@ from typing import Any, Mapping
 
 from ..progress import write_config
 from ..rollouts import evaluate_agents
-from ..runlog import RunLog, Schedule
+from ..runlog import RunLog, Schedule, episode_limit
 from ..tasks import TrainInputError, check_mode, check_task
-from .config import build_config, check_algo, flat_spaces, module_ids, quiet_rllib
+from .config import (build_config, check_algo, is_flat, learner_spaces, module_ids, obs_filter,
+                     quiet_rllib)
 
 __all__ = ["train_rllib", "init_ray", "filter_state"]
 
@@ -82,7 +86,8 @@ def train_rllib(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
                 algo_kwargs: Mapping[str, Any] | None = None, normalize_obs: bool = False,
                 address: str | None = None, num_env_runners: int = 1,
                 num_envs_per_runner: int = 1, num_cpus_per_learner: int = 1,
-                num_gpus_per_learner: float = 0, num_cpus: int | None = None) -> dict:
+                num_gpus_per_learner: float = 0, num_cpus: int | None = None,
+                flat_obs: bool = False, frame_stack: int = 1) -> dict:
     """Train with RLlib; returns the summary :func:`mimo_social.train.train` returns (see the
     module docstring for what it writes)."""
     env_id = check_task(task)
@@ -95,7 +100,11 @@ def train_rllib(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     checkpoint_every = int(checkpoint_every) if checkpoint_every is not None else max(steps // 5, 1)
     env_kwargs = dict(env_kwargs or {})
     algo_kwargs = dict(algo_kwargs or {})
-    agents, per_agent = flat_spaces(task, mode, env_kwargs)  # errors before anything starts
+    flat = is_flat(algo, flat_obs)
+    # errors before anything starts
+    agents, per_agent = learner_spaces(task, mode, env_kwargs, flat=flat, frame_stack=frame_stack)
+    use_filter = obs_filter(normalize_obs, per_agent)
+    observation = {"flat": flat, "frame_stack": int(frame_stack)}
     ids = module_ids(task, mode, agents)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -109,7 +118,8 @@ def train_rllib(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
               "seed": seed, "mode": mode, "normalize_obs": bool(normalize_obs),
               "env_kwargs": env_kwargs, "algo_kwargs": algo_kwargs, "eval_every": eval_every,
               "eval_episodes": eval_episodes, "checkpoint_every": checkpoint_every,
-              "agents": agents, "modules": ids, "checkpoint": "checkpoint",
+              "agents": agents, "modules": ids, "observation": observation,
+              "checkpoint": "checkpoint",
               "address": address, "num_env_runners": int(num_env_runners),
               "num_envs_per_runner": int(num_envs_per_runner),
               "num_cpus_per_learner": num_cpus_per_learner,
@@ -124,10 +134,11 @@ def train_rllib(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
             num_envs_per_runner=num_envs_per_runner, env_kwargs=env_kwargs,
             algo_kwargs=algo_kwargs, num_cpus_per_learner=num_cpus_per_learner,
             num_gpus_per_learner=num_gpus_per_learner, normalize_obs=normalize_obs,
+            flat_obs=flat_obs, frame_stack=frame_stack,
             spaces=(agents, per_agent)).build_algo()
         rows = _iterate(algorithm, task, mode, agents, ids, env_kwargs, steps, seed, out,
                         eval_every, eval_episodes, checkpoint_every, progress, t0,
-                        bool(normalize_obs))
+                        use_filter, observation)
     finally:
         if algorithm is not None:
             algorithm.stop()
@@ -147,13 +158,15 @@ def train_rllib(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
 
 
 def _iterate(algorithm, task, mode, agents, ids, env_kwargs, steps, seed, out, eval_every,
-             eval_episodes, checkpoint_every, progress, t0, normalize) -> list[dict]:
+             eval_episodes, checkpoint_every, progress, t0, normalize,
+             observation) -> list[dict]:
     """``algorithm.train()`` up to ``steps`` environment steps, with the run log."""
     from .callbacks import episodes_of
-    from .env import flat_env
+    from .env import learner_env
     from .evaluation import FILTER_FILE, ModulePolicy, filters_from_state
 
-    eval_env = flat_env(task, mode, **env_kwargs)
+    eval_env = learner_env(task, mode, flat=observation["flat"],
+                           frame_stack=observation["frame_stack"], **env_kwargs)
     bar = None
     if progress:
         from tqdm import tqdm
@@ -166,10 +179,11 @@ def _iterate(algorithm, task, mode, agents, ids, env_kwargs, steps, seed, out, e
         return {a: ModulePolicy(algorithm.get_module(ids[a]), eval_env.action_space(a),
                                 norm.get(a)) for a in agents}
 
-    def evaluate():
-        res = evaluate_agents(policies(), eval_env, eval_episodes, 10_000 + seed)
+    def evaluate(episodes: int, deterministic: bool):
+        res = evaluate_agents(policies(), eval_env, episodes, 10_000 + seed, deterministic)
         if mode is None:  # one-agent task: the summary columns only, as the SB3 path
-            res["agents"] = {}
+            (only,) = res.pop("agents").values()
+            res["lengths"] = only["lengths"]
         return res
 
     def save(path: Path):
@@ -177,8 +191,10 @@ def _iterate(algorithm, task, mode, agents, ids, env_kwargs, steps, seed, out, e
         if normalize:
             (path / FILTER_FILE).write_bytes(pickle.dumps(filter_state(algorithm)))
 
-    schedule = Schedule(eval_every, checkpoint_every, steps)
-    log = RunLog(out, agents, evaluate, lambda: save(out / "best_checkpoint"), t0, bar)
+    schedule = Schedule(eval_every, checkpoint_every, steps, episodes=eval_episodes,
+                        episode_steps=episode_limit(eval_env))
+    log = RunLog(out, agents, evaluate, lambda: save(out / "best_checkpoint"), t0, bar,
+                 schedule, 10_000 + seed)
     try:
         n = 0
         while n < steps:
@@ -190,11 +206,12 @@ def _iterate(algorithm, task, mode, agents, ids, env_kwargs, steps, seed, out, e
                 bar.update(min(n, steps) - bar.n)
             if schedule.checkpoint_due(n):
                 save(out / "checkpoints" / f"step_{n}")
-            if schedule.eval_due(n):
-                log.evaluate(n)
+            episodes = schedule.eval_due(n)
+            if episodes:
+                log.evaluate(n, episodes)
         if schedule.final_checkpoint_due(n):
             save(out / "checkpoints" / f"step_{n}")
-        log.evaluate(n)
+        log.evaluate(n, schedule.final_episodes())
         save(out / "checkpoint")
     finally:
         log.close()
