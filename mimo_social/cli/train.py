@@ -131,7 +131,9 @@ def _train_rllib(args) -> dict:
                        eval_every=args.eval_every, eval_episodes=args.eval_episodes,
                        checkpoint_every=args.checkpoint_every, progress=not args.no_progress,
                        env_kwargs=args.env_kwargs, algo_kwargs=args.algo_kwargs,
-                       normalize_obs=bool(args.normalize_obs), **opts)
+                       normalize_obs=bool(args.normalize_obs),
+                       flat_obs=bool(getattr(args, "flat_obs", False)),
+                       frame_stack=getattr(args, "frame_stack", None) or 1, **opts)
 
 
 def _sb3_train_kwargs(args) -> dict:
