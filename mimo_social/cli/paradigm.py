@@ -39,7 +39,7 @@ def _main(args) -> int:
     try:
         res = run_paradigm(args.task, args.learner or list(LEARNER_NAMES), args.episodes,
                            args.seed, env_kwargs=args.env_kwargs, model=args.model,
-                           deterministic=not args.stochastic)
+                           deterministic=not args.stochastic, progress=True)
     except (TrainInputError, FileNotFoundError) as e:
         print(f"mimo-social paradigm: error: {e}", file=sys.stderr)
         return 2

@@ -189,8 +189,10 @@ def _env_kwargs(task: str, specs: Sequence[str], env_kwargs) -> dict:
 
 def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: int = 5,
                  seed: int = 0, env_kwargs: Mapping[str, Any] | None = None,
-                 model: str = "final", deterministic: bool = True) -> dict:
-    """Each learner on the same seeded episodes of ``task`` (one of :data:`PARADIGMS`).
+                 model: str = "final", deterministic: bool = True,
+                 progress: bool = False) -> dict:
+    """Each learner on the same seeded episodes of ``task`` (one of :data:`PARADIGMS`);
+    ``progress``: a progress bar over the learners (on stderr).
 
     ``episodes``: episodes per learner (contingency: blocks of a live, a replay and a
     non-contingent episode); seeds ``seed``, ``seed + 1``, ... Returns ``task``, ``episodes``,
@@ -211,7 +213,9 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
     kw = _env_kwargs(task, specs, env_kwargs)
     measures = entry(task).measures
     results = []
-    for spec in specs:
+    from tqdm import tqdm
+    for spec in tqdm(specs, desc=f"paradigm {task}", unit="learner", disable=not progress,
+                     dynamic_ncols=True):
         env = entry(task).scripted_env(**kw)   # the learner's spaces, and its episodes
         try:
             learner = make_learner(task, spec, env, model, deterministic)
