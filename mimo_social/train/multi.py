@@ -46,9 +46,9 @@ from .interrupt import StopSignals, workers_ignore_sigint
 from .progress import write_config
 from .rollouts import evaluate_agents
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
-from .single import (finish_config, model_saver, monitored_env, reward_normalizer,
+from .single import (build_model, finish_config, learn_and_finish, monitored_env,
                      vector_defaults, warn)
-from .tasks import RECURRENT_ALGOS, TrainInputError, algo_class, check_mode, task_module
+from .tasks import TrainInputError, algo_class, check_mode, task_module
 
 __all__ = ["train_multi", "check_shared_spaces"]
 
@@ -168,8 +168,6 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
     """shared (one policy, one VecEnv slot per agent) and scripted (one learner) modes."""
     from stable_baselines3.common.vec_env import VecMonitor
 
-    from .encoders import policy_for
-
     agents = list(eval_env.possible_agents)
     if mode == "shared":
         from supersuit.vector.sb3_vector_wrapper import SB3VecEnvWrapper
@@ -191,12 +189,7 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
                                    int(n_envs), worker_timeout)
         per_env_step = 1
     try:
-        venv, normalizer = reward_normalizer(venv, config, algo_kwargs)
-        policy, kw = policy_for(venv.observation_space, algo_kwargs,
-                                bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS)
-        config["policy"] = policy
-        model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
-        save = model_saver(model, normalizer)
+        venv, model, save = build_model(cls, algo, venv, config, algo_kwargs, seed, verbose)
         planned, note = rounding_note(model, algo, steps, per_env_step)
         if note:
             warn(note)
@@ -218,18 +211,8 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
                      schedule, eval_seed)
         try:
             cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop)
-            try:
-                model.learn(total_timesteps=steps * per_env_step, callback=cb)
-            except Exception:
-                if not stop.requested:   # (a worker killed by the same signal)
-                    raise
-            n = int(model.num_timesteps) // per_env_step   # after the last update
-            save(out / "model.zip")
-            if schedule.final_checkpoint_due(n) and not stop.requested:
-                checkpoint(n)
-            if bar is not None:
-                bar.update(n - bar.n)
-            log.evaluate(n, 1 if stop.requested else schedule.final_episodes())
+            learn_and_finish(model, steps, per_env_step, cb, stop, save, out, schedule,
+                             checkpoint, bar, log)
         finally:
             log.close()
     finally:

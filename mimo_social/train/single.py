@@ -29,7 +29,7 @@ from .rollouts import evaluate_policy, vecnormalize_path
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
 
 __all__ = ["train_single", "monitored_env", "vector_defaults", "warn", "reward_normalizer",
-           "model_saver"]
+           "model_saver", "build_model", "learn_and_finish"]
 
 
 def monitored_env(task: str, env_kwargs: dict, observation: dict | None = None):
@@ -104,16 +104,51 @@ def finish_config(config: dict, wall: float, timesteps: int, stop: StopSignals,
     return config
 
 
+def build_model(cls, algo: str, venv, config: dict, algo_kwargs: dict, seed: int,
+                verbose: int):
+    """The SB3 model of one policy on ``venv`` (one learner, or the shared / scripted modes):
+    the rewards normalised when the run asks for it (:func:`reward_normalizer`), the policy
+    :func:`~mimo_social.train.encoders.policy_for` picks for the observation (recorded in
+    ``config["policy"]``). Returns ``(venv, model, save)``: the env the model steps, the model
+    and its :func:`model_saver`."""
+    from .encoders import policy_for     # (torch: lazily, see train_single)
+    from .tasks import RECURRENT_ALGOS
+    venv, normalizer = reward_normalizer(venv, config, algo_kwargs)
+    policy, kw = policy_for(venv.observation_space, algo_kwargs,
+                            bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS)
+    config["policy"] = policy
+    model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
+    return venv, model, model_saver(model, normalizer)
+
+
+def learn_and_finish(model, steps: int, per_env_step: int, callback, stop, save, out: Path,
+                     schedule, checkpoint, bar, log) -> int:
+    """``model.learn`` for ``steps`` env steps (``per_env_step`` transitions each), then what
+    follows the last update: ``model.zip``, the last checkpoint when due, the bar, the final
+    evaluation (one episode of each policy after a stop signal). Returns the env steps done."""
+    try:
+        model.learn(total_timesteps=steps * per_env_step, callback=callback)
+    except Exception:
+        if not stop.requested:   # (a worker killed by the same signal)
+            raise
+    n = int(model.num_timesteps) // per_env_step   # after the model's last update
+    save(out / "model.zip")
+    if schedule.final_checkpoint_due(n) and not stop.requested:
+        checkpoint(n)
+    if bar is not None:
+        bar.update(n - bar.n)
+    log.evaluate(n, 1 if stop.requested else schedule.final_episodes())
+    return n
+
+
 def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every: int | None,
                  eval_episodes: int, checkpoint_every: int, progress: bool, env_kwargs: dict,
                  algo_kwargs: dict, verbose: int, config: dict, n_envs: int = 1,
                  worker_timeout: float = 600.0) -> dict:
     """The one-learner part of :func:`mimo_social.train.runner.train` (arguments checked
     there); ``cls`` is the SB3 algorithm class. ``eval_every=None``: the budgeted schedule."""
-    from .encoders import policy_for     # (torch: not imported by the workers, which import
-    from .hyperparams import to_json     # this module for monitored_env)
-    from .tasks import RECURRENT_ALGOS
-    from .workers import one_learner_vec_env
+    from .hyperparams import to_json     # (torch: not imported by the workers, which import
+    from .workers import one_learner_vec_env     # this module for monitored_env)
 
     algo = str(config.get("algo", cls.__name__)).lower()
     given = config.pop("algo_kwargs_given", None)
@@ -128,12 +163,7 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
                                                  observation), int(n_envs), worker_timeout)
     stop = StopSignals()
     try:
-        venv, normalizer = reward_normalizer(venv, config, algo_kwargs)
-        policy, kw = policy_for(venv.observation_space, algo_kwargs,
-                                bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS)
-        config["policy"] = policy
-        model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
-        save = model_saver(model, normalizer)
+        venv, model, save = build_model(cls, algo, venv, config, algo_kwargs, seed, verbose)
         planned, note = rounding_note(model, algo, steps)
         if note:
             warn(note)
@@ -159,18 +189,8 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         try:
             with stop:
                 cb = sb3_callback(log, schedule, None, 1, checkpoint, stop)
-                try:
-                    model.learn(total_timesteps=steps, callback=cb)
-                except Exception:
-                    if not stop.requested:   # (a worker killed by the same signal)
-                        raise
-                n = int(model.num_timesteps)   # after the model's last update
-                save(out / "model.zip")
-                if schedule.final_checkpoint_due(n) and not stop.requested:
-                    checkpoint(n)
-                if bar is not None:
-                    bar.update(n - bar.n)
-                log.evaluate(n, 1 if stop.requested else schedule.final_episodes())
+                learn_and_finish(model, steps, 1, cb, stop, save, out, schedule, checkpoint,
+                                 bar, log)
         finally:
             log.close()
         wall = time.perf_counter() - t0
