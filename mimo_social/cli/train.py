@@ -108,8 +108,8 @@ def _engine_conflicts(args) -> str | None:
         if bad:
             return f"{', '.join(bad)}: for --engine rllib (the default engine is sb3)"
         return None
-    bad = [f for f, k, d in (("--n-envs", "n_envs", 1), ("--n-cpus", "n_cpus", 0))
-           if given(k, d)]
+    bad = [f for f, k in (("--n-envs", "n_envs"), ("--n-cpus", "n_cpus"))
+           if given(k, None)]
     if bad:
         return (f"{', '.join(bad)}: for --engine sb3; with --engine rllib use --num-env-runners "
                 "and --num-envs-per-runner")
@@ -343,11 +343,10 @@ def add_parser(subparsers) -> None:
     p.add_argument("--seed", type=seed, default=0)
     p.add_argument("--out", required=True, type=output_dir, help="output directory")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.add_argument("--n-envs", type=positive_int, default=None, help="envs stepped together: "
-                   "one learner (one-agent tasks, --mode scripted): one spawned worker process "
-                   "each (1: in this process); --mode shared: worlds (one VecEnv slot per agent "
-                   "of each). Default: one learner: the CPU cores (at most 16); --mode shared "
-                   "and independent: 1")
+    p.add_argument("--n-envs", type=positive_int, default=None, help="envs stepped together "
+                   "(one learner: one-agent tasks, --mode scripted) or worlds (--mode shared: "
+                   "one VecEnv slot per agent of each), in --n-cpus worker processes. Default: "
+                   "4 per CPU core (8 on 2 cores); --mode independent: 1")
     p.add_argument("--flat-obs", action="store_true", help="a learner with eyes sees one flat "
                    "vector (its images flattened, an MLP) instead of its images through the "
                    "CNN (docs/training_vision.md)")
@@ -360,9 +359,10 @@ def add_parser(subparsers) -> None:
     p.add_argument("--worker-timeout", type=positive_float, default=None, metavar="SECONDS",
                    help="an env worker process that does not answer within this time is an "
                    "error naming it (default 600)")
-    p.add_argument("--n-cpus", type=non_negative_int, default=0, help="--mode shared: worker "
-                   "processes for "
-                   "the worlds (0: all in this process)")
+    p.add_argument("--n-cpus", type=non_negative_int, default=None, help="spawned worker "
+                   "processes stepping the --n-envs envs or worlds, each a block of them (0: all "
+                   "in this process). Default: one per CPU core, at most one per env; "
+                   "--mode independent: 0")
     g = p.add_argument_group("RLlib engine (--engine rllib; needs the rllib extra)")
     g.add_argument("--engine", choices=("sb3", "rllib"), default="sb3",
                    help="sb3 (Stable-Baselines3, the default) or rllib (RLlib on Ray)")

@@ -40,6 +40,7 @@ import functools
 import time
 from pathlib import Path
 
+from ..util.cores import cpu_cores
 from .envs import make_parallel_env, make_scripted_env
 from .independent import train_independent
 from .interrupt import StopSignals, workers_ignore_sigint
@@ -78,17 +79,14 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
                 n_cpus: int = 0, verbose: int = 0, config: dict,
                 worker_timeout: float = 600.0) -> dict:
     """The multi-agent part of :func:`mimo_social.train.runner.train` (arguments checked there).
-    ``eval_every=None``: the budgeted schedule. ``n_envs``: worlds (shared mode; ``n_cpus``
-    worker processes for them) or envs of the one learner (scripted mode, a spawned worker each
-    when more than one); the independent mode steps one world."""
+    ``eval_every=None``: the budgeted schedule. ``n_envs``: worlds (shared mode) or envs of
+    the one learner (scripted mode), in ``n_cpus`` spawned worker processes (0: in this
+    process); the independent mode steps one world."""
     mode = check_mode(task, mode)
     if mode == "independent" and (n_envs != 1 or n_cpus != 0):
         raise TrainInputError(f"--mode independent steps one world: n_envs={n_envs}, "
                               f"n_cpus={n_cpus} are for --mode shared (worlds) and --mode "
                               "scripted (envs)")
-    if mode == "scripted" and n_cpus != 0:
-        raise TrainInputError(f"--n-cpus is for --mode shared; --mode scripted runs one worker "
-                              f"process per env when n_envs > 1 (got n_cpus={n_cpus})")
     from .hyperparams import to_json
 
     cls = algo_class(algo)
@@ -114,7 +112,7 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
         # SB3 counts every agent's transition: room for all of them (train's default is steps)
         algo_kwargs["buffer_size"] = min(1_000_000, steps * len(agents))
     given = config.pop("algo_kwargs_given", None)
-    if mode == "scripted":
+    if mode in ("scripted", "shared"):   # the same env steps per rollout as with one env
         algo_kwargs = vector_defaults(algo_kwargs, set(algo_kwargs if given is None else given),
                                       int(n_envs), algo, config.get("algo_kwargs_provenance"))
     config["algo_kwargs"] = to_json(algo_kwargs)
@@ -186,7 +184,7 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
         from .workers import one_learner_vec_env
         venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs),
                                                      config.get("observation")),
-                                   int(n_envs), worker_timeout)
+                                   int(n_envs), worker_timeout, n_workers=int(n_cpus))
         per_env_step = 1
     try:
         venv, model, save = build_model(cls, algo, venv, config, algo_kwargs, seed, verbose)
@@ -210,7 +208,8 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
         log = RunLog(out, agents, evaluate, lambda: save(out / "best_model.zip"), t0, bar,
                      schedule, eval_seed)
         try:
-            cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop)
+            cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop,
+                              update_threads=cpu_cores())
             learn_and_finish(model, steps, per_env_step, cb, stop, save, out, schedule,
                              checkpoint, bar, log)
         finally:

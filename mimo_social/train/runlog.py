@@ -254,14 +254,27 @@ class RunLog:
 
 
 def sb3_callback(log: RunLog, schedule: Schedule, slot_agents: list[str] | None,
-                 per_env_step: int, save_checkpoint: Callable[[int], None], stop=None):
+                 per_env_step: int, save_checkpoint: Callable[[int], None], stop=None,
+                 update_threads: int = 1):
     """SB3 callback of the one-learner, scripted and shared modes: episodes (by slot: agent
     ``slot_agents[i % len]``), evaluations, checkpoints, and a stop when ``stop.requested``
     (:class:`~.interrupt.StopSignals`). ``per_env_step``: SB3 timesteps per environment step
-    (the number of agent slots a world). The final evaluation is the caller's."""
+    (the number of agent slots a world). The final evaluation is the caller's. Torch runs on
+    one thread while the envs step (the workers have the other cores) and on
+    ``update_threads`` for the update in between (the workers wait then)."""
+    import torch
     from stable_baselines3.common.callbacks import BaseCallback
 
     class RunLogCallback(BaseCallback):
+        def _on_rollout_start(self) -> None:
+            torch.set_num_threads(1)
+
+        def _on_rollout_end(self) -> None:
+            torch.set_num_threads(max(1, int(update_threads)))
+
+        def _on_training_end(self) -> None:
+            torch.set_num_threads(1)
+
         def _on_step(self) -> bool:
             n = self.num_timesteps // per_env_step
             for i, info in enumerate(self.locals.get("infos", ())):

@@ -56,17 +56,19 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           checkpoint_every: int | None = None, progress: bool = True,
           env_kwargs: Mapping[str, Any] | None = None,
           algo_kwargs: Mapping[str, Any] | None = None, verbose: int = 0,
-          mode: str | None = None, n_envs: int | None = None, n_cpus: int = 0,
+          mode: str | None = None, n_envs: int | None = None, n_cpus: int | None = None,
           normalize_obs: bool | None = None, flat_obs: bool = False, frame_stack: int = 1,
           worker_timeout: float = 600.0, normalize_reward: bool = False) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
     time). See the module docstring for what it writes.
 
     ``mode`` (``shared``, ``independent``, ``scripted``; default ``shared``) is for the
-    multi-agent tasks (:mod:`mimo_social.train.multi`). ``n_envs``: envs stepped for the
-    learner (one learner and ``scripted``: a spawned worker each when more than one; default:
-    the cores this process may use) or worlds (``shared``, with ``n_cpus`` worker processes;
-    default 1). ``eval_every=None``: the budgeted evaluation schedule
+    multi-agent tasks (:mod:`mimo_social.train.multi`). ``n_envs``: envs stepped together (one
+    learner, ``scripted``) or worlds (``shared``, ``independent``); default
+    :func:`~mimo_social.train.workers.default_n_envs` (4 per core). ``n_cpus``: the spawned
+    worker processes that step them (each a contiguous block, one after the other); default one
+    per core, at most one per env; 0: all in this process. ``eval_every=None``: the budgeted
+    evaluation schedule
     (:class:`~mimo_social.train.runlog.Schedule`). ``algo_kwargs`` override the shipped
     hyperparameters (:mod:`mimo_social.train.hyperparams`; every key checked before anything
     runs). ``normalize_obs`` (None: the task's shipped ``[run]`` default) puts running input
@@ -82,10 +84,6 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     mode = check_mode(task, mode)
     if mode is not None:
         task_module(task)  # a clear error before anything is written
-    if mode is None and n_cpus != 0:
-        raise TrainInputError(f"n_cpus={n_cpus}: worker processes for worlds are for the "
-                              f"multi-agent tasks in --mode shared; {task!r} takes --n-envs "
-                              "(one spawned worker per env)")
     env_id = check_task(task)
     cls = algo_class(algo)
     steps, seed = int(steps), int(seed)
@@ -107,12 +105,17 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     resolved, provenance = resolve(task, algo, algo_kwargs, mode=mode, steps=steps)
     if normalize_obs is None:
         normalize_obs = bool(run_options(task, mode).get("normalize_obs", False))
-    if n_envs is None:
-        if mode in ("shared", "independent"):
-            n_envs = 1
-        else:
-            from .workers import default_n_envs
-            n_envs = default_n_envs()
+    from .workers import default_n_envs, default_workers
+    if n_envs is None:   # independent: one world (its learners step it in lockstep)
+        n_envs = 1 if mode == "independent" else default_n_envs()
+    if isinstance(n_envs, bool) or not isinstance(n_envs, int) or n_envs < 1:
+        raise TrainInputError(f"n_envs={n_envs!r}; allowed: an integer >= 1")
+    if n_cpus is None:
+        n_cpus = 0 if mode == "independent" else default_workers(n_envs)
+    if isinstance(n_cpus, bool) or not isinstance(n_cpus, int) or not 0 <= n_cpus <= n_envs:
+        raise TrainInputError(f"n_cpus={n_cpus!r}; allowed: 0 (every env in this process) to "
+                              f"n_envs={n_envs} (worker processes, each stepping a block of "
+                              "the envs)")
     import torch
 
     eval_every = int(eval_every) if eval_every else None
@@ -143,4 +146,4 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
                         eval_episodes=eval_episodes, checkpoint_every=checkpoint_every,
                         progress=progress, env_kwargs=env_kwargs, algo_kwargs=kwargs,
                         verbose=verbose, config=config, n_envs=int(n_envs),
-                        worker_timeout=float(worker_timeout))
+                        n_cpus=int(n_cpus), worker_timeout=float(worker_timeout))

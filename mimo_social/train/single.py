@@ -27,6 +27,7 @@ from .interrupt import StopSignals
 from .progress import write_config
 from .rollouts import evaluate_policy, vecnormalize_path
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
+from ..util.cores import cpu_cores
 
 __all__ = ["train_single", "monitored_env", "vector_defaults", "warn", "reward_normalizer",
            "model_saver", "build_model", "learn_and_finish"]
@@ -144,7 +145,7 @@ def learn_and_finish(model, steps: int, per_env_step: int, callback, stop, save,
 def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every: int | None,
                  eval_episodes: int, checkpoint_every: int, progress: bool, env_kwargs: dict,
                  algo_kwargs: dict, verbose: int, config: dict, n_envs: int = 1,
-                 worker_timeout: float = 600.0) -> dict:
+                 n_cpus: int = 0, worker_timeout: float = 600.0) -> dict:
     """The one-learner part of :func:`mimo_social.train.runner.train` (arguments checked
     there); ``cls`` is the SB3 algorithm class. ``eval_every=None``: the budgeted schedule."""
     from .hyperparams import to_json     # (torch: not imported by the workers, which import
@@ -156,11 +157,12 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
     algo_kwargs = vector_defaults(algo_kwargs, given, int(n_envs), algo,
                                   config.get("algo_kwargs_provenance"))
     config.update({"algo_kwargs": to_json(algo_kwargs), "n_envs": int(n_envs),
-                   "worker_timeout": float(worker_timeout)})
+                   "n_cpus": int(n_cpus), "worker_timeout": float(worker_timeout)})
     observation = dict(config.get("observation", {}))
     eval_env = make_env(task, **observation, **env_kwargs)
     venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs),
-                                                 observation), int(n_envs), worker_timeout)
+                                                 observation), int(n_envs), worker_timeout,
+                               n_workers=int(n_cpus))
     stop = StopSignals()
     try:
         venv, model, save = build_model(cls, algo, venv, config, algo_kwargs, seed, verbose)
@@ -188,7 +190,8 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         t0 = log.t_start
         try:
             with stop:
-                cb = sb3_callback(log, schedule, None, 1, checkpoint, stop)
+                cb = sb3_callback(log, schedule, None, 1, checkpoint, stop,
+                                  update_threads=cpu_cores())
                 learn_and_finish(model, steps, 1, cb, stop, save, out, schedule, checkpoint,
                                  bar, log)
         finally:
