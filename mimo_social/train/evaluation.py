@@ -143,12 +143,17 @@ class _Bar:
             self.bar.close()
 
 
-def _sampled(run_episodes: Callable[[], dict], seed: int) -> dict:
-    """The stochastic policy's numbers (torch's random numbers forked, seeded with ``seed``)."""
+def _sampled(make: Callable[[], Any], run_episodes: Callable[[Any], dict], seed: int) -> dict:
+    """The stochastic policy's numbers: ``run_episodes(env)`` on a fresh env of ``make()``
+    (closed after), torch's random numbers forked and seeded with ``seed``."""
     import torch
-    with torch.random.fork_rng(devices=[]):
-        torch.manual_seed(seed)
-        res = run_episodes()
+    env = make()
+    try:
+        with torch.random.fork_rng(devices=[]):
+            torch.manual_seed(seed)
+            res = run_episodes(env)
+    finally:
+        env.close()
     keep = ("returns", "lengths", "return_mean", "return_std", "length_mean", "success_rate",
             "agents")
     return {k: res[k] for k in keep if k in res}
@@ -200,13 +205,10 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
         res = evaluate_policy(policy, env, episodes, seed, deterministic, on_step, bar,
                               normalize)
         if both:
-            plain = make_env(config["task"], **obs, **kw)
-            try:
-                res["stochastic"] = _sampled(lambda: evaluate_policy(
-                    policy, plain, episodes, seed, False, on_episode=bar,
-                    normalize=normalize), seed)
-            finally:
-                plain.close()
+            res["stochastic"] = _sampled(
+                lambda: make_env(config["task"], **obs, **kw),
+                lambda e: evaluate_policy(policy, e, episodes, seed, False, on_episode=bar,
+                                          normalize=normalize), seed)
     finally:
         bar.close()
         outputs.close()
@@ -308,13 +310,10 @@ def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed:
         res = evaluate_with_outputs(policies, env, env.unwrapped, episodes, seed, deterministic,
                                     record, video, frames, frame_every, bar, normalize)
         if both:
-            plain = make(config["task"], **kw)
-            try:
-                res["stochastic"] = _sampled(lambda: evaluate_agents(
-                    policies, plain, episodes, seed, False, on_episode=bar,
-                    normalize=normalize), seed)
-            finally:
-                plain.close()
+            res["stochastic"] = _sampled(
+                lambda: make(config["task"], **kw),
+                lambda e: evaluate_agents(policies, e, episodes, seed, False, on_episode=bar,
+                                          normalize=normalize), seed)
     finally:
         bar.close()
     res.update({"task": config["task"], "algo": config["algo"], "mode": config["mode"],
