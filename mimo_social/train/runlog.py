@@ -87,10 +87,12 @@ class Schedule:
     ``eval_every``: evaluate every so many steps with ``episodes`` episodes (per policy), as
     asked. ``None``: the budgeted default: no evaluation before the first update (``first``,
     set once the model exists), candidate points on a geometric grid of :data:`EVAL_POINTS` from
-    there to ``total``, and an evaluation at a point only if the env steps evaluated so far plus
-    its own (``policies * episodes * episode_steps``, an episode counted at its longest) stay
-    within ``fraction`` of the steps trained and leave room for the final evaluation; the final
-    evaluation has as many episodes (1 to ``episodes``) as fit in ``fraction * total``."""
+    there to ``total``, and at a point ``ceil(episodes * n / total)`` episodes per policy (one
+    early, ``episodes`` at the end) if the env steps evaluated so far plus its own
+    (``policies * episodes * episode_steps``, an episode counted at its longest) stay within
+    ``fraction`` of the steps trained and leave room for the final evaluation: early evaluations
+    are short and come as soon as one episode fits, later ones longer. The final evaluation has
+    as many episodes (1 to ``episodes``) as fit in ``fraction * total``."""
 
     def __init__(self, eval_every: int | None, checkpoint_every: int, total: int, *,
                  episodes: int = 5, episode_steps: int = 1000, first: int = 1,
@@ -157,14 +159,16 @@ class Schedule:
             self.next_eval = self.first
         if n < self.next_eval:
             return 0
-        c = self.cost(self.episodes)
         reserve = self.cost(self.final_episodes())
-        if (self.spent + c > self.fraction * n
-                or self.spent + c + reserve > self.fraction * self.total):
+        room = min(self.fraction * n - self.spent,
+                   self.fraction * self.total - reserve - self.spent)
+        # the episodes grow with the run, from one to `episodes` at its end
+        episodes = max(1, min(self.episodes, math.ceil(self.episodes * n / self.total)))
+        if room < self.cost(episodes):
             return 0
         later = self.points()[self.points() > n]
         self.next_eval = int(later[0]) if len(later) else self.total
-        return self.episodes
+        return episodes
 
 
 class RunLog:

@@ -78,6 +78,22 @@ def test_the_budgeted_schedule_spreads_evaluations_and_never_overspends():
     assert made[0] >= 2048 and len(made) >= 5
     gaps = np.diff(made)
     assert gaps[-1] > gaps[0]                  # sparse early, wider apart later
+    # long episodes (1000 steps, 2 policies: 2000 env steps an episode each): the first
+    # evaluation comes as soon as one episode of each fits, at ~10x its cost; later ones longer
+    s = Schedule(None, 0, 300_000, episodes=5, episode_steps=1000, first=2048)
+    made = {}
+    for n in range(2048, 300_000, 64):
+        k = s.eval_due(n)
+        if k:
+            made[n] = k
+            s.spend(s.cost(k))
+            assert s.spent <= EVAL_FRACTION * n
+    first = min(made)
+    assert made[first] == 1 and first <= 25_000
+    assert max(made.values()) >= 3 and list(made.values()) == sorted(made.values())
+    assert s.final_episodes() == 5
+    s.spend(s.cost(s.final_episodes()))
+    assert s.spent <= EVAL_FRACTION * 300_000
     # an explicit interval keeps its meaning, its episodes too
     s = Schedule(128, 0, 512, episodes=3)
     assert [n for n in range(1, 512) if s.eval_due(n)] == [128, 256, 384]
