@@ -11,13 +11,11 @@
     ``("MultiInputPolicy", {"features_extractor_class": EyesExtractor, ...})`` for a ``Dict``
     with an image, else ``("MlpPolicy", {})``.
 
-The image encoder (:class:`ImageEncoder`), sized for square images of 32 to 128 px: pixels
-scaled to [0, 1] inside; a 5x5 convolution of stride 2 with 32 channels, then 3x3 convolutions
-of stride 2 with 64 channels until the side is at most 8 px (two for 32 and 64 px, three for 96
-and 128 px; padding keeps ``ceil(side / 2)`` at each, so a 32 px image ends at 4x4 and nothing
-goes negative), ReLU after each; flattened (at most 64 x 8 x 8 = 4096 values, whatever the
-resolution) and one ``Linear + ReLU`` to ``image_dim`` (128) features. No pooling: where the
-partner's face is in the image is what joint attention needs.
+The image encoder is :class:`~mimo_social.train.image_cnn.ImageCNN` (``ImageEncoder`` here: the
+same class), the one CNN of the SB3 and the RLlib paths, sized for square images of 32 to 128
+px: pixels scaled to [0, 1] inside; a 5x5 convolution of stride 2 with 32 channels, then 3x3
+convolutions of stride 2 with 64 channels until the side is at most 8 px, ReLU after each;
+flattened and one ``Linear + ReLU`` to ``image_dim`` (128) features. No pooling.
 
 Weights: images of the same shape (the two eyes) share one encoder by default
 (``share_weights=True``): both eyes see the same kind of scene, sharing halves the parameters
@@ -40,44 +38,14 @@ from stable_baselines3.common.preprocessing import is_image_space
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 from torch import nn
 
+from .image_cnn import MAX_FINAL_SIDE, ImageCNN
 from .obs_norm import RunningNorm
 
-__all__ = ["ImageEncoder", "EyesExtractor", "policy_spec", "policy_for", "image_space_keys",
-           "RECURRENT_POLICIES"]
+__all__ = ["EyesExtractor", "policy_spec", "policy_for", "image_space_keys",
+           "RECURRENT_POLICIES", "ImageCNN", "ImageEncoder", "MAX_FINAL_SIDE"]
 
-#: the side (px) at or below which no further stride-2 convolution is added
-MAX_FINAL_SIDE = 8
-
-
-class ImageEncoder(nn.Module):
-    """One image ``(C, H, W)``, raw 0..255 values, to ``out_dim`` features (module docstring)."""
-
-    def __init__(self, shape: tuple[int, int, int], out_dim: int = 128,
-                 first_channels: int = 32, channels: int = 64):
-        super().__init__()
-        c, h, w = (int(v) for v in shape)
-        if min(c, h, w) < 1:
-            raise ValueError(f"image shape {shape} not allowed; allowed: (C, H, W), all >= 1")
-        layers: list[nn.Module] = [nn.Conv2d(c, first_channels, 5, stride=2, padding=2),
-                                   nn.ReLU()]
-        side = max(h, w)
-        side = (side + 1) // 2
-        n_in = first_channels
-        n_convs = 1
-        while n_convs < 3 or side > MAX_FINAL_SIDE:
-            layers += [nn.Conv2d(n_in, channels, 3, stride=2, padding=1), nn.ReLU()]
-            n_in, side, n_convs = channels, (side + 1) // 2, n_convs + 1
-            if side == 1:
-                break
-        layers.append(nn.Flatten())
-        self.cnn = nn.Sequential(*layers)
-        with torch.no_grad():
-            n_flat = int(self.cnn(torch.zeros(1, c, h, w)).shape[1])
-        self.head = nn.Sequential(nn.Linear(n_flat, out_dim), nn.ReLU())
-        self.out_dim = int(out_dim)
-
-    def forward(self, images: torch.Tensor) -> torch.Tensor:
-        return self.head(self.cnn(images.float() * (1.0 / 255.0)))
+#: the image CNN's former name here (the class lives in :mod:`~mimo_social.train.image_cnn`)
+ImageEncoder = ImageCNN
 
 
 def image_space_keys(space: spaces.Space) -> tuple[str, ...]:
@@ -108,14 +76,14 @@ class EyesExtractor(BaseFeaturesExtractor):
         if not keys:
             raise TypeError(f"EyesExtractor needs a Dict observation with an image (a uint8 "
                             f"Box (C, H, W), bounds 0..255), got {observation_space}")
-        encoders: dict[str, ImageEncoder] = {}
-        by_shape: dict[tuple, ImageEncoder] = {}
+        encoders: dict[str, ImageCNN] = {}
+        by_shape: dict[tuple, ImageCNN] = {}
         for key in keys:
             shape = _channels_first(observation_space[key].shape)
             if share_weights and shape in by_shape:
                 encoders[key] = by_shape[shape]
             else:
-                encoders[key] = by_shape[shape] = ImageEncoder(shape, image_dim)
+                encoders[key] = by_shape[shape] = ImageCNN(shape, image_dim)
         others = [k for k in observation_space.spaces if k not in encoders]
         n_other = sum(int(spaces.flatdim(observation_space[k])) for k in others)
         if vector_dim is not None and n_other > 0:

@@ -7,6 +7,10 @@ the policy: they are saved in ``model.zip`` and restored by ``PPO.load`` / ``SAC
 evaluation needs nothing else. They are updated from the batches the policy is trained on (SB3
 puts the policy in training mode only in ``train()``), never while acting or evaluating.
 
+The statistics and their update are :class:`~mimo_social.train.image_cnn.RunningMeanStd`'s
+(the normaliser of the RLlib eyes module too); ``RunningNorm`` is that module and an SB3
+``BaseFeaturesExtractor``, flattening its input and learning in training mode.
+
 ``mimo-social train ... --normalize-obs`` uses it (``policy_kwargs={"features_extractor_class":
 RunningNorm}``).
 """
@@ -18,34 +22,21 @@ import torch
 from gymnasium import spaces
 from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
 
+from .image_cnn import RunningMeanStd
+
 __all__ = ["RunningNorm"]
 
 
-class RunningNorm(BaseFeaturesExtractor):
+class RunningNorm(RunningMeanStd, BaseFeaturesExtractor):
+    """Running mean/std normalisation of a flattened observation (module docstring); the
+    state-dict keys are ``mean``, ``var`` and ``count``."""
+
     def __init__(self, observation_space: spaces.Box, clip: float = 10.0, eps: float = 1e-8):
         n = int(np.prod(observation_space.shape))
-        super().__init__(observation_space, features_dim=n)
-        self.clip, self.eps = float(clip), float(eps)
-        self.register_buffer("mean", torch.zeros(n))
-        self.register_buffer("var", torch.ones(n))
-        self.register_buffer("count", torch.tensor(1e-4, dtype=torch.float64))
-
-    @torch.no_grad()
-    def _update(self, x: torch.Tensor) -> None:
-        """Merge a batch's mean and variance into the running ones (Chan et al.'s parallel
-        formula)."""
-        b = x.shape[0]
-        bm, bv = x.mean(0), x.var(0, unbiased=False)
-        total = self.count + b
-        delta = bm - self.mean
-        w = float(b / total)
-        self.mean += delta * w
-        m2 = self.var * float(self.count) + bv * b + delta.pow(2) * float(self.count * b / total)
-        self.var.copy_(m2 / float(total))
-        self.count.copy_(total)
+        super().__init__(n, clip, eps, observation_space=observation_space, features_dim=n)
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         x = observations.flatten(1).float()
-        if self.training and x.shape[0] > 1:
-            self._update(x)
-        return ((x - self.mean) / torch.sqrt(self.var + self.eps)).clamp(-self.clip, self.clip)
+        if self.training:
+            self.update(x)     # (a batch of one row is skipped)
+        return self.normalize(x)

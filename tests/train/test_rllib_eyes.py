@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import csv
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,6 +18,8 @@ import torch  # noqa: E402
 from gymnasium import spaces  # noqa: E402
 
 EYES = {"max_steps": 20, "per_agent": [{"vision": {"width": 32, "height": 32}}, {}]}
+#: saved with the code of before (data/make_eyes_cnn_models.py)
+OLD_STATE = Path(__file__).resolve().parent / "data" / "rllib_eyes_state.npz"
 TINY = {"train_batch_size_per_learner": 40, "minibatch_size": 20, "num_epochs": 1,
         "fcnet_hiddens": [16], "image_dim": 16}
 
@@ -133,6 +136,83 @@ def test_frame_stack_stacks_eye_channels_and_normalize_obs_normalises_in_the_mod
     module.forward_train({"obs": obs})               # the learner's pass updates them
     after = module.get_state()
     assert any(not np.allclose(after[k], v) for k, v in state.items())
+
+
+def _small_module(eyes, algo="ppo"):
+    from ray.rllib.core.rl_module.rl_module import RLModuleSpec
+
+    from mimo_social.train.rllib.module import EyesAPPOModule, EyesPPOModule
+
+    parts = {eye: spaces.Box(0, 255, (3, 32, 32), np.uint8) for eye in eyes}
+    parts["vector"] = spaces.Box(-np.inf, np.inf, (5,), np.float32)
+    return RLModuleSpec(module_class=EyesAPPOModule if algo == "appo" else EyesPPOModule,
+                        observation_space=spaces.Dict(parts),
+                        action_space=spaces.Box(-1, 1, (2,), np.float32),
+                        model_config={"image_dim": 8, "fcnet_hiddens": [16],
+                                      "normalize_vector": True}).build()
+
+
+def test_the_module_uses_the_one_image_cnn_of_both_paths():
+    from mimo_social.train import image_cnn
+    from mimo_social.train.rllib import module as rllib_module
+
+    assert rllib_module.ImageCNN is image_cnn.ImageCNN
+    assert rllib_module.RunningMeanStd is image_cnn.RunningMeanStd
+    module = _small_module(("eye_left", "eye_right"))
+    cnns = module.encoder.cnns
+    assert type(cnns["eye_left"]) is image_cnn.ImageCNN and cnns["eye_left"] is cnns["eye_right"]
+    assert "encoder.cnns.eye_right.cnn.4.weight" in module.get_state()
+    assert "encoder.cnns.eye_left.head.0.bias" in module.get_state()
+
+
+def test_a_module_state_saved_before_the_shared_cnn_loads():
+    """``rllib_eyes_state.npz``: the state of an ``EyesPPOModule`` (one 32 px eye, a 5-float
+    vector, ``image_dim`` 8, ``fcnet_hiddens`` [16], ``normalize_vector``) saved when the module
+    had its own CNN (layers ``convs.*`` / ``out.0``), with its action-distribution inputs and
+    values on two observations. ``set_state`` is what RLlib's checkpoint restore calls, with
+    ``strict=False``: a layer left out would pass silently, so the values are compared."""
+    data = np.load(OLD_STATE)
+    old = {k[len("state/"):]: data[k] for k in data.files if k.startswith("state/")}
+    assert "encoder.cnns.eye_left.convs.0.weight" in old
+    obs = {k[len("obs_"):]: torch.from_numpy(data[k]) for k in data.files
+           if k.startswith("obs_")}
+    today = {k.replace(".convs.", ".cnn.").replace("eye_left.out.", "eye_left.head."): v
+             for k, v in old.items()}
+    torch.manual_seed(1)
+    module = _small_module(("eye_left",))
+    assert sorted(module.get_state()) == sorted(today)
+    module.set_state(old)
+    state = module.get_state()
+    for key, value in today.items():   # (RLlib passes float64 through float32: the count)
+        np.testing.assert_allclose(np.asarray(state[key]), value, rtol=1e-7, atol=0,
+                                   err_msg=key)
+    with torch.no_grad():
+        dist = module.forward_inference({"obs": obs})["action_dist_inputs"].numpy()
+        values = module.compute_values({"obs": obs}).numpy()
+    np.testing.assert_allclose(dist, data["dist_inputs"], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(values, data["values"], rtol=0, atol=1e-5)
+
+    # APPO's checkpoint holds the same names under its target network's
+    appo = _small_module(("eye_left",), "appo")
+    appo.make_target_networks()
+    appo.set_state({**old, **{f"_old_{k}": v for k, v in old.items()
+                              if k.startswith(("encoder.", "pi."))}})
+    with torch.no_grad():
+        target = next(iter(appo.forward_target({"obs": obs}).values())).numpy()
+    np.testing.assert_allclose(target, data["dist_inputs"], rtol=0, atol=1e-6)
+
+    # two eyes sharing one CNN: the state held a copy under each eye (the MLPs are wider here)
+    both = _small_module(("eye_left", "eye_right"))
+    cnn_state = {k: v for k, v in old.items() if k.startswith("encoder.cnns.")}
+    both.set_state({**{k: v for k, v in both.get_state().items()
+                       if not k.startswith("encoder.cnns.")},
+                    **cnn_state, **{k.replace("eye_left", "eye_right"): v
+                                    for k, v in cnn_state.items()}})
+    state = both.get_state()
+    for key in ("cnn.0.weight", "cnn.4.bias", "head.0.weight"):
+        for eye in ("eye_left", "eye_right"):
+            np.testing.assert_array_equal(np.asarray(state[f"encoder.cnns.{eye}.{key}"]),
+                                          today[f"encoder.cnns.eye_left.{key}"])
 
 
 @pytest.fixture(scope="module")

@@ -4,17 +4,21 @@ eye a ``uint8`` channel-first image ``(3 * frame_stack, H, W)``, every other sen
 ``"vector"``. :func:`~mimo_social.train.rllib.config.build_config` gives them to PPO and APPO
 for such agents; agents without eyes keep RLlib's default module on their flat Box.
 
-The network is the one of the SB3 path (:mod:`mimo_social.train.encoders`), written for RLlib:
+The network is the one of the SB3 path (:mod:`mimo_social.train.encoders`), written for RLlib;
+the CNN and the running statistics are the same classes (:mod:`mimo_social.train.image_cnn`):
 
-* a CNN per image (:class:`ImageCNN`): pixels scaled to [0, 1], a 5x5 convolution of stride 2
-  with 32 channels, then 3x3 convolutions of stride 2 with 64 channels (at least three
-  convolutions in all) until the side is at most 8 px, ReLU after each, flattened, then
-  ``Linear + ReLU`` to ``image_dim`` (128) features. Images of the same shape (the two eyes)
-  share one CNN (``share_weights``), their features are kept apart (concatenated);
+* a CNN per image (:class:`~mimo_social.train.image_cnn.ImageCNN`): pixels scaled to [0, 1], a
+  5x5 convolution of stride 2 with 32 channels, then 3x3 convolutions of stride 2 with 64
+  channels (at least three convolutions in all) until the side is at most 8 px, ReLU after
+  each, flattened, then ``Linear + ReLU`` to ``image_dim`` (128) features. Images of the same
+  shape (the two eyes) share one CNN (``share_weights``), their features are kept apart
+  (concatenated). Its layers are ``cnn.*`` and ``head.0`` (state keys such as
+  ``encoder.cnns.eye_left.cnn.0.weight``); checkpoints saved when this module had its own copy
+  (``convs.*``, ``out.0``) are renamed as they load;
 * the ``"vector"`` appended to the image features as it is, or (``normalize_vector``) shifted and
-  scaled by running statistics (:class:`RunningMeanStd`, updated by the learner's training
-  passes, torch buffers of the module: saved in its checkpoint and sent to the env runners with
-  the weights; the pixels are only scaled);
+  scaled by running statistics (:class:`~mimo_social.train.image_cnn.RunningMeanStd`, updated
+  by the learner's training passes, torch buffers of the module: saved in its checkpoint and
+  sent to the env runners with the weights; the pixels are only scaled);
 * as SB3's PPO: the features shared by a policy MLP and a separate value MLP (``fcnet_hiddens``
   of ``fcnet_activation``: two tanh layers of 64), a linear action layer and a linear value
   layer; SB3's initial weights (orthogonal, gain sqrt 2, 0.01 on the action layer, 1 on the
@@ -48,16 +52,15 @@ from ray.rllib.core.rl_module.torch import TorchRLModule
 from torch import nn
 
 from ...core.wrappers import VECTOR_KEY
+from ..image_cnn import MAX_FINAL_SIDE, ImageCNN, RunningMeanStd
 
 __all__ = ["EyesPPOModule", "EyesAPPOModule", "EyesEncoder", "ImageCNN", "RunningMeanStd",
-           "DEFAULTS", "has_images"]
+           "DEFAULTS", "has_images", "MAX_FINAL_SIDE"]
 
 #: the model settings of the modules (SB3's PPO network behind the CNN)
 DEFAULTS: dict[str, Any] = {"fcnet_hiddens": [64, 64], "fcnet_activation": "tanh",
                             "free_log_std": True, "image_dim": 128, "share_weights": True,
                             "normalize_vector": False}
-#: the side (px) at or below which no further stride-2 convolution is added
-MAX_FINAL_SIDE = 8
 HIDDEN_GAIN, PI_GAIN, VF_GAIN = math.sqrt(2.0), 0.01, 1.0
 _ACTIVATIONS = {"tanh": nn.Tanh, "relu": nn.ReLU, "elu": nn.ELU, "silu": nn.SiLU,
                 "swish": nn.SiLU, "linear": nn.Identity, None: nn.Identity}
@@ -82,58 +85,6 @@ def _image_shapes(space: spaces.Space) -> dict[str, tuple[int, int, int]]:
                 and np.all(sub.high == 255)):
             out[key] = tuple(int(v) for v in sub.shape)
     return out
-
-
-class ImageCNN(nn.Module):
-    """One channel-first image ``(C, H, W)`` of raw 0..255 values to ``out_dim`` features
-    (module docstring)."""
-
-    def __init__(self, shape: tuple[int, int, int], out_dim: int = 128):
-        super().__init__()
-        c, h, w = shape
-        layers: list[nn.Module] = [nn.Conv2d(c, 32, 5, stride=2, padding=2), nn.ReLU()]
-        side, n_in, n_convs = (max(h, w) + 1) // 2, 32, 1
-        while (n_convs < 3 or side > MAX_FINAL_SIDE) and side > 1:
-            layers += [nn.Conv2d(n_in, 64, 3, stride=2, padding=1), nn.ReLU()]
-            n_in, side, n_convs = 64, (side + 1) // 2, n_convs + 1
-        layers.append(nn.Flatten())
-        self.convs = nn.Sequential(*layers)
-        with torch.no_grad():
-            n_flat = int(self.convs(torch.zeros(1, c, h, w)).shape[1])
-        self.out = nn.Sequential(nn.Linear(n_flat, int(out_dim)), nn.ReLU())
-
-    def forward(self, images: torch.Tensor) -> torch.Tensor:
-        return self.out(self.convs(images.float() * (1.0 / 255.0)))
-
-
-class RunningMeanStd(nn.Module):
-    """Inputs shifted and scaled by a running mean and variance (clipped to +-10); the
-    statistics are buffers, updated only by :meth:`update`."""
-
-    def __init__(self, n: int, clip: float = 10.0, eps: float = 1e-8):
-        super().__init__()
-        self.clip, self.eps = float(clip), float(eps)
-        self.register_buffer("mean", torch.zeros(n))
-        self.register_buffer("var", torch.ones(n))
-        self.register_buffer("count", torch.tensor(1e-4, dtype=torch.float64))
-
-    @torch.no_grad()
-    def update(self, x: torch.Tensor) -> None:
-        """Merge a batch's mean and variance into the running ones."""
-        b = x.shape[0]
-        if b < 2:
-            return
-        batch_mean, batch_var = x.mean(0), x.var(0, unbiased=False)
-        total = self.count + b
-        delta = batch_mean - self.mean
-        self.mean += delta * float(b / total)
-        m2 = (self.var * float(self.count) + batch_var * b
-              + delta.pow(2) * float(self.count * b / total))
-        self.var.copy_(m2 / float(total))
-        self.count.copy_(total)
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        return ((x - self.mean) / torch.sqrt(self.var + self.eps)).clamp(-self.clip, self.clip)
 
 
 class EyesEncoder(nn.Module):
