@@ -45,6 +45,7 @@ import numpy as np
 from .machine import load_average, machine_info
 
 __all__ = ["TrainingConfig", "DEFAULT_TASKS", "DEFAULT_WORKERS", "TARGETS", "TARGET_WORKERS",
+           "TARGET_ENVS_PER_WORKER",
            "ENV_WARMUP", "configs", "env_alone", "learning_phase", "measure", "targets",
            "format_table", "markdown"]
 
@@ -56,6 +57,8 @@ DEFAULT_WORKERS = (1, 2)
 #: :data:`TARGET_WORKERS` workers
 TARGETS = {"reach": 0.60, "high_five": 0.60, "mirror": 0.40}
 TARGET_WORKERS = 2
+#: the envs per worker the targets are read at: ``train``'s default
+TARGET_ENVS_PER_WORKER = 4
 #: untimed vector steps of the env alone after its reset
 ENV_WARMUP = 10
 
@@ -65,23 +68,34 @@ Rate = Callable[["TrainingConfig", int, int], dict]
 @dataclass(frozen=True)
 class TrainingConfig:
     """One configuration: ``task``, its training ``mode`` (None: a one-agent task; ``scripted``:
-    one learner, the partner scripted) and the number of env ``workers``."""
+    one learner, the partner scripted), the number of env ``workers`` (processes) and the envs
+    each steps (``envs_per_worker``; ``n_envs`` in all)."""
 
     task: str
     mode: str | None
     workers: int
+    envs_per_worker: int = 1
+
+    @property
+    def n_envs(self) -> int:
+        return self.workers * self.envs_per_worker
 
     @property
     def name(self) -> str:
         mode = f" --mode {self.mode}" if self.mode else ""
-        return f"{self.task}{mode}, {self.workers} worker{'s' if self.workers > 1 else ''}"
+        return (f"{self.task}{mode}, {self.workers} worker{'s' if self.workers > 1 else ''} x "
+                f"{self.envs_per_worker} env{'s' if self.envs_per_worker > 1 else ''}")
 
 
 def configs(tasks: Sequence[str], workers: Sequence[int],
-            modes: Mapping[str, str | None]) -> list[TrainingConfig]:
-    """Every task x workers configuration, a task's worker counts next to each other;
+            modes: Mapping[str, str | None],
+            envs_per_worker: Sequence[int] = (1,)) -> list[TrainingConfig]:
+    """Every task x workers x envs-per-worker configuration, a task's next to each other;
     ``modes``: every task that may be measured -> its training mode. ValueError, naming what is
-    allowed, for an unknown task or a worker count below 1."""
+    allowed, for an unknown task or a count below 1."""
+    for k in envs_per_worker:
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"envs_per_worker={k!r}; allowed: integers >= 1, e.g. 1,4")
     tasks, workers = list(tasks), list(workers)
     if not tasks:
         raise ValueError("no task given; allowed: " + ", ".join(modes))
@@ -96,7 +110,8 @@ def configs(tasks: Sequence[str], workers: Sequence[int],
             raise ValueError(f"workers={n!r}; allowed: integers >= 1, e.g. 1,2")
     if len(set(tasks)) != len(tasks) or len(set(workers)) != len(workers):
         raise ValueError(f"a task or worker count is repeated: tasks {tasks}, workers {workers}")
-    return [TrainingConfig(t, modes[t], int(n)) for t in tasks for n in workers]
+    return [TrainingConfig(t, modes[t], int(n), int(k)) for t in tasks for n in workers
+            for k in dict.fromkeys(envs_per_worker)]
 
 
 def _check_steps(steps: int) -> int:
@@ -226,15 +241,17 @@ def _versions() -> dict:
 
 
 def targets(results: dict) -> list[dict]:
-    """Issue 29's targets (:data:`TARGETS`, with :data:`TARGET_WORKERS` workers) for the
-    measured tasks: task, the ratio wanted, the ratio measured and whether it is met (None:
-    not measured with that many workers)."""
-    by = {(r["task"], r["workers"]): r["ratio"] for r in results["rows"]}
+    """Issue 29's targets (:data:`TARGETS`, with :data:`TARGET_WORKERS` workers of
+    :data:`TARGET_ENVS_PER_WORKER` envs, train's default) for the measured tasks: task, the
+    ratio wanted, the ratio measured and whether it is met (None: not measured so)."""
+    by = {(r["task"], r["workers"], r.get("envs_per_worker", 1)): r["ratio"]
+          for r in results["rows"]}
     out = []
     for task in dict.fromkeys(r["task"] for r in results["rows"]):
         if task in TARGETS:
-            got = by.get((task, TARGET_WORKERS))
-            out.append({"task": task, "workers": TARGET_WORKERS, "wanted": TARGETS[task],
+            got = by.get((task, TARGET_WORKERS, TARGET_ENVS_PER_WORKER))
+            out.append({"task": task, "workers": TARGET_WORKERS,
+                        "envs_per_worker": TARGET_ENVS_PER_WORKER, "wanted": TARGETS[task],
                         "ratio": got, "met": None if got is None else got >= TARGETS[task]})
     return out
 
@@ -242,13 +259,14 @@ def targets(results: dict) -> list[dict]:
 def format_table(results: dict) -> str:
     """The markdown table: per task and workers the env alone's and PPO's env steps/s, their
     ratio, the whole train call's steps/s and the parts of the call outside the timed phase."""
-    lines = ["| task | workers | env alone steps/s | PPO steps/s | PPO / env | whole train() "
-             "steps/s | start s (to the 1st update's end) | final eval steps, s |",
+    lines = ["| task | workers x envs | env alone steps/s | PPO steps/s | PPO / env | whole "
+             "train() steps/s | start s (to the 1st update's end) | final eval steps, s |",
              "|---|---|---|---|---|---|---|---|"]
     for r in results["rows"]:
         e, p = r["env"], r["ppo"]
         task = f"`{r['task']}`" + (f" ({r['mode']})" if r["mode"] else "")
-        lines.append(f"| {task} | {r['workers']} | {e['steps_per_s']:.0f} | "
+        lines.append(f"| {task} | {r['workers']} x {r.get('envs_per_worker', 1)} | "
+                     f"{e['steps_per_s']:.0f} | "
                      f"{p['steps_per_s']:.0f} | **{r['ratio']:.0%}** | "
                      f"{p.get('call_steps_per_s', float('nan')):.0f} | "
                      f"{p.get('startup_s', float('nan')):.1f} | "
@@ -278,7 +296,8 @@ def markdown(results: dict) -> str:
         for t in met:
             verdict = ("not measured" if t["met"] is None
                        else f"{t['ratio']:.0%}: {'met' if t['met'] else 'NOT met'}")
-            text.append(f"- `{t['task']}`, {t['workers']} workers: target >= "
+            text.append(f"- `{t['task']}`, {t['workers']} workers x {t['envs_per_worker']} "
+                        "envs: target >= "
                         f"{t['wanted']:.0%} of the env alone; {verdict}")
     if results.get("command"):
         text += ["", "```", results["command"], "```"]

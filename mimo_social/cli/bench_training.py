@@ -26,6 +26,7 @@ from pathlib import Path
 
 from ..bench import training as bench
 from ..train import MULTI_TASKS, TASKS, train
+from ..train.workers import ENVS_PER_WORKER
 from ._args import comma_choices, output_dir, output_file, positive_int, seed, write_file
 
 __all__ = ["NAME", "HELP", "add_parser", "run", "MODES", "DEFAULT_STEPS", "DEFAULT_STEPS_EYES",
@@ -48,16 +49,16 @@ DEFAULT_STEPS_EYES = 4096
 OBSERVATION = {"flat": False, "frame_stack": 1}
 
 
-def rollout_steps(task: str, mode: str | None, workers: int,
+def rollout_steps(task: str, mode: str | None, n_envs: int,
                   algo_kwargs: dict | None = None) -> int:
-    """Env steps per PPO rollout in a run of ``task`` with ``workers`` envs: the shipped
-    ``n_steps`` (under ``algo_kwargs``) per env, as train() divides it, times ``workers``."""
+    """Env steps per PPO rollout in a run of ``task`` with ``n_envs`` envs: the shipped
+    ``n_steps`` (under ``algo_kwargs``) per env, as train() divides it, times ``n_envs``."""
     from ..train.hyperparams import resolve, to_sb3
     from ..train.single import vector_defaults
 
     resolved, _ = resolve(task, "ppo", algo_kwargs, mode=mode)
-    kw = vector_defaults(to_sb3("ppo", resolved), set(algo_kwargs or {}), int(workers), "ppo")
-    return int(kw.get("n_steps", 2048)) * int(workers)
+    kw = vector_defaults(to_sb3("ppo", resolved), set(algo_kwargs or {}), int(n_envs), "ppo")
+    return int(kw.get("n_steps", 2048)) * int(n_envs)
 
 
 def has_eyes(task: str) -> bool:
@@ -79,12 +80,14 @@ def default_steps(tasks) -> dict:
 
 
 def env_rate(config: bench.TrainingConfig, steps: int, seed: int = 0) -> dict:
-    """The env alone: the learner's vector env with ``config.workers`` envs, random actions."""
+    """The env alone: the learner's vector env (``config.n_envs`` envs in ``config.workers``
+    worker processes), random actions."""
     from ..train.single import monitored_env
     from ..train.workers import one_learner_vec_env   # (imports SB3)
 
     env_fn = functools.partial(monitored_env, config.task, {}, dict(OBSERVATION))
-    return bench.env_alone(lambda: one_learner_vec_env(env_fn, config.workers), steps, seed)
+    return bench.env_alone(lambda: one_learner_vec_env(env_fn, config.n_envs,
+                                                       n_workers=config.workers), steps, seed)
 
 
 def ppo_rate(config: bench.TrainingConfig, steps: int, seed: int = 0, *, root: str | Path,
@@ -92,16 +95,16 @@ def ppo_rate(config: bench.TrainingConfig, steps: int, seed: int = 0, *, root: s
     """A PPO run of ``steps`` env steps into ``root/<task>_<workers>`` (the shipped
     hyperparameters under ``algo_kwargs``) and its learning phase's figures. ValueError when
     ``steps`` does not reach past the first rollout (nothing to time)."""
-    rollout = rollout_steps(config.task, config.mode, config.workers, algo_kwargs)
+    rollout = rollout_steps(config.task, config.mode, config.n_envs, algo_kwargs)
     if steps <= rollout:
         raise ValueError(f"steps={steps}: {config.name} needs more than one PPO rollout "
                          f"({rollout} env steps) to time the learning after the first update; "
                          f"give at least {2 * rollout}")
-    out = Path(root) / f"{config.task}_{config.workers}"
+    out = Path(root) / f"{config.task}_{config.workers}x{config.envs_per_worker}"
     t0 = time.time()
-    train(config.task, "ppo", steps, seed, out, mode=config.mode, n_envs=config.workers,
-          progress=False, eval_every=10 * steps, eval_episodes=1,
-          checkpoint_every=rollout + config.workers, algo_kwargs=algo_kwargs)
+    train(config.task, "ppo", steps, seed, out, mode=config.mode, n_envs=config.n_envs,
+          n_cpus=config.workers, progress=False, eval_every=10 * steps, eval_episodes=1,
+          checkpoint_every=rollout + config.n_envs, algo_kwargs=algo_kwargs)
     res = bench.learning_phase(out, t0, time.time())
     if res["rollout"] != rollout:
         raise RuntimeError(f"{out}: the run's rollout is {res['rollout']} env steps, not the "
@@ -111,11 +114,12 @@ def ppo_rate(config: bench.TrainingConfig, steps: int, seed: int = 0, *, root: s
 
 def measure(tasks=bench.DEFAULT_TASKS, workers=bench.DEFAULT_WORKERS,
             steps: int | dict | None = None, seed: int = 0, *, root: str | Path | None = None,
-            algo_kwargs: dict | None = None, progress: bool = False, command: str = "") -> dict:
+            algo_kwargs: dict | None = None, progress: bool = False, command: str = "",
+            envs_per_worker=(ENVS_PER_WORKER,)) -> dict:
     """:func:`mimo_social.bench.training.measure` with SB3's measuring functions: every task x
     workers configuration, ``steps`` env steps each (or task -> steps; None:
     :func:`default_steps`); the runs go to ``root`` (None: a temporary folder, removed)."""
-    configurations = bench.configs(tasks, workers, MODES)
+    configurations = bench.configs(tasks, workers, MODES, envs_per_worker)
     if steps is None:
         steps = default_steps(tasks)
     with tempfile.TemporaryDirectory(prefix="bench_training_") as tmp:
@@ -141,6 +145,12 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
                                                         "worker count"),
                         default=[str(n) for n in bench.DEFAULT_WORKERS],
                         help="env worker counts, comma-separated, 1 to 16 (default 1,2)")
+    parser.add_argument("--envs-per-worker", type=comma_choices([str(n) for n in range(1, 33)],
+                                                                "envs per worker"),
+                        default=[str(ENVS_PER_WORKER)],
+                        help=f"envs each worker steps, comma-separated, 1 to 32 (default "
+                             f"{ENVS_PER_WORKER}: train's; 1 is the one-env-per-process "
+                             "layout of before)")
     parser.add_argument("--steps", type=positive_int, default=None,
                         help=f"env steps per configuration, each side; more than one PPO "
                              f"rollout of 2048 (default {DEFAULT_STEPS}, {DEFAULT_STEPS_EYES} "
@@ -155,11 +165,12 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> int:
     workers = [int(n) for n in args.workers]
+    envs = [int(n) for n in args.envs_per_worker]
     command = (f"mimo-social bench training --tasks {','.join(args.tasks)} --workers "
-               f"{','.join(map(str, workers))}"
+               f"{','.join(map(str, workers))} --envs-per-worker {','.join(map(str, envs))}"
                + (f" --steps {args.steps}" if args.steps else "") + f" --seed {args.seed}")
     results = measure(args.tasks, workers, args.steps, args.seed, root=args.runs,
-                      progress=True, command=command)
+                      progress=True, command=command, envs_per_worker=envs)
     print(bench.markdown(results))
     if args.json:
         write_file(args.json, json.dumps(results, indent=1))

@@ -15,22 +15,29 @@ TINY = {"n_steps": 64, "batch_size": 64, "n_epochs": 1}
 
 
 def test_measure_gives_positive_rates_for_each_configuration(tmp_path):
-    res = bench_training.measure(("reach",), (1, 2), 256, root=tmp_path, algo_kwargs=TINY)
-    assert [(r["task"], r["workers"]) for r in res["rows"]] == [("reach", 1), ("reach", 2)]
-    assert [r["order"] for r in res["rows"]] == [["env", "ppo"], ["ppo", "env"]]
+    res = bench_training.measure(("reach",), (1, 2), 640, root=tmp_path, algo_kwargs=TINY,
+                                 envs_per_worker=(1, 2))
+    assert [(r["task"], r["workers"], r["envs_per_worker"]) for r in res["rows"]] == [
+        ("reach", 1, 1), ("reach", 1, 2), ("reach", 2, 1), ("reach", 2, 2)]
+    assert [r["order"] for r in res["rows"]] == [["env", "ppo"], ["ppo", "env"]] * 2
     for r in res["rows"]:
         assert r["env"]["steps_per_s"] > 0 and r["ppo"]["steps_per_s"] > 0 and r["ratio"] > 0
-        assert r["env"]["env_steps"] == 256
+        assert r["env"]["env_steps"] == 640
         ppo = r["ppo"]
+        n_envs = r["workers"] * r["envs_per_worker"]
         # the timed phase: from the checkpoint one vector step after the first update to the end
-        assert ppo["rollout"] == 64 * r["workers"]
-        assert ppo["first_mark"] == ppo["rollout"] + r["workers"]
+        assert ppo["rollout"] == 64 * n_envs
+        assert ppo["first_mark"] == ppo["rollout"] + n_envs
+        config = json.loads((tmp_path / f"reach_{r['workers']}x{r['envs_per_worker']}"
+                             / "config.json").read_text())
+        assert (config["n_envs"], config["n_cpus"]) == (n_envs, r["workers"])
         assert ppo["env_steps"] == ppo["timesteps_done"] - ppo["first_mark"] > 0
         assert ppo["eval_steps"] > 0 and ppo["startup_s"] > 0 and ppo["final_s"] > 0
     json.dumps(res)                                     # plain JSON
     text = bench.markdown(res)
-    assert "| `reach` | 1 |" in text and "| `reach` | 2 |" in text and "PPO / env" in text
-    assert "`reach`, 2 workers: target >= 60% of the env alone" in text
+    assert "| `reach` | 1 x 1 |" in text and "| `reach` | 2 x 2 |" in text
+    assert "PPO / env" in text
+    assert "`reach`, 2 workers x 4 envs: target >= 60% of the env alone; not measured" in text
     assert "torch" in text and "MuJoCo" in text
 
 
@@ -48,20 +55,24 @@ def _fake(kind):
 
 
 def test_the_table_the_order_and_the_targets():
-    configs = bench.configs(bench.DEFAULT_TASKS, bench.DEFAULT_WORKERS, bench_training.MODES)
+    configs = bench.configs(bench.DEFAULT_TASKS, bench.DEFAULT_WORKERS, bench_training.MODES,
+                            (bench.TARGET_ENVS_PER_WORKER,))
     assert [c.name for c in configs] == [
-        "reach, 1 worker", "reach, 2 workers", "high_five --mode scripted, 1 worker",
-        "high_five --mode scripted, 2 workers", "mirror --mode scripted, 1 worker",
-        "mirror --mode scripted, 2 workers"]
+        "reach, 1 worker x 4 envs", "reach, 2 workers x 4 envs",
+        "high_five --mode scripted, 1 worker x 4 envs",
+        "high_five --mode scripted, 2 workers x 4 envs",
+        "mirror --mode scripted, 1 worker x 4 envs", "mirror --mode scripted, 2 workers x 4 envs"]
     res = bench.measure(configs, {"reach": 10, "high_five": 20, "mirror": 30},
                         env_rate=_fake("env"), ppo_rate=_fake("ppo"))
     assert [r["order"][0] for r in res["rows"]] == ["env", "ppo"] * 3
     assert [r["env"]["steps"] for r in res["rows"]] == [10, 10, 20, 20, 30, 30]
     table = bench.format_table(res)
-    assert table.count("\n") == 7 and "| `mirror` (scripted) | 2 | 2000 | 1000 | **50%** |" in table
+    assert table.count("\n") == 7
+    assert "| `mirror` (scripted) | 2 x 4 | 2000 | 1000 | **50%** |" in table
     met = {t["task"]: t["met"] for t in bench.targets(res)}
     assert met == {"reach": False, "high_five": False, "mirror": True}
-    assert "`mirror`, 2 workers: target >= 40% of the env alone; 50%: met" in bench.markdown(res)
+    assert ("`mirror`, 2 workers x 4 envs: target >= 40% of the env alone; 50%: met"
+            in bench.markdown(res))
 
 
 @pytest.mark.parametrize("tasks, workers, match", [
