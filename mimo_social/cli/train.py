@@ -345,8 +345,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--n-envs", type=positive_int, default=None, help="envs stepped together "
                    "(one learner: one-agent tasks, --mode scripted) or worlds (--mode shared: "
-                   "one VecEnv slot per agent of each), in --n-cpus worker processes. Default: "
-                   "4 per CPU core (8 on 2 cores); --mode independent: 1")
+                   "one VecEnv slot per agent of each; --mode independent: each agent's model "
+                   "a slot per world), in --n-cpus worker processes. Default: 4 per CPU core "
+                   "(8 on 2 cores)")
     p.add_argument("--flat-obs", action="store_true", help="a learner with eyes sees one flat "
                    "vector (its images flattened, an MLP) instead of its images through the "
                    "CNN (docs/training_vision.md)")
@@ -361,8 +362,7 @@ def add_parser(subparsers) -> None:
                    "error naming it (default 600)")
     p.add_argument("--n-cpus", type=non_negative_int, default=None, help="spawned worker "
                    "processes stepping the --n-envs envs or worlds, each a block of them (0: all "
-                   "in this process). Default: one per CPU core, at most one per env; "
-                   "--mode independent: 0")
+                   "in this process). Default: one per CPU core, at most one per env")
     g = p.add_argument_group("RLlib engine (--engine rllib; needs the rllib extra)")
     g.add_argument("--engine", choices=("sb3", "rllib"), default="sb3",
                    help="sb3 (Stable-Baselines3, the default) or rllib (RLlib on Ray)")

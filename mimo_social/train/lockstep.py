@@ -1,16 +1,24 @@
-"""Independent learners in one world: a ParallelEnv stepped in lockstep by one thread per agent.
+"""Independent learners in shared worlds: one learner thread per agent, the worlds stepped in
+lockstep by the thread that made them.
 
-Each agent's SB3 model learns on a Gymnasium view of one shared ParallelEnv (:class:`AgentView`),
-all views stepped in lockstep by a :class:`Lockstep`: every model's ``learn()`` runs in its own
-thread, a view's ``step``/``reset`` posts the agent's request and blocks; once every agent that
-must act has posted, the main thread (the only one that touches the env, so renderers keep their
-GL context) steps (or resets) the env once and each agent gets its own result. Threads take turns
-(a baton passed in agent order), so exactly one of them runs at any moment: the global random
-generators of numpy and torch are used in the same order every run (deterministic under a seed as
-far as SB3 is), and evaluations and checkpoints run in the main thread while every model is
-parked between two env steps. Any SB3 algorithm works unchanged. An exception in one thread (or a
-model that stops early) aborts the others with :class:`LockstepAborted` / :class:`LockstepError`;
-nothing hangs.
+Two hubs share the turn-taking (the baton) below:
+
+* :class:`Lockstep`: one ParallelEnv; each agent's learner sees a Gymnasium view of it
+  (:class:`AgentView`).
+* :class:`VecLockstep`: a batch of ``n_envs`` worlds (``possible_agents``, per-agent spaces,
+  ``reset(seed, options)`` and ``step(actions)`` with one row per world); each agent's learner
+  sees an SB3 VecEnv with one slot per world (:mod:`mimo_social.train.independent` builds both:
+  its ``WorldBatch`` steps the worlds in this process or in spawned worker processes).
+
+Every model's ``learn()`` runs in its own thread, a view's ``step``/``reset`` posts the agent's
+request and blocks; once every agent that must act has posted, the main thread (the only one that
+touches the worlds, so renderers keep their GL context) steps (or resets) them once and each agent
+gets its own result. Threads take turns (a baton passed in agent order), so exactly one of them
+runs at any moment: the global random generators of numpy and torch are used in the same order
+every run (deterministic under a seed as far as SB3 is), and evaluations and checkpoints run in
+the main thread while every model is parked between two env steps. Any SB3 algorithm works
+unchanged. An exception in one thread (or a model that stops early) aborts the others with
+:class:`LockstepAborted` / :class:`LockstepError`; nothing hangs.
 """
 
 from __future__ import annotations
@@ -21,7 +29,8 @@ from typing import Any, Callable, Mapping
 import gymnasium as gym
 import numpy as np
 
-__all__ = ["Lockstep", "AgentView", "LockstepError", "LockstepAborted", "run_lockstep"]
+__all__ = ["Lockstep", "VecLockstep", "AgentView", "LockstepError", "LockstepAborted",
+           "run_lockstep"]
 
 
 class LockstepError(RuntimeError):
@@ -135,10 +144,10 @@ class Lockstep:
             self.turn = None
         self.cond.notify_all()
 
-    def _operate(self) -> list[str]:
-        """Every running agent has posted: step or reset the env, hand out the results."""
+    def _posted(self) -> tuple[list[str], list[str]]:
+        """(agents asking to step, agents asking to reset); a LockstepError if an agent has
+        stopped while others still post."""
         active = [a for a in self.order if a not in self.finished]
-        live = set(self.env.agents)
         stepping = [a for a in active if self.request[a][0] == "step"]
         resetting = [a for a in active if self.request[a][0] == "reset"]
         if self.finished:
@@ -147,6 +156,18 @@ class Lockstep:
                 f"{', '.join(gone)} stopped learning at env step {self.env_steps} while "
                 f"{', '.join(active)} still want to {'step' if stepping else 'reset'}: every "
                 "agent must train for the same number of steps with the same algorithm settings")
+        return stepping, resetting
+
+    def _reset_args(self) -> tuple[int | None, dict | None]:
+        """The seed and options of a reset: the first given, in agent order."""
+        seeds = [self.request[a][1][0] for a in self.order if self.request[a][1][0] is not None]
+        options = [self.request[a][1][1] for a in self.order if self.request[a][1][1]]
+        return (seeds[0] if seeds else None), (options[0] if options else None)
+
+    def _operate(self) -> list[str]:
+        """Every running agent has posted: step or reset the env, hand out the results."""
+        stepping, resetting = self._posted()
+        live = set(self.env.agents)
         if stepping:
             if set(stepping) != live or not set(resetting).isdisjoint(live):
                 raise LockstepError(
@@ -162,12 +183,72 @@ class Lockstep:
             if self.on_step is not None:
                 self.on_step(obs, rewards, terms, truncs, infos)
             return stepping
-        seeds = [self.request[a][1][0] for a in self.order if self.request[a][1][0] is not None]
-        options = [self.request[a][1][1] for a in self.order if self.request[a][1][1]]
-        obs, infos = self.env.reset(seed=seeds[0] if seeds else None,
-                                    options=options[0] if options else None)
+        seed, options = self._reset_args()
+        obs, infos = self.env.reset(seed=seed, options=options)
         for a in self.order:
             self.result[a] = (obs[a], infos[a])
+            self.request[a] = None
+        if self.on_reset is not None:
+            self.on_reset(obs, infos)
+        return list(self.order)
+
+
+class VecLockstep(Lockstep):
+    """``n_envs`` worlds shared by one learner thread per agent: :class:`Lockstep`'s turns over a
+    batch of worlds (``batch``: ``possible_agents``, ``n_worlds``, ``reset(seed, options) ->
+    (obs, infos)`` and ``step(actions) -> (obs, rewards, dones, infos, reset_infos)`` with
+    ``obs`` / ``rewards`` / ``actions`` dicts agent -> one row per world, ``dones`` one flag per
+    world and ``infos`` / ``reset_infos`` one dict agent -> info per world; a world whose
+    episode ended is reset by the batch itself).
+
+    ``call(agent, "step", actions)`` (the agent's actions, one row per world) returns the
+    agent's ``(obs, rewards, dones, infos, reset_infos)`` (one row or entry per world);
+    ``call(agent, "reset", (seed, options))`` returns its ``(obs, infos)``. Every agent must ask
+    for the same thing: all step or all reset (SB3 resets its VecEnv once, when ``learn()``
+    starts). The reset's seed is the first one given, in agent order (world ``w`` gets ``seed +
+    w``). :attr:`env_steps` counts env steps summed over the worlds (``n_envs`` a batch step).
+    ``on_step(obs, rewards, dones, infos)`` / ``on_reset(obs, infos)`` run in the serving
+    thread after each batch step / reset, every learner waiting.
+    """
+
+    def __init__(self, batch, on_step=None, on_reset=None, poll_s: float = 1.0):
+        super().__init__(batch, on_step=on_step, on_reset=on_reset, poll_s=poll_s)
+        self.n_envs = int(batch.n_worlds)
+        self.batch_steps = 0
+        self.owner = threading.current_thread()
+
+    def call_worlds(self, kind: str, name: str, args: tuple = (), kwargs: dict | None = None):
+        """``get`` / ``set`` an attribute of, or ``call`` a method of, every world (one result
+        each), from the thread that made the hub only (the one that touches the worlds)."""
+        if threading.current_thread() is not self.owner:
+            raise LockstepError(f"{kind} {name!r} of the worlds from thread "
+                                f"{threading.current_thread().name}: only the thread that made "
+                                "the hub touches the worlds")
+        return self.env.call_worlds(kind, name, args, kwargs)
+
+    def _operate(self) -> list[str]:
+        """Every agent has posted: step or reset every world once, hand out each agent's part."""
+        stepping, resetting = self._posted()
+        if stepping and resetting:
+            raise LockstepError(
+                f"agents {stepping} want to step and {resetting} to reset: the agents' vector "
+                "envs must reset together (once, when every learn() starts)")
+        if stepping:
+            obs, rewards, dones, infos, reset_infos = self.env.step(
+                {a: self.request[a][1] for a in self.order})
+            self.env_steps += self.n_envs
+            self.batch_steps += 1
+            for a in self.order:
+                self.result[a] = (obs[a], rewards[a], dones.copy(), [i[a] for i in infos],
+                                  [r.get(a, {}) for r in reset_infos])
+                self.request[a] = None
+            if self.on_step is not None:
+                self.on_step(obs, rewards, dones, infos)
+            return list(self.order)
+        seed, options = self._reset_args()
+        obs, infos = self.env.reset(seed=seed, options=options)
+        for a in self.order:
+            self.result[a] = (obs[a], [i[a] for i in infos])
             self.request[a] = None
         if self.on_reset is not None:
             self.on_reset(obs, infos)

@@ -83,10 +83,6 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
     the one learner (scripted mode), in ``n_cpus`` spawned worker processes (0: in this
     process); the independent mode steps one world."""
     mode = check_mode(task, mode)
-    if mode == "independent" and (n_envs != 1 or n_cpus != 0):
-        raise TrainInputError(f"--mode independent steps one world: n_envs={n_envs}, "
-                              f"n_cpus={n_cpus} are for --mode shared (worlds) and --mode "
-                              "scripted (envs)")
     from .hyperparams import to_json
 
     cls = algo_class(algo)
@@ -112,7 +108,7 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
         # SB3 counts every agent's transition: room for all of them (train's default is steps)
         algo_kwargs["buffer_size"] = min(1_000_000, steps * len(agents))
     given = config.pop("algo_kwargs_given", None)
-    if mode in ("scripted", "shared"):   # the same env steps per rollout as with one env
+    if mode in ("scripted", "shared", "independent"):   # the env steps per rollout of one env
         algo_kwargs = vector_defaults(algo_kwargs, set(algo_kwargs if given is None else given),
                                       int(n_envs), algo, config.get("algo_kwargs_provenance"))
     config["algo_kwargs"] = to_json(algo_kwargs)
@@ -136,7 +132,9 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
                 models, done = train_independent(cls, algo_kwargs, task, env_kwargs, steps, seed,
                                                  out, eval_env, eval_episodes, eval_seed,
                                                  schedule, bar, t0, verbose, stop=stop,
-                                                 config=config)
+                                                 config=config, n_envs=int(n_envs),
+                                                 n_cpus=int(n_cpus),
+                                                 worker_timeout=float(worker_timeout))
                 log = done.log
             else:
                 model, log, venv = _train_one_policy(cls, algo, algo_kwargs, module, task, mode,

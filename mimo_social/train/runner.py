@@ -106,12 +106,12 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     if normalize_obs is None:
         normalize_obs = bool(run_options(task, mode).get("normalize_obs", False))
     from .workers import default_n_envs, default_workers
-    if n_envs is None:   # independent: one world (its learners step it in lockstep)
-        n_envs = 1 if mode == "independent" else default_n_envs()
+    if n_envs is None:
+        n_envs = default_n_envs()
     if isinstance(n_envs, bool) or not isinstance(n_envs, int) or n_envs < 1:
         raise TrainInputError(f"n_envs={n_envs!r}; allowed: an integer >= 1")
     if n_cpus is None:
-        n_cpus = 0 if mode == "independent" else default_workers(n_envs)
+        n_cpus = default_workers(n_envs)
     if isinstance(n_cpus, bool) or not isinstance(n_cpus, int) or not 0 <= n_cpus <= n_envs:
         raise TrainInputError(f"n_cpus={n_cpus!r}; allowed: 0 (every env in this process) to "
                               f"n_envs={n_envs} (worker processes, each stepping a block of "
