@@ -8,8 +8,9 @@ the catalogue (:mod:`mimo_social.envs.catalog`). A social task learns in one of 
 * ``shared`` (default): parameter sharing, one policy for every agent through SuperSuit
   (:func:`~mimo_social.train.vector.sb3_vec_env`; one VecEnv slot per agent, ``n_envs`` worlds,
   ``n_cpus`` worker processes); every agent needs the same observation and action space;
-* ``independent``: one policy per agent, all acting in one world at the same time (each model's
-  ``learn()`` in its own thread on a lockstep Gymnasium view of the shared ParallelEnv);
+* ``independent``: one policy per agent, all acting in the same worlds at the same time (each
+  model's ``learn()`` in its own thread on a lockstep VecEnv of its slots in ``n_envs`` worlds,
+  ``n_cpus`` worker processes; :mod:`mimo_social.train.independent`);
 * ``scripted``: one learner, its partner driven by the task's default scripted partner: the
   catalogue's Gymnasium id of the task, the same path as a one-agent task.
 

@@ -342,8 +342,8 @@ def test_independent_training_with_a_failing_evaluation_raises_instead_of_hangin
     monkeypatch.setattr(independent, "evaluate_agents", broken)
     with pytest.raises(RuntimeError, match="evaluation broke"):
         _train_in_thread(timeout_s=60, task="high_five", algo="ppo", steps=256, seed=0,
-                         out=tmp_path / "broken", mode="independent", eval_every=64,
-                         eval_episodes=1, checkpoint_every=0, progress=False,
+                         out=tmp_path / "broken", mode="independent", n_envs=1, n_cpus=0,
+                         eval_every=64, eval_episodes=1, checkpoint_every=0, progress=False,
                          env_kwargs={"max_steps": 30}, algo_kwargs=FAST)
     assert not [t for t in threading.enumerate() if t.name.startswith("learn-")]  # all ended
     with open(tmp_path / "broken" / "episodes.csv", newline="") as f:   # stopped at step 64
@@ -412,8 +412,8 @@ def test_bad_mode_task_and_options_say_what_is_allowed(tmp_path, monkeypatch, ca
         train("reach", "ppo", 64, 0, tmp_path / "a", mode="independent")
     with pytest.raises(TrainInputError, match="allowed: shared, independent, scripted"):
         train("high_five", "ppo", 64, 0, tmp_path / "b", mode="together")
-    with pytest.raises(TrainInputError, match="--mode shared"):
-        train("high_five", "ppo", 64, 0, tmp_path / "c", mode="independent", n_envs=2)
+    with pytest.raises(TrainInputError, match="n_cpus=3"):   # more workers than worlds
+        train("high_five", "ppo", 64, 0, tmp_path / "c", mode="independent", n_envs=2, n_cpus=3)
     with pytest.raises(TrainInputError, match="allowed: reach.*high_five"):
         train("juggle", "ppo", 64, 0, tmp_path / "d")
     # a catalogued social task whose module lacks scripted_env: named, with what it needs
