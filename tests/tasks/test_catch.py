@@ -110,7 +110,8 @@ def test_catch_randomises_the_ball_and_pays_one_a_touching_step_and_the_steps_le
     cost = 0.2 ** 2 / 40                       # c_w at activation 0.2 everywhere, at most
     assert all(1.0 - cost - 1e-9 <= r < 1.0 for r in rewards[:-1])
     env.close()
-    paper = catch_v0.parallel_env(task_options={"hold_time": 0.03, "pay_remaining": False})
+    with pytest.warns(UserWarning, match="pay_remaining=False"):
+        paper = catch_v0.parallel_env(task_options={"hold_time": 0.03, "pay_remaining": False})
     paper.reset(seed=1)
     palm = paper.world.data.site_xpos[paper.world.agents[0].palm_sites[0]].copy()
     paper.task.place_ball(paper, palm + np.array([0.0, 0.0, paper.task._radius + 0.004]))
@@ -182,5 +183,21 @@ def test_holding_the_ball_without_finishing_pays_less_than_catching():
     assert np.all(held < caught - 50)                       # measured: ~780 against ~880
     assert held.mean() > 700                                # it did hold the ball all along
     # with the paper's +100 alone, the same hold would beat catching (measured: ~200)
-    paper, n = run(controller, seeds, pay_remaining=False)
+    with pytest.warns(UserWarning, match="holding the ball pay more than catching"):
+        paper, n = run(controller, seeds, pay_remaining=False)
     assert n == 3 and np.all(paper < 300) and np.all(held > paper + 400)
+
+
+def test_the_papers_reward_warns_that_holding_pays_more_than_catching():
+    """``pay_remaining=False`` (the paper's +100 alone) warns, with the measured returns; the
+    default does not; the table says it too."""
+    import warnings
+    with pytest.warns(UserWarning, match=r"pay_remaining=False.*holding the ball pay more than "
+                                         r"catching.*782.*202"):
+        catch_v0.parallel_env(task_options={"pay_remaining": False}).close()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        catch_v0.parallel_env().close()
+        catch_v0.parallel_env(task_options={"pay_remaining": True}).close()
+    table = " ".join(catch_package.__doc__.split())
+    assert "holding pays more than catching" in table and "`UserWarning`" in table

@@ -50,6 +50,23 @@ def test_constants_equal_the_table():
     env.close()
 
 
+def test_control_step_is_the_published_codes_and_the_table_gives_the_papers_text():
+    """5 ms (one physics step a control step), as the published code and the physics row say;
+    the row also gives the paper's text (10 ms: two physics steps), which
+    ``physics={"frame_skip": 2}`` runs."""
+    physics = dict(parse_docstring(selfbody.__doc__, "selfbody")[1])["physics"]
+    assert physics.startswith("one physics step (5 ms) per control step (`frame_skip=1`), as the "
+                              "published code")
+    assert "two physics steps for every control step" in physics and "(10 ms)" in physics
+    assert 'physics={"frame_skip": 2}' in physics and "gives no control step" not in physics
+    env = selfbody_v0.parallel_env()
+    assert (env.frame_skip, env.physics.timestep) == (1, 0.005) and env.dt == pytest.approx(0.005)
+    env.close()
+    paper = selfbody_v0.parallel_env(physics={"frame_skip": 2})
+    assert paper.frame_skip == 2 and paper.dt == pytest.approx(0.01)
+    paper.close()
+
+
 def test_touching_the_target_primitive_pays_500_and_ends():
     env = selfbody_v0.parallel_env(task_options={"target": "right_upper_leg"})
     env.reset(seed=0)

@@ -12,6 +12,7 @@ import pytest
 
 import mimo_social  # noqa: F401  (registers the ids)
 from mimo_social.envs import standup_v0
+from mimo_social.envs.task_docs import parse_docstring
 from mimo_social.tasks.standup.controller import StandupController
 from mimo_social.tasks import standup as task
 
@@ -99,6 +100,23 @@ def test_constants_equal_the_table():
     assert env.action_space(A).shape == (27,)
     assert set(env.observation_space(A).spaces) == {"proprioception", "vestibular"}
     env.close()
+
+
+def test_control_step_is_the_published_codes_and_the_table_gives_the_papers_text():
+    """10 ms (two physics steps a control step), as the published code and the physics row say;
+    the row also gives the paper's text (5 ms: one physics step), which
+    ``physics={"frame_skip": 1}`` runs."""
+    physics = dict(parse_docstring(task.__doc__, "standup")[1])["physics"]
+    assert physics.startswith("two physics steps of 5 ms per control step (`frame_skip=2`, "
+                              "control step 10 ms as published)")
+    assert "uses one physics step per control step" in physics and "(5 ms)" in physics
+    assert 'physics={"frame_skip": 1}' in physics
+    env = standup_v0.parallel_env()
+    assert (env.frame_skip, env.physics.timestep) == (2, 0.005) and env.dt == pytest.approx(0.01)
+    env.close()
+    paper = standup_v0.parallel_env(physics={"frame_skip": 1})
+    assert paper.frame_skip == 1 and paper.dt == pytest.approx(0.005)
+    paper.close()
 
 
 def test_reward_is_head_height_above_20_cm_minus_the_control_cost():

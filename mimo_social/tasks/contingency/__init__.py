@@ -6,11 +6,22 @@ agents:
     `scripted_env` drives the caregiver (`ContingencyCaregiver`, below); `parallel_env` makes it a
     second learner (condition "live" only)
 body:
-    the learner stands (as in `mirror_v0`), hip fixed in the world, every joint held; head and eyes
-    held looking at the caregiver's face (`tasks/dyad.py` aims them for the pair's bodies), so the
-    caregiver's face is in the middle of both eye images without any aiming; the caregiver kneels
-    (its own posture's legs), every joint held, head and eyes on the learner's face. Nothing moves
-    but the faces: the paradigm is about expressions
+    the learner stands (as in `mirror_v0`), hip fixed in the world, every joint held; by default
+    head and eyes held looking at the caregiver's face (`tasks/dyad.py` aims them for the pair's
+    bodies), so the caregiver's face is in the middle of both eye images without any aiming, and
+    nothing moves but the faces (the paradigm is about expressions): the gaze measure
+    (`gaze_fraction`) is then 1.0 for every learner, random and zero included, by construction (a
+    constant, not a measure of the learner). With `gaze_free` (off) the learner's head and eyes
+    are its own (9 motors: head swivel, tilt, sideways tilt, each eye's 3), starting at rest, with
+    head support (the task cancels gravity on them: a zero action keeps the head where it is), so
+    it can look at the caregiver's face or away: Murray and Trevarthen's gaze avoidance becomes
+    measurable. Measured (`gaze_free`, adult caregiver, 600 steps, seed 0): the rest pose looks
+    62 degrees below the kneeling adult's face, so zero action 0.00 of the steps on the face,
+    uniform random 0.05, turning head and eyes to the face (`GazeAtTarget`, PD on its own motors)
+    0.97 (0.3 s to turn), turning them to its own right hand 0.00; with an 18-month-old partner
+    (`per_agent=[{}, {"body": "infant"}]`) the rest pose already looks at its face (2 degrees off:
+    zero action 1.00). The caregiver kneels (its own posture's legs), every joint held, head and
+    eyes on the learner's face
 scene:
     the pair face to face, `distance` (0.3 m) apart for two 18-month-olds; the kneeling adult is
     placed by the measured reach of its arm (0.37 m, `tasks/dyad.py`), as in `mirror_v0`: its face
@@ -39,11 +50,11 @@ reset:
     timer from the env's seed)
 action:
     `Dict(motors=Box(0,), expression=Discrete(7))`: the learner's face is its action (no motor is
-    free)
+    free); with `gaze_free` `motors=Box(-1, 1, (9,))`, its head and eye motors
 observation:
     `eye_left`, `eye_right` (64x64x3 RGB: the caregiver's face reaches the learner only through its
-    eyes), `proprioception` (0 floats: no free joint); never the caregiver's expression, mode or
-    stream
+    eyes), `proprioception` (0 floats: no free joint; with `gaze_free` 54, its head and eye
+    joints); never the caregiver's expression, mode or stream
 reward:
     +1 on a step of shared smiling: the learner and the caregiver both show "happy" while the
     learner's gaze is on the caregiver's face (`partners/cues.py`, `learner_cues`), else 0; with
@@ -74,14 +85,15 @@ infos:
     `window_s` after one, in which the caregiver begins to smile), `contingency_index`
     (`response_rate - baseline_rate`: Watson's conditional-probability difference: about the
     response probability in live, lower in replay and non-contingent, where the caregiver's smiles
-    follow the learner's only by chance), `is_success`
+    follow the learner's only by chance), `is_success`. `gaze_on_face` and `gaze_fraction` are the
+    learner's own gaze only with `gaze_free` (held: always 1)
 options:
     `condition` ("live", "replay", "non_contingent"), `distance` (0.3 m, 0.22 to 2.0),
     `response_delay_s` (0.5 s, 0 to 5), `response_probability` (0.8, 0 to 1), `response_duration_s`
     (1.0 s, 0.01 to 10), `timer_rate_hz` (0.5, 0 to 10: the non-contingent rate before any live
     episode), `window_s` (1.5 s, 0.05 to 10: the contingency index's window; keep it above the
-    delay), `success_fraction` (0.2, 0.01 to 1), `reward_free` (False), `scripted_partner` (False;
-    set by `scripted_env`)
+    delay), `success_fraction` (0.2, 0.01 to 1), `reward_free` (False), `gaze_free` (False: the
+    learner's head and eyes free, see body), `scripted_partner` (False; set by `scripted_env`)
 privileged cues:
     none: the caregiver's face reaches the learner only through its eyes; the reward and the
     measures read both faces and the gaze from the world (no observation)
@@ -108,6 +120,27 @@ summary:
     10; caregiver smile onsets per second 0.35 / 0.35 (the same stream) / 0.24. The pattern Murray
     and Trevarthen report (fewer positive expressions when the same mother is replayed) shows in the
     share of the steps smiling, not in the smile onsets (the detector keeps bidding briefly)
+effects:
+    `measures.effects(policy, episodes, seed, env_kwargs)` runs any policy as the learner (a
+    scripted partner, a function `obs -> action`, or an SB3 model: its observation flattened or its
+    images made channel-first and its flat action decoded as the model needs;
+    `measures.as_learner`) in the blocks of `condition_summary` and returns, per block, the live
+    episode's measure minus the replay's (`live_minus_replay`: Murray and Trevarthen's double
+    video) and minus the non-contingent one's (`live_minus_non_contingent`), mean +- sd over
+    blocks, for `smiling_fraction`, `learner_smile_rate`, `gaze_fraction`, `contingency_index` and
+    `shared_fraction` (`format_effects` prints them). The reward pays shared smiling in every
+    condition: smiling less or looking away in replay earns nothing; the effects measure whether a
+    learner does. Measured, 10 blocks of 2000 steps (seeds 1000-1009, the learner's eyes off: no
+    policy here reads them), live minus replay / live minus non-contingent: the scripted
+    `ContingencyDetectorController` smiling +0.195 +- 0.156 / +0.212 +- 0.136 of the steps,
+    contingency index +0.81 +- 0.58 / +0.62 +- 0.34, shared smiling +0.170 +- 0.103 / +0.192 +-
+    0.097, smile onsets per second +0.02 / +0.05, gaze 0 (held; with `gaze_free` it looks at the
+    face 0.99 of the steps in every condition: the same effects, no gaze avoidance); a random face
+    each step (held) smiling -0.001 +- 0.009 / 0.000 +- 0.006, contingency index -0.005 +- 0.019 /
+    +0.027 +- 0.024, shared -0.001 / -0.003 (no effect); with `gaze_free` uniform random actions
+    look at the face 0.09 / 0.11 / 0.09 of the steps (live / replay / non-contingent), gaze effect
+    -0.023 +- 0.052 / -0.003 +- 0.043, shared smiling 0.013 of the live steps (0 of 10 successes);
+    zero action 0 on every effect, held or free
 sources:
     not in the MIMo paper: a paradigm of this package after Watson (1972, 1979: infants detect the
     contingency of events on their own behaviour, measured as conditional probabilities; the smile
@@ -121,7 +154,9 @@ sources:
     from learning a contingency (Millar 1972)
 version history:
     v0, issue 19: first version, with `still_face_v0`, `imitation_v0` and the contingent and replay
-    caregivers
+    caregivers; v0, issue 30: the `gaze_free` option (default off: the held gaze, spaces and
+    numbers unchanged; the gaze measure was 1.0 for every learner), the scripted infant looks at the
+    face when its gaze is free, `measures.effects` for any policy
 
 The learner's action and the caregiver's face of the same step are compared; a scripted caregiver
 reads the learner's face before the learner's action of a step applies, so its answers come one

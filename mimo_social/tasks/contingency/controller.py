@@ -9,8 +9,13 @@ estimates:
     its quiet windows (``window_s`` long, no smile onset of its own in them nor in the ``window_s``
     before) in which the other begins to smile; with prior counts (1 of 2 smiles answered, 1 of 4
     windows hit: an estimate of 0.25 at the start)
+looks:
+    with head and eye motors (the task option ``gaze_free``) at the other's face, all the time:
+    :class:`~mimo_social.partners.gaze.GazeAtTarget`'s PD law on its head and eye motors, target
+    the other's ``head_centre`` site (its other motors, if any, at rest); without them its gaze
+    is the task's to hold
 acts:
-    smiles through its own ``expression`` action (motors, if any, at rest). From a neutral face it
+    smiles through its own ``expression`` action. From a neutral face it
     begins to smile at a rate (per second) of ``base_rate`` (1.5) x exp(``gain`` (5) x (estimate -
     ``expected`` (0.25))), kept within 0.05-10. A smile lasts while it waits for an answer (up to
     ``bid_s``, 0.8 s) and, once answered, as long as the other smiles; then a neutral pause drawn
@@ -41,6 +46,7 @@ from gymnasium import spaces
 from ...expressions.faces import EXPRESSIONS
 from ...util.checks import ConfigError, check_number, check_numbers, show
 from ...partners.base import Partner, agent_index, zero_action
+from ...partners.gaze import NEEDED as GAZE_MOTORS, GazeAtTarget
 
 __all__ = ["ContingencyDetectorController"]
 
@@ -89,6 +95,12 @@ class ContingencyDetectorController(Partner):
             raise ValueError(f"ContingencyDetectorController: {agent} has no partner in this env")
         self._me, self._other = me, others[0]
         self._action = zero_action(space)
+        self._gaze = None
+        if set(GAZE_MOTORS) <= set(env.world.agents[me].actuated_names):
+            face = f"{env.possible_agents[self._other]}/head_centre"
+            self._gaze = GazeAtTarget(targets=[face], hold_s=(3600.0, 3600.0), head_share=1.0)
+            # one target: its generator draws nothing that matters (this one's stays untouched)
+            self._gaze.reset(env, agent, np.random.default_rng(0))
         self._dt = float(env.dt)
         self._window = max(1, int(round(self.window_s / self._dt)))
         self._pause = 0
@@ -178,4 +190,6 @@ class ContingencyDetectorController(Partner):
                 self._bout_start = t
                 self._answer_at = None
         face = HAPPY if self._smiling else NEUTRAL
-        return {"motors": self._action["motors"].copy(), "expression": np.int64(face)}
+        motors = self._action["motors"].copy() if self._gaze is None else \
+            self._gaze.act(env, agent, observation)["motors"]
+        return {"motors": motors, "expression": np.int64(face)}

@@ -1,10 +1,15 @@
 """The contingency paradigm's measures: blocks of a live, a replay (of that block's live
 episode) and a non-contingent episode; per condition the learner's smile rate, the share of the
 steps smiling, gaze on the caregiver's face, response and baseline rates, the contingency index
-and shared smiling (mean and sd over blocks), from each episode's last learner info.
+and shared smiling (mean and sd over blocks), from each episode's last learner info; and the
+paradigm's effect for any policy.
 
 :func:`run` is what ``mimo-social paradigm contingency`` calls for each learner (the catalogue
-entry's ``measures``); :func:`rows` its lines in the side-by-side table.
+entry's ``measures``); :func:`rows` its lines in the side-by-side table. :func:`effects` runs a
+policy (a scripted partner, a function of the observation, or an SB3 model: :func:`as_learner`)
+for seeded blocks and returns the live-minus-replay and live-minus-non-contingent differences
+of each block's measures (:data:`EFFECT_MEASURES`), mean and sd over blocks;
+:func:`format_effects` prints them.
 """
 
 from __future__ import annotations
@@ -14,11 +19,13 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ...core.episodes import run_episodes
-from ...util.checks import ConfigError, check_choice
+from ...core.wrappers import ActionDecoder, ImageDict, ObsFlattener, image_keys
+from ...util.checks import ConfigError, check_choice, check_int, show
 from .controller import ContingencyDetectorController
 from .task import CONDITIONS, MEASURES, scripted_env
 
-__all__ = ["UNIT", "AGENT", "summarize", "condition_summary", "format_summary", "run", "rows"]
+__all__ = ["UNIT", "AGENT", "EFFECT_MEASURES", "summarize", "condition_summary",
+           "format_summary", "run", "rows", "as_learner", "effects", "format_effects"]
 
 #: what one of :func:`run`'s ``episodes`` is: a block of one episode per condition
 UNIT = "blocks (live, replay, non-contingent)"
@@ -62,13 +69,14 @@ def condition_summary(episodes: int = 5, seed: int = 0, controller: Any = None,
     learner = ContingencyDetectorController() if controller is None else controller
     env = scripted_env(**dict(env_kwargs or {}))
     try:
-        return _blocks(env, learner, episodes, seed, conditions)
+        return summarize(_blocks(env, learner, episodes, seed, conditions))
     finally:
         env.close()
 
 
-def _blocks(env, learner, episodes: int, seed: int, conditions: Sequence[str]) -> dict:
-    """:func:`condition_summary` in ``env``, the scripted form (conditions checked)."""
+def _blocks(env, learner, episodes: int, seed: int, conditions: Sequence[str]) -> list[dict]:
+    """Each episode's last learner info, block by block, in ``env``, the scripted form
+    (conditions checked; see :func:`condition_summary`)."""
     task = env.unwrapped.task
     finals = []
     for block in range(int(episodes)):
@@ -76,15 +84,15 @@ def _blocks(env, learner, episodes: int, seed: int, conditions: Sequence[str]) -
             task.set_condition(cond)
             [episode] = run_episodes(env, {AGENT: learner}, 1, seed + block,
                                      policy_seeds=[[seed + block, k]])
-            finals.append(episode.last_infos[AGENT])
-    return summarize(finals)
+            finals.append(dict(episode.last_infos[AGENT]))
+    return finals
 
 
 def run(learner, episodes: int, seed: int, env) -> dict:
     """``learner`` in ``episodes`` blocks of live, replay and non-contingent episodes of
     ``env`` (the scripted form, :func:`~mimo_social.tasks.contingency.task.scripted_env`, which
     the caller made and closes), as :func:`condition_summary`."""
-    return _blocks(env, learner, episodes, seed, CONDITIONS)
+    return summarize(_blocks(env, learner, episodes, seed, CONDITIONS))
 
 
 def format_summary(table: Mapping[str, Mapping[str, tuple[float, float]]]) -> str:
@@ -111,3 +119,128 @@ def rows(summaries: Sequence[Mapping]) -> list[tuple[str, list[str]]]:
             out.append((f"{cond}: {m}", [f"{s[cond][m][0]:.2f} +- {s[cond][m][1]:.2f}"
                                          for s in summaries]))
     return out
+
+
+# -- the paradigm's effect, for any policy ------------------------------------------------------
+#: the measures whose live-minus-other difference per block is the paradigm's effect
+EFFECT_MEASURES = ("smiling_fraction", "learner_smile_rate", "gaze_fraction",
+                   "contingency_index", "shared_fraction")
+
+
+def _shapes(space):
+    """A space's shape, or a Dict's key -> shape."""
+    parts = getattr(space, "spaces", None)
+    return {k: _shapes(v) for k, v in parts.items()} if isinstance(parts, Mapping) \
+        else space.shape
+
+
+class _Model:
+    """An SB3 model (``predict``) as a policy of the env's agent: the observation as the model
+    takes it (as is, flat, or images channel-first with :class:`ImageDict`), its action mapped
+    onto the agent's action space (as is, or :class:`ActionDecoder`'s flat layout)."""
+
+    def __init__(self, model, deterministic: bool):
+        self.model, self.deterministic = model, bool(deterministic)
+        self.name = type(model).__name__
+
+    def reset(self, env, agent, rng) -> None:
+        seen, space = self.model.observation_space, env.observation_space(agent)
+        self._observe = None
+        if seen != space:
+            keys = image_keys(space)
+            if keys and keys[0] in getattr(seen, "spaces", {}):   # images channel-first
+                stack = seen[keys[0]].shape[0] // max(1, space[keys[0]].shape[-1])
+                self._observe = ImageDict(space, max(1, stack))
+            else:
+                self._observe = ObsFlattener(space)
+            if _shapes(self._observe.space) != _shapes(seen):
+                raise ValueError(f"as_learner: the model observes {_shapes(seen)}, {agent} gets "
+                                 f"{_shapes(space)}; allowed: a model trained on this env's "
+                                 "observation, as is, flat or with its images channel-first")
+        acts, own = self.model.action_space, env.action_space(agent)
+        self._decode = None if acts == own else ActionDecoder(own)
+        if self._decode is not None and self._decode.space.shape != acts.shape:
+            raise ValueError(f"as_learner: the model acts in {acts}, {agent} in {own}; allowed: "
+                             f"a model acting in {own} or in {self._decode.space}")
+        self._state, self._first = None, True
+        if not self.deterministic and callable(getattr(self.model, "set_random_seed", None)):
+            self.model.set_random_seed(int(rng.integers(2 ** 31)))
+
+    def act(self, env, agent, obs):
+        if self._observe is not None:
+            obs = self._observe(obs, self._first) if isinstance(self._observe, ImageDict) \
+                else self._observe(obs)
+        action, self._state = self.model.predict(obs, state=self._state,
+                                                 episode_start=np.array([self._first]),
+                                                 deterministic=self.deterministic)
+        self._first = False
+        return action if self._decode is None else self._decode(action, agent)
+
+
+class _Function:
+    """A function of the observation that returns the agent's action."""
+
+    def __init__(self, fn):
+        self.fn, self.name = fn, getattr(fn, "__name__", type(fn).__name__)
+
+    def act(self, env, agent, obs):
+        return self.fn(obs)
+
+
+def as_learner(policy, deterministic: bool = True):
+    """``policy`` as a policy of the episode loop (``act(env, agent, obs)``, optional
+    ``reset``): a scripted partner or any object with ``act`` as it is; an SB3 model (an object
+    with ``predict``) acting on the agent's observation (``deterministic``: the mode of its
+    action distribution, else sampled, seeded per episode), its observation and action mapped
+    from the env's as the model needs; a function ``obs -> action`` (an action of the agent's
+    action space)."""
+    if callable(getattr(policy, "act", None)):
+        return policy
+    if callable(getattr(policy, "predict", None)):
+        return _Model(policy, deterministic)
+    if callable(policy):
+        return _Function(policy)
+    raise ValueError(f"policy={show(policy)} not allowed; allowed: an object with act(env, agent, "
+                     "obs) (a scripted partner), an SB3 model (predict) or a function obs -> "
+                     "action")
+
+
+def effects(policy, episodes: int = 10, seed: int = 0,
+            env_kwargs: Mapping[str, Any] | None = None, deterministic: bool = True) -> dict:
+    """``policy`` (:func:`as_learner`) as ``infant_0`` in ``episodes`` blocks of a live, a
+    replay (of that block's live episode) and a non-contingent episode of the scripted
+    contingency (:func:`~mimo_social.tasks.contingency.task.scripted_env` with ``env_kwargs``;
+    block ``b`` reset with seed ``seed + b``, as :func:`condition_summary`). Returns
+    ``{"episodes": n, "live_minus_replay": {measure: (mean, sd)}, "live_minus_non_contingent":
+    {...}, "summary": summarize}``: per block, each :data:`EFFECT_MEASURES` entry of the live
+    episode minus that of the replay (Murray and Trevarthen's double video: more smiling and
+    gaze at the face live) or of the non-contingent episode, mean and sd over blocks."""
+    episodes = check_int("effects", "episodes", episodes, 1)
+    env = scripted_env(**dict(env_kwargs or {}))
+    try:
+        finals = _blocks(env, as_learner(policy, deterministic), episodes, seed, CONDITIONS)
+    finally:
+        env.close()
+    # block x condition x measure
+    v = np.array([[float(f[m]) for m in EFFECT_MEASURES] for f in finals], float)
+    v = v.reshape(episodes, len(CONDITIONS), len(EFFECT_MEASURES))
+    out: dict[str, Any] = {"episodes": episodes}
+    for k, other in enumerate(CONDITIONS[1:], start=1):
+        d = v[:, 0] - v[:, k]
+        out[f"live_minus_{other}"] = {m: (float(mean), float(sd)) for m, mean, sd
+                                      in zip(EFFECT_MEASURES, d.mean(axis=0), d.std(axis=0))}
+    out["summary"] = summarize(finals)
+    return out
+
+
+def format_effects(result: Mapping) -> str:
+    """:func:`effects`' result as a markdown table: a row per measure, a column per
+    difference (mean +- sd over blocks)."""
+    cols = [f"live_minus_{c}" for c in CONDITIONS[1:]]
+    lines = [f"contingency effects over {result['episodes']} blocks (mean +- sd)",
+             "| measure | " + " | ".join(c.replace("_", " ") for c in cols) + " |",
+             "|---" * (len(cols) + 1) + "|"]
+    for m in EFFECT_MEASURES:
+        cells = [f"{result[c][m][0]:+.3f} +- {result[c][m][1]:.3f}" for c in cols]
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)

@@ -3,14 +3,12 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from ...body.joint_groups import held_posture
+from ...body.joint_groups import GAZE_JOINTS, held_posture
 from ...core.task import Plot, Task, TaskOptions
 from ...core.world import AgentSetup
 from ...expressions.faces import EXPRESSIONS
@@ -39,8 +37,9 @@ MEASURES = ("learner_smile_rate", "smiling_fraction", "gaze_fraction", "response
 class ContingencyOptions(TaskOptions):
     """The condition (live, replay, non-contingent), the distance between the faces (m), the
     scripted caregiver's response delay (s) and probability, the contingency index's window (s),
-    the share of shared-smile steps for success, reward-free mode and whether ``infant_1`` is
-    the scripted caregiver (no eyes, no reward)."""
+    the share of shared-smile steps for success, reward-free mode, whether the learner's head
+    and eyes are free (``gaze_free``) and whether ``infant_1`` is the scripted caregiver (no
+    eyes, no reward)."""
 
     task = "contingency"
     condition: str = "live"
@@ -52,6 +51,7 @@ class ContingencyOptions(TaskOptions):
     window_s: float = 1.5
     success_fraction: float = 0.2
     reward_free: bool = False
+    gaze_free: bool = False
     scripted_partner: bool = False
 
     def __post_init__(self):
@@ -64,6 +64,7 @@ class ContingencyOptions(TaskOptions):
         self._number("window_s", 0.05, 10.0)
         self._number("success_fraction", 0.01, 1.0)
         self._bool("reward_free")
+        self._bool("gaze_free")
         self._bool("scripted_partner")
         if self.condition != "live" and not self.scripted_partner:
             raise ConfigError(
@@ -176,18 +177,34 @@ class Contingency(Task):
             out["posture"] = "kneeling" if body == "adult" else "standing"
         return out
 
+    def _free(self, i) -> tuple[str, ...]:
+        """Agent i's motor joints: the learner's head and eyes with ``gaze_free``, else none."""
+        return GAZE_JOINTS if i == 0 and self.options.gaze_free else ()
+
     def held_joints(self, i, config):
-        """Agent i's held joints (rad): all, standing knees a little bent, or its own posture's
-        angles (the kneeling adult)."""
+        """Agent i's held joints (rad): all but its free ones, standing knees a little bent, or
+        its own posture's angles (the kneeling adult)."""
         angles = held_angles(config, "standing", {"right_knee": -5, "left_knee": -5})
-        return held_posture(tables_of(config), keep=(), angles=angles)
+        return held_posture(tables_of(config), keep=self._free(i), angles=angles)
 
     def setup(self, i, config):
         plan = task_plan(self, "standing", self.options.distance, self.held_joints, (0, 1))
         pos, facing = face_to_face(i, plan.distance)
-        frozen = {**self.held_joints(i, config), **plan.gaze[i]}
+        free = self._free(i)
+        aimed = {k: v for k, v in plan.gaze[i].items() if k not in free}
+        frozen = {**self.held_joints(i, config), **aimed}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
-                          frozen=frozen, base="fixed", actuated=())
+                          frozen=frozen, base="fixed", actuated=free)
+
+    def bind(self, env):
+        """The learner's head and eye dofs (``gaze_free``: gravity on them is cancelled)."""
+        a = env.world.agents[0]
+        self._head_dofs = a.dof_adr[a.actuated_joint_idx]
+
+    def before_physics(self, env):
+        if len(self._head_dofs):     # head support: a zero action holds the head up
+            d = env.world.data
+            d.qfrc_applied[self._head_dofs] = d.qfrc_bias[self._head_dofs]
 
     # -- running -------------------------------------------------------------------------------
     def reset(self, env, rng):

@@ -1,21 +1,28 @@
 """The still-face paradigm's measures over episodes: per phase (interaction, still face,
 reunion) the share of the phase's steps with a smile, with the gaze on the caregiver's face and
-with self-touch, from each episode's last learner info.
+with self-touch, from each episode's last learner info; and the paradigm's effect for any policy.
 
 :func:`run` is what ``mimo-social paradigm still_face`` calls for each learner (the catalogue
-entry's ``measures``); :func:`rows` its lines in the side-by-side table.
+entry's ``measures``); :func:`rows` its lines in the side-by-side table. :func:`effects` runs a
+policy (a scripted partner, a function of the observation, or an SB3 model: :func:`as_learner`)
+for seeded episodes and returns the still-face effect: per episode, the still phase's drop of
+smiling and of gaze at the face from the interaction, their recovery in reunion and the rise of
+self-touch, as mean and sd over episodes (:data:`EFFECTS`); :func:`format_effects` prints them.
 """
 
 from __future__ import annotations
 
-from typing import Iterable, Mapping, Sequence
+from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
 from ...core.episodes import run_episodes
-from .task import MEASURES, PHASES
+from ...core.wrappers import ActionDecoder, ImageDict, ObsFlattener, image_keys
+from ...util.checks import check_int, show
+from .task import MEASURES, PHASES, scripted_env
 
-__all__ = ["UNIT", "AGENT", "still_face_summary", "format_still_face_summary", "run", "rows"]
+__all__ = ["UNIT", "AGENT", "EFFECTS", "still_face_summary", "format_still_face_summary", "run",
+           "rows", "as_learner", "effects", "format_effects"]
 
 #: what one of :func:`run`'s ``episodes`` is
 UNIT = "episodes"
@@ -62,9 +69,17 @@ def run(learner, episodes: int, seed: int, env) -> dict:
     (:func:`~mimo_social.tasks.still_face.task.scripted_env`, which the caller made and closes;
     seeds ``seed``, ``seed + 1``, ...): :func:`still_face_summary` of the last infos, plus
     ``return``: (mean, sd) over episodes."""
+    return _summary(*_episodes(learner, episodes, seed, env))
+
+
+def _episodes(learner, episodes: int, seed: int, env) -> tuple[list[dict], list[float]]:
+    """Each episode's last learner info and return."""
     done = run_episodes(env, {AGENT: learner}, episodes, seed)
-    out = still_face_summary([e.last_infos[AGENT] for e in done])
-    returns = [e.returns[AGENT] for e in done]
+    return [dict(e.last_infos[AGENT]) for e in done], [e.returns[AGENT] for e in done]
+
+
+def _summary(finals: list[dict], returns: list[float]) -> dict:
+    out = still_face_summary(finals)
     out["return"] = (float(np.mean(returns)), float(np.std(returns)))
     return out
 
@@ -83,3 +98,123 @@ def rows(summaries: Sequence[Mapping]) -> list[tuple[str, list[str]]]:
         for m in MEASURES:
             out.append((f"{phase}: {m}", [_ms(s["phases"][phase][m]) for s in summaries]))
     return out
+
+
+# -- the paradigm's effect, for any policy ------------------------------------------------------
+#: the effects, each a per-episode difference of two phases' shares of steps:
+#: name -> (measure, phase counted positive, phase counted negative)
+EFFECTS = {"smile_still_drop": ("smile", "interaction", "still"),
+           "smile_reunion_recovery": ("smile", "reunion", "still"),
+           "gaze_still_drop": ("gaze", "interaction", "still"),
+           "gaze_reunion_recovery": ("gaze", "reunion", "still"),
+           "self_touch_still_rise": ("self_touch", "still", "interaction")}
+
+
+def _shapes(space):
+    """A space's shape, or a Dict's key -> shape."""
+    parts = getattr(space, "spaces", None)
+    return {k: _shapes(v) for k, v in parts.items()} if isinstance(parts, Mapping) \
+        else space.shape
+
+
+class _Model:
+    """An SB3 model (``predict``) as a policy of the env's agent: the observation as the model
+    takes it (as is, flat, or images channel-first with :class:`ImageDict`), its action mapped
+    onto the agent's action space (as is, or :class:`ActionDecoder`'s flat layout)."""
+
+    def __init__(self, model, deterministic: bool):
+        self.model, self.deterministic = model, bool(deterministic)
+        self.name = type(model).__name__
+
+    def reset(self, env, agent, rng) -> None:
+        seen, space = self.model.observation_space, env.observation_space(agent)
+        self._observe = None
+        if seen != space:
+            keys = image_keys(space)
+            if keys and keys[0] in getattr(seen, "spaces", {}):   # images channel-first
+                stack = seen[keys[0]].shape[0] // max(1, space[keys[0]].shape[-1])
+                self._observe = ImageDict(space, max(1, stack))
+            else:
+                self._observe = ObsFlattener(space)
+            if _shapes(self._observe.space) != _shapes(seen):
+                raise ValueError(f"as_learner: the model observes {_shapes(seen)}, {agent} gets "
+                                 f"{_shapes(space)}; allowed: a model trained on this env's "
+                                 "observation, as is, flat or with its images channel-first")
+        acts, own = self.model.action_space, env.action_space(agent)
+        self._decode = None if acts == own else ActionDecoder(own)
+        if self._decode is not None and self._decode.space.shape != acts.shape:
+            raise ValueError(f"as_learner: the model acts in {acts}, {agent} in {own}; allowed: "
+                             f"a model acting in {own} or in {self._decode.space}")
+        self._state, self._first = None, True
+        if not self.deterministic and callable(getattr(self.model, "set_random_seed", None)):
+            self.model.set_random_seed(int(rng.integers(2 ** 31)))
+
+    def act(self, env, agent, obs):
+        if self._observe is not None:
+            obs = self._observe(obs, self._first) if isinstance(self._observe, ImageDict) \
+                else self._observe(obs)
+        action, self._state = self.model.predict(obs, state=self._state,
+                                                 episode_start=np.array([self._first]),
+                                                 deterministic=self.deterministic)
+        self._first = False
+        return action if self._decode is None else self._decode(action, agent)
+
+
+class _Function:
+    """A function of the observation that returns the agent's action."""
+
+    def __init__(self, fn):
+        self.fn, self.name = fn, getattr(fn, "__name__", type(fn).__name__)
+
+    def act(self, env, agent, obs):
+        return self.fn(obs)
+
+
+def as_learner(policy, deterministic: bool = True):
+    """``policy`` as a policy of the episode loop (``act(env, agent, obs)``, optional
+    ``reset``): a scripted partner or any object with ``act`` as it is; an SB3 model (an object
+    with ``predict``) acting on the agent's observation (``deterministic``: the mode of its
+    action distribution, else sampled, seeded per episode), its observation and action mapped
+    from the env's as the model needs; a function ``obs -> action`` (an action of the agent's
+    action space)."""
+    if callable(getattr(policy, "act", None)):
+        return policy
+    if callable(getattr(policy, "predict", None)):
+        return _Model(policy, deterministic)
+    if callable(policy):
+        return _Function(policy)
+    raise ValueError(f"policy={show(policy)} not allowed; allowed: an object with act(env, agent, "
+                     "obs) (a scripted partner), an SB3 model (predict) or a function obs -> "
+                     "action")
+
+
+def effects(policy, episodes: int = 10, seed: int = 0,
+            env_kwargs: Mapping[str, Any] | None = None, deterministic: bool = True) -> dict:
+    """``policy`` (:func:`as_learner`) as ``infant_0`` in ``episodes`` episodes of the scripted
+    still face (:func:`~mimo_social.tasks.still_face.task.scripted_env` with ``env_kwargs``;
+    seeds ``seed``, ``seed + 1``, ...). Returns ``{"episodes": n, "effects": {name: (mean, sd)},
+    "summary": still_face_summary, "return": (mean, sd)}``; each effect (:data:`EFFECTS`) is
+    a difference of two phases' shares of steps, taken per episode: a drop of smiling or gaze
+    in the still face is positive, and so is their recovery in reunion and the rise of
+    self-touch."""
+    episodes = check_int("effects", "episodes", episodes, 1)
+    env = scripted_env(**dict(env_kwargs or {}))
+    try:
+        finals, returns = _episodes(as_learner(policy, deterministic), episodes, seed, env)
+    finally:
+        env.close()
+    summary = _summary(finals, returns)
+    plus = np.array([[float(r[f"{k}_{p}"]) for k, p, _ in EFFECTS.values()] for r in finals])
+    minus = np.array([[float(r[f"{k}_{m}"]) for k, _, m in EFFECTS.values()] for r in finals])
+    d = plus - minus                                   # episode x effect
+    out = {name: (float(mean), float(sd))
+           for name, mean, sd in zip(EFFECTS, d.mean(axis=0), d.std(axis=0))}
+    return {"episodes": episodes, "effects": out, "summary": summary,
+            "return": summary["return"]}
+
+
+def format_effects(result: Mapping) -> str:
+    """:func:`effects`' result as lines ``name: mean +- sd``."""
+    lines = [f"still-face effects over {result['episodes']} episodes (mean +- sd)"]
+    lines += [f"{name}: {m:+.3f} +- {sd:.3f}" for name, (m, sd) in result["effects"].items()]
+    return "\n".join(lines)

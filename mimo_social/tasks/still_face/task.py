@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Iterable, Mapping
 
 import mujoco
 import numpy as np
@@ -16,6 +15,7 @@ from ...core.task import Plot, Task, TaskOptions
 from ...core.world import AgentSetup
 from ...expressions.faces import EXPRESSIONS
 from ...partners.cues import learner_cues
+from ...util.checks import ConfigError
 from ..common import face_to_face
 from ..dyad import held_angles, tables_of, task_plan
 from ...core.factory import make_aec, make_parallel, with_options
@@ -50,8 +50,8 @@ SELF_PARTS = ("head", "upper_body", "lower_body")
 class StillFaceOptions(TaskOptions):
     """The phases' lengths (s: interaction, still face, reunion), the standard pair's distance
     (m), whether the learner's arms are free, head support, the share of interactive steps that
-    must be engaged for success, reward-free mode and whether ``infant_1`` is a scripted
-    caregiver (no eyes, no reward)."""
+    must be engaged for success, the reward of a still-phase step with the classic response,
+    reward-free mode and whether ``infant_1`` is a scripted caregiver (no eyes, no reward)."""
 
     task = "still_face"
     phases_s: tuple = (5.0, 5.0, 5.0)
@@ -59,6 +59,7 @@ class StillFaceOptions(TaskOptions):
     arms_free: bool = True
     head_support: bool = True
     success_fraction: float = 0.5
+    still_response_reward: float = 0.0
     reward_free: bool = False
     scripted_partner: bool = False
 
@@ -69,8 +70,14 @@ class StillFaceOptions(TaskOptions):
         self._bool("arms_free")
         self._bool("head_support")
         self._number("success_fraction", 0.05, 1.0)
+        self._number("still_response_reward", 0.0, 10.0)
         self._bool("reward_free")
         self._bool("scripted_partner")
+        if self.still_response_reward > 0 and not self.arms_free:
+            raise ConfigError(
+                f"{self.task}: task option still_response_reward={self.still_response_reward!r} "
+                "pays the still-phase response, which needs self-touch, with arms_free=False; "
+                "allowed: still_response_reward=0 or arms_free=True")
 
 
 def self_touch_geoms(world, i: int) -> tuple[np.ndarray, np.ndarray]:
@@ -189,7 +196,7 @@ class StillFace(Task):
         self._steps = np.zeros(3, np.int64)
         self._engaged_steps = 0
         self._inter_steps = 0
-        self._now = (False, False, False, False)
+        self._now = (False, False, False, False, False)
         d.qfrc_applied[self._care_dof] = 0.0
 
     def before_physics(self, env):
@@ -249,15 +256,19 @@ class StillFace(Task):
         touch = self._self_touch(w.data)
         engaged = gaze and smiling and w.expression_of(1) == HAPPY and self.phase != 1
         p = self.phase
+        # the classic still-face response: sober, gaze averted, self-comforting
+        response = p == 1 and touch and not smiling and not gaze
         self._steps[p] += 1
         self._counts[p] += (smiling, gaze, touch)
         if p != 1:
             self._inter_steps += 1
             self._engaged_steps += int(engaged)
-        self._now = (smiling, gaze, touch, engaged)
+        self._now = (smiling, gaze, touch, engaged, response)
         if self.options.reward_free:
             return np.zeros(2)
-        return self._weights * float(engaged)
+        out = self._weights * float(engaged)
+        out[0] += self.options.still_response_reward * float(response)   # the infant's own
+        return out
 
     def plots(self):
         """Reward, the phase (0 interaction, 1 still face, 2 reunion), the learner's smile and
@@ -272,15 +283,15 @@ class StillFace(Task):
 
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
-        keys = ["phase", "smiling", "gaze_on_face", "self_touch", "engaged", "engaged_steps",
-                "interactive_steps", "is_success"]
+        keys = ["phase", "smiling", "gaze_on_face", "self_touch", "engaged", "still_response",
+                "engaged_steps", "interactive_steps", "is_success"]
         keys += [f"{k}_{p}" for p in PHASES for k in MEASURES]
         return {k: "number" for k in keys}
 
     def _info(self) -> dict:
-        smiling, gaze, touch, engaged = self._now
+        smiling, gaze, touch, engaged, response = self._now
         out = {"phase": int(self.phase), "smiling": smiling, "gaze_on_face": gaze,
-               "self_touch": touch, "engaged": engaged,
+               "self_touch": touch, "engaged": engaged, "still_response": response,
                "engaged_steps": int(self._engaged_steps),
                "interactive_steps": int(self._inter_steps),
                "is_success": bool(self._engaged_steps >= self._need)}
