@@ -40,7 +40,6 @@ import functools
 import time
 from pathlib import Path
 
-from ..util.cores import cpu_cores
 from .envs import make_parallel_env, make_scripted_env
 from .independent import train_independent
 from .interrupt import StopSignals, workers_ignore_sigint
@@ -206,8 +205,7 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
         log = RunLog(out, agents, evaluate, lambda: save(out / "best_model.zip"), t0, bar,
                      schedule, eval_seed)
         try:
-            cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop,
-                              update_threads=cpu_cores())
+            cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop)
             learn_and_finish(model, steps, per_env_step, cb, stop, save, out, schedule,
                              checkpoint, bar, log)
         finally:

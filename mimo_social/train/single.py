@@ -27,7 +27,6 @@ from .interrupt import StopSignals
 from .progress import write_config
 from .rollouts import evaluate_policy, vecnormalize_path
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
-from ..util.cores import cpu_cores
 
 __all__ = ["train_single", "monitored_env", "vector_defaults", "warn", "reward_normalizer",
            "model_saver", "build_model", "learn_and_finish"]
@@ -190,8 +189,7 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         t0 = log.t_start
         try:
             with stop:
-                cb = sb3_callback(log, schedule, None, 1, checkpoint, stop,
-                                  update_threads=cpu_cores())
+                cb = sb3_callback(log, schedule, None, 1, checkpoint, stop)
                 learn_and_finish(model, steps, 1, cb, stop, save, out, schedule, checkpoint,
                                  bar, log)
         finally:
