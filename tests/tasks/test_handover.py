@@ -1,11 +1,13 @@
-"""The handover task: API, seeds, the physical initial grasp, the reward and success rules."""
+"""The handover task: API, seeds, the physical initial grasp, the reward (the shaping toward the
+giver's ready posture) and success rules (each clause of the success: test_handover_clauses.py)."""
 
 import mujoco
 import numpy as np
 import pytest
 
 from mimo_social.envs import handover_v0
-from mimo_social.tasks.handover import OFFER_TARGET, HandoverOptions, scripted_giver
+from mimo_social.tasks.handover import OFFER_TARGET, READY_OFFSET, HandoverOptions, scripted_giver
+from mimo_social.tasks.handover.controller import ARM, ReceiveController, hand_frame, palm_posture
 from mimo_social.partners import ScriptedPartners, zero_action
 from mimo_social.partners.hand_offer import HandOffer
 
@@ -22,6 +24,34 @@ def _scripted(task_options=None, **kwargs):
 def _ball(env):
     w = env.unwrapped.world
     return w.data.xpos[w.prop_bodies["ball"]].copy()
+
+
+def _ready_point(env):
+    """The ready point, computed here from the table's words: READY_OFFSET (forward, left, up)
+    from the offered ball's centre at reset, in the receiver's heading frame (it faces +x)."""
+    w = env.unwrapped.world
+    R = w.data.xmat[w.agents[0].root_body].reshape(3, 3)
+    np.testing.assert_allclose(R[:, 0], (1.0, 0.0, 0.0), atol=1e-9)
+    return _ball(env) + np.asarray(READY_OFFSET)
+
+
+def _potential(env, ready, in_hand=False):
+    """The shaping's potential as the table states it (default scales 10, 2, 2): -10 x the palm
+    centre's distance to the ready point + 2 x the palm normal's upward component (+ 2 x the
+    four fingers' mean flexion fraction when the ball is in the receiver's hand)."""
+    w = env.unwrapped.world
+    d = w.data
+    a = w.agents[0]
+    site = a.palm_sites[0]
+    R = d.xmat[w.model.site_bodyid[site]].reshape(3, 3)
+    phi = -10.0 * np.linalg.norm(d.site_xpos[site] - ready) + 2.0 * (-R[2, 1])
+    if in_hand:
+        k = [j for j, n in enumerate(a.joint_names)
+             if n.split("_")[1:2] in (["index"], ["middle"], ["ring"], ["little"])
+             and n.split("_")[-1] in ("mcp", "pip", "dip")]
+        frac = d.qpos[a.qpos_adr[k]] / a.joint_range[k, 1]
+        phi += 2.0 * float(np.clip(frac, 0.0, 1.0).mean())
+    return phi
 
 
 def test_agents_and_spaces():   # the API checks: tests/conformance
@@ -71,19 +101,20 @@ def test_the_ball_stays_in_the_givers_hand_when_the_receiver_is_idle(actuation):
     assert m.neq == 0
     assert np.linalg.norm(d.qvel[w.prop_dof["ball"]:][:3]) < 0.05
     start = _ball(env)
+    ready = _ready_point(env)
     idle = {"infant_0": zero_action(env.action_space("infant_0"))}
-    before = None
+    before = _potential(env, ready)
     total = 0.0
     for _ in range(200):                                            # 2 s
         _, rew, term, trunc, infos = env.step(idle)
         info = infos["infant_0"]
         assert info["holder"] == "giver" and not info["dropped"] and not info["is_success"]
         assert not term["infant_0"]
-        # progress shaping: 10 x the decrease of the palm-to-ball distance, for both
-        if before is not None:
-            assert rew["infant_0"] == pytest.approx(10.0 * (before - info["distance"]))
+        # the shaping: the potential's increase (toward the ready point, palm up), for both
+        now = _potential(env, ready)
+        assert rew["infant_0"] == pytest.approx(now - before, abs=1e-9)
         assert info["partner_rewards"]["infant_1"] == rew["infant_0"]
-        before = info["distance"]
+        before = now
         total += rew["infant_0"]
     assert env.partners["infant_1"].tip == 0.0 and not env.partners["infant_1"].released
     assert np.linalg.norm(_ball(env) - start) < 0.02
@@ -91,6 +122,50 @@ def test_the_ball_stays_in_the_givers_hand_when_the_receiver_is_idle(actuation):
     assert abs(total) < 0.5                                          # doing nothing earns ~0
     tip = d.site_xpos[w.agents[0].palm_sites[0]]
     assert info["distance"] == pytest.approx(np.linalg.norm(tip - _ball(env)), abs=1e-9)
+
+
+def test_the_shaping_leads_to_where_the_giver_waits():
+    """The ready point lies where the scripted giver's condition for tipping the ball holds
+    (an open palm up beside its hand: HandOffer.open_hand_ready): a palm put there kinematically,
+    facing up, satisfies it; the potential is higher there than with the palm at the ball (where
+    the shaping pointed before issue 30) or hanging; the scripted receiver's shaping return up
+    to the giver's tip is the potential's rise, and the giver tips once its palm is there."""
+    env = _scripted(max_steps=600)
+    env.reset(seed=1000)
+    inner = env.unwrapped
+    w = inner.world
+    m, d = w.model, w.data
+    a = w.agents[0]
+    giver = env.partners["infant_1"]
+    ready = _ready_point(env)
+    hang = _potential(env, ready)
+    k = a.qpos_adr[[a.joint_names.index(n) for n in ARM]]
+    saved = d.qpos.copy()
+    up = hand_frame((0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+    start = np.deg2rad([60.0, 20.0, -60.0, -60.0, -80.0, 0.0, 0.0])
+    q, res, _ = palm_posture(w, 0, ready, up, start=start)
+    assert res < 2e-3
+    d.qpos[k] = q
+    mujoco.mj_forward(m, d)
+    assert giver.open_hand_ready(d)                                  # what the giver waits for
+    at_ready = _potential(env, ready)
+    q, res, _ = palm_posture(w, 0, _ball(env) - (0.0, 0.0, 0.035), up, start=start)
+    d.qpos[k] = q
+    mujoco.mj_kinematics(m, d)
+    at_ball = _potential(env, ready)
+    assert at_ready > at_ball + 0.3 and at_ready > hang + 2.0
+    d.qpos[:] = saved
+    mujoco.mj_forward(m, d)
+    receiver = ReceiveController()
+    receiver.reset(inner, "infant_0", None)
+    total, phi0 = 0.0, _potential(env, ready)
+    while giver.tip == 0.0:
+        _, rew, *_ = env.step({"infant_0": receiver.act(inner, "infant_0", None)})
+        total += rew["infant_0"]
+    palm = d.site_xpos[a.palm_sites[0]]
+    assert np.linalg.norm(palm - ready) < 0.02
+    assert total == pytest.approx(_potential(env, ready) - phi0, abs=1e-6)
+    assert total > 0.8 * (at_ready - phi0)                           # most of the way there
 
 
 def test_receiver_holding_the_ball_alone_is_a_success_for_both():
@@ -226,6 +301,9 @@ def test_where_the_ball_is_offered_does_not_reach_the_receivers_observation():
     ({"task_options": {"end_on_success": 1}}, r"end_on_success=1.*True or False"),
     ({"task_options": {"shaping": "no"}}, r"shaping='no'.*True or False"),
     ({"task_options": {"shaping_scale": -1}}, r"shaping_scale=-1.*from 0"),
+    ({"task_options": {"palm_up_scale": -1}}, r"palm_up_scale=-1.*from 0"),
+    ({"task_options": {"grip_scale": "x"}}, r"grip_scale='x'"),
+    ({"task_options": {"grasp_height": 2}}, r"grasp_height=2.*from -1 to 1"),
     ({"task_options": {"assisted_gaze": 1}}, r"assisted_gaze=1.*True or False"),
     ({"hands": "mitten"}, r"hands='mitten' not allowed.*five_fingers"),
     ({"posture": "sitting"}, r"posture='sitting' not allowed.*standing"),

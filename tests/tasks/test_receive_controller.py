@@ -8,11 +8,11 @@ import pytest
 from mimo_social.envs import handover_v0
 from mimo_social.partners import zero_action
 from mimo_social.tasks.reach.controller import ReachController
-from mimo_social.tasks.handover.controller import (ARM, CupAndLeave, ReceiveController,
+from mimo_social.tasks.handover.controller import (ARM, CupAndLeave, OpenPalm, ReceiveController,
                                                       hand_frame, palm_posture)
 from mimo_social.tasks.handover import HandoverOptions, scripted_giver
 
-SEEDS = range(1000, 1020)
+SEEDS = range(1000, 1030)
 
 
 def _env(task_options=None, **kwargs):
@@ -151,9 +151,11 @@ def test_hacks_score_less_than_the_scripted_receiver():
     scripted = episode(ReceiveController(), 1000)[3]
     touch = episode(ReachController(depth=0.02), 1000)           # fingertips into the ball
     leave = episode(CupAndLeave(), 1000)                         # take the shaping, leave
+    cupped = episode(OpenPalm(cup_deg=(20.0, 20.0, 10.0)), 1000)  # the ball rests, never closed
     zero = episode("zero", 1000)[3]
     assert not touch[0] and touch[3] < scripted - 5.0
     assert not leave[0] and leave[1] and leave[3] < zero - 5.0   # a drop: worse than idling
+    assert not cupped[0] and cupped[3] < scripted - 5.0
 
 
 @pytest.mark.parametrize("kwargs, pattern", [
@@ -183,11 +185,13 @@ def test_missing_motors_or_prop_are_reported():
 
 
 @pytest.mark.slow
-def test_twenty_episodes_scripted_random_zero_and_hacks():
-    """The baselines row of the handover table (seeds 1000-1019, scripted giver)."""
+def test_thirty_episodes_scripted_random_zero_and_hacks():
+    """The baselines row of the handover table (seeds 1000-1029, scripted giver)."""
     policies = {"scripted": ReceiveController, "zero": lambda: "zero",
                 "random": lambda: "random", "touch": lambda: ReachController(depth=0.02),
-                "cup_and_leave": CupAndLeave}
+                "cup_and_leave": CupAndLeave, "open_palm": OpenPalm,
+                "open_palm_curled": lambda: OpenPalm(cup_deg=(20.0, 20.0, 10.0))}
+    n = len(SEEDS)
     rows = {}
     for name, make in policies.items():
         res = [episode(make(), seed) for seed in SEEDS]
@@ -195,10 +199,11 @@ def test_twenty_episodes_scripted_random_zero_and_hacks():
         wins = [r[2] for r in res if r[0]]
         rows[name] = (sum(r[0] for r in res), ret.mean(), ret.std(), sum(r[1] for r in res),
                       np.mean(wins) if wins else float("nan"))
-        print(f"{name}: success {rows[name][0]} / 20, return {ret.mean():.2f} +- {ret.std():.2f}"
+        print(f"{name}: success {rows[name][0]} / {n}, return {ret.mean():.2f} +- {ret.std():.2f}"
               f", drops {rows[name][3]}, steps to success {rows[name][4]:.0f}")
-    assert rows["scripted"][0] >= 16                            # >= 80 %
-    for name in ("zero", "random", "touch", "cup_and_leave"):
-        assert rows[name][0] <= 3                               # <= 15 %
-        assert rows[name][1] < rows["scripted"][1]
+    assert rows["scripted"][0] >= 0.8 * n                       # >= 80 %
+    for name in policies:
+        if name != "scripted":
+            assert rows[name][0] <= 0.15 * n                    # <= 15 %
+            assert rows[name][1] < rows["scripted"][1]
     assert rows["cup_and_leave"][1] < rows["zero"][1]           # dropping: worse than idling

@@ -15,10 +15,13 @@ scene:
 geometry:
     the offered ball's centre is 20.1 cm from the receiver's right shoulder (15.7 cm ahead, 11.5 cm
     toward the midline, 5 cm lower) and 22.1 cm from the giver's; MIMo's straight arm reaches 22.2
-    cm from the shoulder to the palm centre (27.7 cm to the fingertips); the receiving hand of
-    :class:`~mimo_social.tasks.handover.controller.ReceiveController` (palm up beside the giver's
-    hand) lies 20.2 cm from the shoulder, reached by its inverse kinematics within 1 mm (measured at
-    the default options; tests/partners/test_receive.py)
+    cm from the shoulder to the palm centre (27.7 cm to the fingertips); the *ready point*
+    (:data:`READY_OFFSET`: 1 cm ahead of the offered ball's centre at reset, 5.5 cm to the
+    receiver's right, 4.7 cm lower, in the receiver's heading frame: beside the giver's palm on its
+    little-finger side, ~5 cm from its centre), where the scripted giver waits for the receiver's
+    open hand and where :class:`~mimo_social.tasks.handover.controller.ReceiveController` holds its
+    palm up, lies 20.2 cm from the receiver's shoulder, reached by its inverse kinematics within 1
+    mm (measured at the default options; tests/tasks/test_receive_controller.py)
 reset:
     the giver's arm is posed in its offer posture
     (:func:`~mimo_social.partners.hand_offer.offer_posture` for `offer_target` = 18 cm ahead of its
@@ -38,9 +41,10 @@ scripted giver:
     poke by one finger does neither (tests/partners/test_hand_offer.py)
 scripted receiver:
     :class:`~mimo_social.tasks.handover.controller.ReceiveController` (through its own motors,
-    reading the ball's position): holds its hand out open, palm up, beside the giver's, lets the
-    ball roll in and closes the fingers gently. With the scripted giver: 19 / 20 successes (seeds
-    1000-1019), 20 / 20 (seeds 0-19)
+    reading the ball's position): holds its hand out open, palm up, at the ready point, lets the
+    ball roll in and closes the fingers gently (0.05 of the motors' strength: they curl over the
+    ball, up to ~0.3 radii past its centre, the grasp the success needs). With the scripted
+    giver: 29 / 30 successes (seeds 1000-1029)
 action:
     per agent: the right-arm motors, 29 (spring-damper, in [-1, 1]) or 58 (muscles, in [0, 1]); plus
     the expression when `expressions=True`
@@ -51,21 +55,31 @@ observation:
     coordinates: before contact the receiver's observation does not change with where the ball is
     offered (tested)
 reward (both):
-    `shaping` (on): `shaping_scale` (10) x the decrease, this step, of the distance from the
-    receiver's right palm centre to the ball (progress: it sums to 10 x (start - end distance), so
-    hovering earns at most ~2 and leaving gives it back); `+success_reward` (10) on success;
-    `failure_reward` (-10) when the ball drops. Holding the ball is the optimum; dropping it is
-    worse than never trying (zero action: ~0)
+    `shaping` (on): the increase, this step, of a potential that leads the receiver's right hand
+    to the giver's ready posture (what the scripted giver waits for before it tips the ball in: an
+    open palm up beside its hand): minus `shaping_scale` (10) x the distance (m) from the
+    receiver's palm centre to the ready point, plus `palm_up_scale` (2) x the upward component of
+    the palm's normal (-1 to 1), plus, while the ball touches the receiver's hand and not the
+    giver's, `grip_scale` (2) x the closure of its four fingers (mean fraction of the mcp, pip,
+    dip flexion ranges). Progress only: it sums to the potential's end minus start (the scripted
+    receiver: ~+4.5), so hovering earns nothing more and leaving gives it back; `+success_reward`
+    (10) on success; `failure_reward` (-10) when the ball drops. Holding the ball is the optimum;
+    dropping it is worse than never trying (zero action: ~0)
 success:
-    the ball touches at least `min_parts` (2) segments of the receiver's right hand (palm, finger
-    segments), no longer touches the giver's hand and is above `drop_height`, continuously for
-    `hold_time` (0.3 s); `is_success` in the last step's info is the episode's outcome
+    the receiver holds the ball, without a break, for `hold_time` (0.3 s): it touches at least
+    `min_parts` (2) segments of the receiver's right hand (palm, finger segments); the hand is
+    closed around it (contacts on both sides of the ball's centre along the palm's normal: one at
+    least `grasp_height` (0) radii past the centre away from the palm, i.e. fingers curled over
+    the ball, and one on the palm's side); it does not touch the giver's hand; and it is above
+    `drop_height`. A ball resting on an open palm, or on the back of the hand, is not held (the
+    hack `OpenPalm`: 0 / 30). `is_success` in the last step's info is the episode's outcome; one
+    test per clause: tests/tasks/test_handover_clauses.py
 termination:
     both agents, on success (`end_on_success`) or when the ball falls below `drop_height` (0.25 m:
     well below the hands, near the floor); truncation at `max_steps` (600, 6 s)
 infos:
     `is_success`, `holder` (`"giver"`: the ball touches the giver's hand; `"receiver"`: the
-    receiver's hand in >= `min_parts` segments and not the giver's; `"none"` otherwise), `dropped`,
+    receiver holds it, as the success says, this step; `"none"` otherwise), `dropped`,
     `receiver_parts`, `held_steps`, `distance` (receiver's palm centre to the ball, m)
 privileged cues:
     `assisted_gaze` (False): when on, the task points the receiver's head and eyes at the ball and
@@ -78,19 +92,25 @@ two learners:
     zero actions it sinks and the ball falls within 0.5 s: a failure for both); nothing makes the
     giver let go but its own fingers
 baselines:
-    20 episodes each, reset seeds 1000-1019, `scripted_env(scripted_giver())` (the receiver acts):
-    scripted `ReceiveController` 19 / 20 successes, return 10.9 +- 4.9, 204 steps (2.0 s) to
-    success; zero action 0 / 20, -0.03 +- 0.04; random (uniform) 0 / 20, -1.8 +- 4.2 (3 drops);
-    hacks: touch the ball (`ReachController(depth=0.02)`) 0 / 20, 1.4 +- 0.1; hold the hand out and
-    leave when the ball comes (`CupAndLeave`) 0 / 20, -9.7 +- 0.2 (20 drops); command: `python -m
-    pytest -m slow tests/partners/test_receive.py -s` (prints them). PPO receiver, scripted giver, 2
-    seeds, 200k env steps each (SB3 defaults, 22 min): evaluation (10 episodes every 20k) 0 %
-    success throughout, return between -10 and +1.3 (it learns to bring the hand to the ball, then
-    alternates with knocking it down); the final models on the 20 episodes above: 0 / 20, 0.2 +- 2.9
-    and 0 / 20, -2.0 +- 5.3: not above random on success (`mimo-social compare --task handover
-    --mode scripted --algos ppo --seeds 2 --steps 200000 --out runs/handover15 --eval-every 20000
-    --eval-episodes 10 --jobs 2`, then `mimo-social baselines handover --episodes 20 --seed 1000
-    --run runs/handover15/ppo_seed0 runs/handover15/ppo_seed1`)
+    30 episodes each, reset seeds 1000-1029, `scripted_env(scripted_giver())` (the receiver acts;
+    issue 30's success and shaping): scripted `ReceiveController` 29 / 30 successes, return 13.9 +-
+    3.7, 216 steps (2.2 s) to success (1 drop: seed 1005); zero action 0 / 30, 0.01 +- 0.13; random
+    (uniform) 0 / 30, -1.0 +- 3.1 (3 drops); hacks: the open never-closing palm (`OpenPalm`: held
+    out like the scripted cup, fingers never closed) 0 / 30, -3.6 +- 4.4 (22 drops), the same with
+    the fingers pre-curled (`OpenPalm(cup_deg=(20, 20, 10))`: the ball rests in it for the whole
+    episode) 0 / 30, 3.8 +- 0.2; touch the ball (`ReachController(depth=0.02)`) 0 / 30, 0.4 +- 0.2;
+    hold the hand out and leave when the ball comes (`CupAndLeave`) 0 / 30, -9.0 +- 0.1 (30 drops).
+    Before issue 30 (the ball resting on 2 hand segments was a success) `OpenPalm` succeeded 3 / 20
+    (seeds 1000-1019; the same with `grasp_height=-1`). Command: `python -m pytest -m slow
+    tests/tasks/test_receive_controller.py -s` (prints them, ~5 min). PPO receiver (issue 15's
+    reward and success, not rerun since): scripted giver, 2 seeds, 200k env steps each (SB3
+    defaults, 22 min): evaluation (10 episodes every 20k) 0 % success throughout, return between -10
+    and +1.3 (it learns to bring the hand to the ball, then alternates with knocking it down); the
+    final models on seeds 1000-1019: 0 / 20, 0.2 +- 2.9 and 0 / 20, -2.0 +- 5.3: not above random on
+    success (`mimo-social compare --task handover --mode scripted --algos ppo --seeds 2 --steps
+    200000 --out runs/handover15 --eval-every 20000 --eval-episodes 10 --jobs 2`, then `mimo-social
+    baselines handover --episodes 20 --seed 1000 --run runs/handover15/ppo_seed0
+    runs/handover15/ppo_seed1`)
 sources:
     not in the MIMo paper: a social task of this package; rationale (give and take, 9-18 months),
     the release rule and figures: `docs/social/handover.md`
@@ -104,7 +124,12 @@ version history:
     "posture": "kneeling"}]`, kneeling leaning 15 deg; `offer_target` is then unused) holds the ball
     where the infant giver would (`ADULT_OFFER` from the receiver's right shoulder) and tips its
     palm 1.5 (`ADULT_PRESENT`); partners of other bodies placed by their measured reach, looking at
-    each other's face (`tasks/dyad.py`, docs/bodies.md); two 18-month-olds unchanged
+    each other's face (`tasks/dyad.py`, docs/bodies.md); two 18-month-olds unchanged; v0, issue 30:
+    success needs the ball held in a closed hand (contacts on both sides of its centre,
+    `grasp_height`; was: resting on 2 hand segments, which an open palm met) and above
+    `drop_height` to count as held; the shaping leads to the giver's ready posture (ready point,
+    palm up, finger closure with the ball in hand; `palm_up_scale`, `grip_scale`; was: the palm's
+    distance to the ball, which pointed at the ball still in the giver's hand); the hack `OpenPalm`
 
 A learning giver starts with the same grasp but holds it only if it acts: with zero actions its arm
 sinks under gravity and the ball falls (a failure) within half a second.
@@ -118,9 +143,10 @@ that tips the ball into the receiver's open hand and lets go only once that hand
 another partner is given.
 """
 
-from .task import (Handover, HandoverOptions, scripted_giver, OFFER_TARGET, parallel_env, env,
-                   scripted_env)
-from .controller import ReceiveController, hand_frame, palm_posture
+from .task import (Handover, HandoverOptions, scripted_giver, OFFER_TARGET, READY_OFFSET,
+                   parallel_env, env, scripted_env)
+from .controller import ReceiveController, OpenPalm, hand_frame, palm_posture
 
-__all__ = ["Handover", "HandoverOptions", "scripted_giver", "OFFER_TARGET", "parallel_env", "env",
-           "scripted_env", "ReceiveController", "hand_frame", "palm_posture"]
+__all__ = ["Handover", "HandoverOptions", "scripted_giver", "OFFER_TARGET", "READY_OFFSET",
+           "parallel_env", "env", "scripted_env", "ReceiveController", "OpenPalm", "hand_frame",
+           "palm_posture"]

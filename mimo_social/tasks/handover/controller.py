@@ -11,19 +11,23 @@ reads:
     agent's action
 posture:
     the *cup*: the palm centre ``offset`` (forward, left, up; m, in the receiver's heading frame)
-    from the ball (default 1 cm ahead, 5.5 cm to the right, 4.7 cm lower: beside the giver's palm,
-    on its little-finger side), the palm facing up and leaning ``lean`` (slopes toward the wrist and
-    toward the thumb) so a ball that rolls in settles against the palm's heel and the thumb; fingers
-    pointing straight ahead, slightly curled (``cup_deg``: mcp, pip, dip), the thumb at rest; solved
-    by damped least squares over shoulder, elbow and wrist (palm position and hand orientation
+    from the ball (default the task's ready point,
+    :data:`~mimo_social.tasks.handover.READY_OFFSET`: 1 cm ahead, 5.5 cm to the right, 4.7 cm
+    lower: beside the giver's palm, on its little-finger side, where the giver waits for an open
+    hand), the palm facing up and leaning ``lean`` (slopes toward the wrist and toward the thumb)
+    so a ball that rolls in settles against the palm's heel and the thumb; fingers pointing
+    straight ahead, slightly curled (``cup_deg``: mcp, pip, dip), the thumb at rest; solved by
+    damped least squares over shoulder, elbow and wrist (palm position and hand orientation
     together) on a scratch copy of the state
 phases:
     ``reach``: PD toward the cup posture via a point ``below`` (m) lower and 3 cm further out (so
     the hand comes up beside the giver's, not through it), then the cup itself; ``cup``: hold the
     cup; ``close`` (once the ball has touched the own hand for ``close_after`` s): the fingers' and
     thumb's flexors get the constant command ``grip`` (a gentle grip, of the motor's strength or of
-    full activation), the arm holds; ``hold`` (once no other hand has touched the ball for
-    ``settle`` s): the hand draws back ``draw_back`` (m) toward the body and keeps the grip
+    full activation: the fingers curl over the ball, up to ~0.3 radii past its centre: the closed
+    hand the task's success needs), the arm holds; ``hold`` (once no other hand has touched the
+    ball for ``settle`` s): the hand draws back ``draw_back`` (m) toward the body and keeps the
+    grip
 arm:
     PD control per joint toward the phase's target angles, gains from each joint's own inertia (the
     diagonal of the joint-space mass matrix at reset; natural frequency ``frequency``, damping ratio
@@ -36,8 +40,9 @@ state:
     ``target_angles`` (rad, per motor)
 
 It needs the right arm's motors (shoulder, elbow, wrist) and the five fingers' in its action (the
-handover task's action). Measured success: the handover table (``tasks/handover/task.py``) and
-``tests/partners/test_receive.py``.
+handover task's action). Measured success: the handover table (``tasks/handover/__init__.py``)
+and ``tests/tasks/test_receive_controller.py``. :class:`CupAndLeave` and :class:`OpenPalm` are
+hacks the task must not reward (checks, not solutions).
 """
 
 from __future__ import annotations
@@ -50,9 +55,10 @@ from ...core.kinematics import hand_geoms
 from ...util.checks import ConfigError, check_number, check_numbers, show
 from ...partners.base import (Partner, agent_index, motor_action, pd_gains, require_motors,
                                require_prop, torque_controls)
+from .task import READY_OFFSET
 
 
-__all__ = ["ReceiveController", "hand_frame", "palm_posture"]
+__all__ = ["ReceiveController", "CupAndLeave", "OpenPalm", "hand_frame", "palm_posture"]
 
 ARM = RIGHT_SHOULDER_ELBOW + RIGHT_WRIST
 PHASES = ("reach", "cup", "close", "hold")
@@ -138,7 +144,7 @@ class ReceiveController(Partner):
     ``prop``: the ball's prop name.
     """
 
-    def __init__(self, offset=(0.01, -0.055, -0.047), lean=(0.3, 0.1),
+    def __init__(self, offset=READY_OFFSET, lean=(0.3, 0.1),
                  cup_deg=(10.0, 10.0, 5.0), grip: float = 0.05, close_after: float = 0.1,
                  settle: float = 0.1, draw_back: float = 0.0, below: float = 0.04,
                  frequency: float = 3.0, damping: float = 1.0, tolerance: float = 0.01,
@@ -316,3 +322,15 @@ class CupAndLeave(ReceiveController):
             self.left = True
             self.phase = "cup"
             self.target_angles = self._start.copy()
+
+
+class OpenPalm(ReceiveController):
+    """A hack for the handover's success (a check, not a solution): holds the open, slightly
+    cupped hand out like :class:`ReceiveController` (so the giver tips the ball into it) and
+    keeps it so, never closing the fingers on the ball: the ball rests on the palm and the
+    thumb. The success needs the fingers closed around the ball, so this does not succeed."""
+
+    def _advance(self, env):
+        super()._advance(env)
+        if self.phase in ("close", "hold"):
+            self.phase = "cup"

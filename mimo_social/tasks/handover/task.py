@@ -17,10 +17,10 @@ from ...core.world import AgentSetup, Prop
 from ...partners.hand_offer import OPEN_FINGERS_DEG, HandOffer, offer_posture
 from ...partners.offer_target import adapts, reach_target
 
-__all__ = ["Handover", "HandoverOptions", "scripted_giver", "OFFER_TARGET", "parallel_env", "env",
-           "scripted_env"]
+__all__ = ["Handover", "HandoverOptions", "scripted_giver", "OFFER_TARGET", "READY_OFFSET",
+           "parallel_env", "env", "scripted_env"]
 from ...util.checks import ConfigError
-from ..common import geoms_touching, parts_outside
+from ..common import parts_outside
 from ..dyad import held_angles, tables_of, task_plan
 from ...core.factory import make_aec, make_parallel
 
@@ -37,6 +37,12 @@ ADULT_OFFER = (0.170, 0.110, -0.080)
 #: episodes (seeds 0-3), tipped 1.5 it hands it over in 4 of 4 (tests/tasks/test_partner_bodies.py)
 ADULT_PRESENT = 1.5
 BALL_TOWARD_FINGERS = 0.01           # m from the palm centre toward the fingers: the ball's rest
+#: the ready point, where the scripted giver waits for the receiver's open hand before it tips
+#: the ball into it: m from the offered ball's centre at reset, in the receiver's heading frame
+#: (forward, left, up): beside the giver's palm on its little-finger side, lower than the ball;
+#: there the receiver's palm centre is ~5 cm from the giver's (HandOffer's ``ready_radius``: 8
+#: cm). The shaping leads the receiver's palm centre here; ReceiveController cups its hand here
+READY_OFFSET = (0.01, -0.055, -0.047)
 
 
 def arms_only_touch(tables) -> dict:
@@ -48,9 +54,12 @@ def arms_only_touch(tables) -> dict:
 @dataclass(frozen=True)
 class HandoverOptions(TaskOptions):
     """Distance (m), ball radius (m) and mass (kg), hold time (s), receiver segments needed,
-    drop height (m), rewards, progress shaping and its scale, giver settling time (s), receiver
-    arm noise (deg), the giver's offer target (m from its right shoulder: forward, left, up),
-    whether success ends the episode, and whether the task aims the eyes (a privileged cue)."""
+    how far past the ball's centre a finger must touch it for a grasp (``grasp_height``, in ball
+    radii, away from the palm), drop height (m), rewards, progress shaping and its scales (per m
+    toward the ready point, per unit of the palm normal's upward component, per unit of finger
+    closure with the ball in the hand), giver settling time (s), receiver arm noise (deg), the
+    giver's offer target (m from its right shoulder: forward, left, up), whether success ends the
+    episode, and whether the task aims the eyes (a privileged cue)."""
 
     task = "handover"
     privileged: ClassVar[tuple[str, ...]] = ("assisted_gaze",)
@@ -59,11 +68,14 @@ class HandoverOptions(TaskOptions):
     ball_mass: float = 0.03
     hold_time: float = 0.3
     min_parts: int = 2
+    grasp_height: float = 0.0
     drop_height: float = 0.25
     success_reward: float = 10.0
     failure_reward: float = -10.0
     shaping: bool = True
     shaping_scale: float = 10.0
+    palm_up_scale: float = 2.0
+    grip_scale: float = 2.0
     settle_time: float = 0.3
     arm_noise: float = 10.0
     offer_target: tuple[float, float, float] | None = OFFER_TARGET
@@ -76,11 +88,14 @@ class HandoverOptions(TaskOptions):
         self._number("ball_mass", 0.005, 0.3)
         self._number("hold_time", 0.0, 5.0)
         self._int("min_parts", 1, 10)
+        self._number("grasp_height", -1.0, 1.0)
         self._number("drop_height", 0.0, 0.5)
         self._number("success_reward", -1e6, 1e6)
         self._number("failure_reward", -1e6, 1e6)
         self._bool("shaping")
         self._number("shaping_scale", 0.0, 1000.0)
+        self._number("palm_up_scale", 0.0, 1000.0)
+        self._number("grip_scale", 0.0, 1000.0)
         self._number("settle_time", 0.0, 2.0)
         self._number("arm_noise", 0.0, 45.0)
         self._bool("end_on_success")
@@ -181,6 +196,10 @@ class Handover(Task):
         self._giver_palm = int(w.agents[GIVER].palm_sites[0])
         self._fingers = [self._finger_tables(w, i) for i in (RECEIVER, GIVER)]
         self._hand_body = [int(m.site_bodyid[w.agents[i].palm_sites[0]]) for i in (0, 1)]
+        # the receiver's four fingers' flexion joints (qpos addresses, upper limits): the closure
+        tables = self._fingers[RECEIVER]
+        self._flex_q = np.concatenate([q for q, _, _ in tables])
+        self._flex_top = np.concatenate([top for _, top, _ in tables])
         boxes = [k for k in np.flatnonzero(m.geom_bodyid == self._hand_body[GIVER])
                  if m.geom_type[k] == mujoco.mjtGeom.mjGEOM_BOX]
         self._half_thickness = float(min(m.geom_size[k].min() for k in boxes)) if boxes else 0.006
@@ -248,13 +267,22 @@ class Handover(Task):
         # the giver: arm in the offer posture, the ball in its palm, fingers curled onto it
         self.put_ball_in_hand(env, GIVER, o.offer_target)
         self._settle(env)
+        # the ready point: beside the offered ball, where the scripted giver waits (READY_OFFSET)
+        R = d.xmat[r.root_body].reshape(3, 3)
+        heading = float(np.arctan2(R[1, 0], R[0, 0]))
+        fwd = np.array([np.cos(heading), np.sin(heading), 0.0])
+        left = np.array([-fwd[1], fwd[0], 0.0])
+        f, l, u = READY_OFFSET
+        self._ready_point = d.xpos[self._ball_body] + f * fwd + l * left + (0.0, 0.0, u)
         self._held_for = 0
         self._hold_steps = max(1, int(round(o.hold_time / env.dt)))
         self._success = self._dropped = False
         self._holder = "giver"
         self._parts = 0
+        self._grasped = False
         self.before_physics(env)
         self._distance = self._palm_distance(d)
+        self._potential = self._shaping_potential(d, False)
 
     def _close_fingers(self, env, i: int):
         """Curl each of agent i's four fingers (mcp, pip, dip together, from straight toward
@@ -306,29 +334,67 @@ class Handover(Task):
         return float(np.linalg.norm(d.site_xpos[self._receiver_palm]
                                     - d.xpos[self._ball_body]))
 
+    def _shaping_potential(self, d, in_hand: bool) -> float:
+        """The shaping's potential (the reward is its increase): minus ``shaping_scale`` x the
+        distance (m) from the receiver's right palm centre to the ready point, plus
+        ``palm_up_scale`` x the palm normal's upward component (-1 to 1), plus, while the ball
+        touches the receiver's hand and not the giver's (``in_hand``), ``grip_scale`` x the
+        closure of its four fingers (mcp, pip, dip: mean fraction of their flexion range,
+        0 straight, 1 fully flexed)."""
+        o = self.options
+        ready = float(np.linalg.norm(d.site_xpos[self._receiver_palm] - self._ready_point))
+        self._ready_distance = ready
+        up = -float(d.xmat[self._hand_body[RECEIVER], 7])   # the right palm faces the hand's -y
+        phi = -o.shaping_scale * ready + o.palm_up_scale * up
+        if in_hand:
+            closure = np.clip(d.qpos[self._flex_q] / self._flex_top, 0.0, 1.0)
+            phi += o.grip_scale * float(closure.mean())
+        return phi
+
     def _contacts(self, d):
-        """Segments of the receiver's right hand touching the ball, and whether the giver's
-        right hand touches it."""
-        other = geoms_touching(d, self._ball_geom)
-        if not len(other):
-            return 0, False
+        """How the ball is touched now: the segments of the receiver's right hand touching it,
+        whether the giver's right hand touches it, and whether the receiver's hand is closed
+        around it: touching it on both sides of its centre along the palm's normal, at least
+        ``grasp_height`` radii past the centre away from the palm (fingers curled over it) and
+        on the palm's side (the height of each contact point over the ball's centre, along the
+        normal out of the receiver's palm)."""
+        n = d.ncon
+        if n == 0:
+            return 0, False, False
+        c = d.contact
+        g1, g2 = c.geom1[:n], c.geom2[:n]
+        ob = self._ball_geom
+        other = np.where(g1 == ob, g2, np.where(g2 == ob, g1, -1))
+        idx = np.flatnonzero((other >= 0) & (c.dist[:n] <= 0.0))
+        other = other[idx]
         whose = self._hand_of[other]
-        parts = len(np.unique(self._geom_body[other[whose == RECEIVER]]))
-        return parts, bool(np.any(whose == GIVER))
+        mine = whose == RECEIVER
+        giver = bool(np.any(whose == GIVER))
+        if not mine.any():
+            return 0, giver, False
+        parts = len(np.unique(self._geom_body[other[mine]]))
+        normal = -d.xmat[self._hand_body[RECEIVER]].reshape(3, 3)[:, 1]  # out of the palm
+        height = (c.pos[idx[mine]] - d.xpos[self._ball_body]) @ normal / self.options.ball_radius
+        closed = bool((height >= self.options.grasp_height).any() and (height < 0.0).any())
+        return parts, giver, closed
 
     def rewards(self, env):
         d = env.world.data
         o = self.options
-        self._parts, giver_holds = self._contacts(d)
+        self._parts, giver_touches, self._grasped = self._contacts(d)
         ball = d.xpos[self._ball_body]
         self._dropped = bool(ball[2] < o.drop_height)
-        receiver_holds = self._parts >= o.min_parts and not giver_holds
-        self._holder = "giver" if giver_holds else "receiver" if receiver_holds else "none"
-        self._held_for = self._held_for + 1 if receiver_holds and not self._dropped else 0
+        # the receiver holds the ball: enough of its segments, closed around it, the giver's
+        # hand off it, and the ball above the drop height
+        receiver_holds = (self._parts >= o.min_parts and self._grasped and not giver_touches
+                          and not self._dropped)
+        self._holder = "giver" if giver_touches else "receiver" if receiver_holds else "none"
+        self._held_for = self._held_for + 1 if receiver_holds else 0
         self._success = self._held_for >= self._hold_steps
-        distance = self._palm_distance(d)
-        r = o.shaping_scale * (self._distance - distance) if o.shaping else 0.0
-        self._distance = distance
+        self._distance = self._palm_distance(d)
+        phi = self._shaping_potential(d, self._parts > 0 and not giver_touches)
+        r = phi - self._potential if o.shaping else 0.0
+        self._potential = phi
         if self._success:
             r += o.success_reward
         if self._dropped:
@@ -336,11 +402,13 @@ class Handover(Task):
         return np.array([r, r])
 
     def plots(self):
-        """The shared reward (one line), the ball's distance to the receiver's palm, who holds
-        the ball (-1 giver, 0 nobody, 1 receiver) and success."""
+        """The shared reward (one line), the ball's distance to the receiver's palm, the palm's
+        distance to the ready point, who holds the ball (-1 giver, 0 nobody, 1 receiver) and
+        success."""
         holder = {"giver": -1.0, "none": 0.0, "receiver": 1.0}
         return [Plot.reward(shared=True),
                 Plot("ball_to_hand", "m", lambda env: self._distance, per_agent=False),
+                Plot("hand_to_ready", "m", lambda env: self._ready_distance, per_agent=False),
                 Plot("holder", "-1 giver, 0 none, 1 receiver",
                      lambda env: holder[self._holder], per_agent=False),
                 Plot("success", "0/1", lambda env: self._success, per_agent=False)]
