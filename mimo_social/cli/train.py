@@ -8,6 +8,8 @@
     ``--algo-kwargs '{"n_steps": 512}'`` and ``--env-kwargs '{"max_steps": 200}'`` override.
     ``--algo recurrent_ppo``: sb3-contrib's RecurrentPPO (an LSTM policy: memory);
     ``--normalize-reward``: SB3's VecNormalize on the rewards, saved as ``vecnormalize.pkl``.
+    ``--curriculum selfbody`` (env options by stage) and ``--bc-episodes N`` (a warm start
+    cloned from the scripted controller): docs/training.md.
 
 ``mimo-social eval DIR --episodes 10 [--record run.rrd] [--video run.mp4 | --frames DIR]``
     Reloads ``DIR/model.zip`` (``--model best`` or a path for another), runs the episodes with the
@@ -114,7 +116,11 @@ def _engine_conflicts(args) -> str | None:
         return (f"{', '.join(bad)}: for --engine sb3; with --engine rllib use --num-env-runners "
                 "and --num-envs-per-runner")
     bad = [f for f, k, d in (("--normalize-reward", "normalize_reward", False),
-                             ("--algo recurrent_ppo", "algo", None))
+                             ("--algo recurrent_ppo", "algo", None),
+                             ("--curriculum", "curriculum", None),
+                             ("--bc-episodes", "bc_episodes", None),
+                             ("--bc-epochs", "bc_epochs", None),
+                             ("--bc-kwargs", "bc_kwargs", None))
            if given(k, d) and (k != "algo" or args.algo == "recurrent_ppo")]
     if bad:
         return f"{', '.join(bad)}: for --engine sb3 (the default engine)"
@@ -149,6 +155,9 @@ def _sb3_train_kwargs(args) -> dict:
         kw["frame_stack"] = args.frame_stack
     if getattr(args, "normalize_reward", False):
         kw["normalize_reward"] = True
+    for key in ("curriculum", "bc_episodes", "bc_epochs", "bc_kwargs"):
+        if getattr(args, key, None) is not None:
+            kw[key] = getattr(args, key)
     return kw
 
 
@@ -363,6 +372,20 @@ def add_parser(subparsers) -> None:
     p.add_argument("--n-cpus", type=non_negative_int, default=None, help="spawned worker "
                    "processes stepping the --n-envs envs or worlds, each a block of them (0: all "
                    "in this process). Default: one per CPU core, at most one per env")
+    c = p.add_argument_group("curriculum and demonstrations (one learner: a one-agent task or "
+                             "--mode scripted; docs/training.md)")
+    c.add_argument("--curriculum", default=None, metavar="NAME|FILE",
+                   help="env options that change by stage as the run trains: a shipped "
+                   "curriculum's name (e.g. selfbody) or a .toml / .json file; evaluations run "
+                   "on its last stage")
+    c.add_argument("--bc-episodes", type=non_negative_int, default=None, metavar="N",
+                   help="behaviour-cloning warm start: N seeded episodes of the task's scripted "
+                   "controller cloned into the policy before any RL step (default 0: none)")
+    c.add_argument("--bc-epochs", type=positive_int, default=None,
+                   help="epochs over the demonstrations (default 20)")
+    c.add_argument("--bc-kwargs", type=json_object, default=None,
+                   help="JSON settings of the warm start: batch_size (64), lr (1e-3), loss "
+                   "(mse or nll), log_std (PPO: the log-std after cloning)")
     g = p.add_argument_group("RLlib engine (--engine rllib; needs the rllib extra)")
     g.add_argument("--engine", choices=("sb3", "rllib"), default="sb3",
                    help="sb3 (Stable-Baselines3, the default) or rllib (RLlib on Ray)")

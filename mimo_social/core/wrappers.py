@@ -299,6 +299,16 @@ class ActionDecoder:
         return {"motors": motors,
                 "expression": np.int64(self.expression_start + int(np.argmax(logits)))}
 
+    def encode(self, action):
+        """The inverse: the flat action for ``action`` (logits HIGH/LOW; face-only: its id)."""
+        if self.discrete:
+            return int(action["expression"])
+        if not self.n_expressions:
+            return np.asarray(action, np.float32).ravel()
+        logits = np.full(self.n_expressions, LOGIT_LOW, np.float32)
+        logits[int(action["expression"]) - self.expression_start] = LOGIT_HIGH
+        return np.concatenate([np.asarray(action["motors"], np.float32).ravel(), logits])
+
 
 def _numbers(action, who: str, field: str, allowed: str) -> np.ndarray:
     """``action`` as a float64 array, else a ValueError naming the agent, the field, the value

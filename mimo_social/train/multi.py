@@ -40,14 +40,15 @@ import functools
 import time
 from pathlib import Path
 
-from .envs import make_parallel_env, make_scripted_env
+from .curriculum import monitored_curriculum_env
+from .envs import make_env, make_parallel_env, make_scripted_env
 from .independent import train_independent
 from .interrupt import StopSignals, workers_ignore_sigint
 from .progress import write_config
 from .rollouts import evaluate_agents
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
-from .single import (build_model, finish_config, learn_and_finish, monitored_env,
-                     vector_defaults, warn)
+from .single import (build_model, curriculum_controller, finish_config, learn_and_finish,
+                     monitored_env, vector_defaults, warm_start_run, warn)
 from .tasks import TrainInputError, algo_class, check_mode, task_module
 
 __all__ = ["train_multi", "check_shared_spaces"]
@@ -76,11 +77,13 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
                 eval_every: int | None, eval_episodes: int, checkpoint_every: int,
                 progress: bool, env_kwargs: dict, algo_kwargs: dict, n_envs: int = 1,
                 n_cpus: int = 0, verbose: int = 0, config: dict,
-                worker_timeout: float = 600.0) -> dict:
+                worker_timeout: float = 600.0, curriculum=None, bc: dict | None = None) -> dict:
     """The multi-agent part of :func:`mimo_social.train.runner.train` (arguments checked there).
     ``eval_every=None``: the budgeted schedule. ``n_envs``: worlds (shared mode) or envs of
     the one learner (scripted mode), in ``n_cpus`` spawned worker processes (0: in this
-    process); the independent mode steps one world."""
+    process); the independent mode steps one world. ``curriculum`` and ``bc`` (scripted mode,
+    checked by the runner): as :func:`~mimo_social.train.single.train_single`'s; the
+    evaluations run on the curriculum's last stage."""
     mode = check_mode(task, mode)
     from .hyperparams import to_json
 
@@ -91,8 +94,9 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
     # scripted: the learner's observations as make_env gives them (images for the CNN); shared
     # and independent: flat (the runner says so in config["observation"])
     observation = dict(config.get("observation", {"flat": mode != "scripted"}))
+    final_kwargs = env_kwargs if curriculum is None else curriculum.stages[-1].kwargs(env_kwargs)
     eval_env = (make_scripted_env if mode == "scripted" else make_parallel_env)(
-        task, **observation, **env_kwargs)
+        task, **observation, **final_kwargs)
     if mode == "shared":
         try:
             check_shared_spaces(eval_env, task)
@@ -140,7 +144,7 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
                                                      env_kwargs, steps, seed, out, eval_env,
                                                      eval_seed, schedule, bar, t0, verbose,
                                                      n_envs, n_cpus, worker_timeout, stop,
-                                                     config)
+                                                     config, curriculum, bc)
     finally:
         eval_env.close()
         if bar is not None:
@@ -159,8 +163,9 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
 
 def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, steps, seed, out,
                       eval_env, eval_seed, schedule, bar, t0, verbose, n_envs, n_cpus,
-                      worker_timeout, stop, config):
-    """shared (one policy, one VecEnv slot per agent) and scripted (one learner) modes."""
+                      worker_timeout, stop, config, curriculum=None, bc=None):
+    """shared (one policy, one VecEnv slot per agent) and scripted (one learner) modes; the
+    scripted mode takes a ``curriculum`` and a warm start (``bc``)."""
     from stable_baselines3.common.vec_env import VecMonitor
 
     agents = list(eval_env.possible_agents)
@@ -179,12 +184,15 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
         per_env_step = len(agents)
     else:
         from .workers import one_learner_vec_env
-        venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs),
-                                                     config.get("observation")),
-                                   int(n_envs), worker_timeout, n_workers=int(n_cpus))
+        env_fn = (functools.partial(monitored_env, task, dict(env_kwargs),
+                                    config.get("observation")) if curriculum is None else
+                  functools.partial(monitored_curriculum_env, task, config.get("observation"),
+                                    curriculum.plan(env_kwargs)))
+        venv = one_learner_vec_env(env_fn, int(n_envs), worker_timeout, n_workers=int(n_cpus))
         per_env_step = 1
     try:
         venv, model, save = build_model(cls, algo, venv, config, algo_kwargs, seed, verbose)
+        control = curriculum_controller(curriculum, venv, None, config, out)
         planned, note = rounding_note(model, algo, steps, per_env_step)
         if note:
             warn(note)
@@ -204,8 +212,21 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
 
         log = RunLog(out, agents, evaluate, lambda: save(out / "best_model.zip"), t0, bar,
                      schedule, eval_seed)
+        if control is not None:
+            control.t_start = log.t_start
+            log.columns.append(control.columns)
+        if bc is not None:   # on the learner's Gymnasium env, with the evaluated stage's kwargs
+            demo_env = make_env(task, **config.get("observation", {}),
+                                **(env_kwargs if curriculum is None
+                                   else curriculum.stages[-1].kwargs(env_kwargs)))
+            try:
+                warm_start_run(model, task, demo_env, bc, seed, config, out, log,
+                               schedule.episodes)
+            finally:
+                demo_env.close()
         try:
-            cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop)
+            cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop,
+                              on_step=None if control is None else control.on_step)
             learn_and_finish(model, steps, per_env_step, cb, stop, save, out, schedule,
                              checkpoint, bar, log)
         finally:

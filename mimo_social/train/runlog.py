@@ -184,6 +184,8 @@ class RunLog:
         self._evaluate, self._save_best = evaluate, save_best
         self.t_start, self.bar, self.schedule, self.eval_seed = t_start, bar, schedule, eval_seed
         self.rows: list[dict] = []
+        #: functions giving further columns of every progress row (e.g. a curriculum's stage)
+        self.columns: list[Callable[[], dict]] = []
         self.best = -math.inf
         self.train_returns: list[float] = []
         self.eval_steps = 0
@@ -210,12 +212,15 @@ class RunLog:
             return int(np.sum(np.max(per, axis=0)))
         return int(np.sum(res["lengths"]))
 
-    def evaluate(self, n: int, episodes: int) -> dict:
+    def evaluate(self, n: int, episodes: int, budget: bool = True) -> dict:
+        """One evaluation row at env step ``n``; ``budget=False``: its steps are not taken from
+        the schedule's evaluation budget (an evaluation outside the schedule, e.g. right after a
+        behaviour-cloning warm start)."""
         det = self._evaluate(episodes, True)
         sto = self._stochastic(episodes)
         steps = self._env_steps(det) + self._env_steps(sto)
         self.eval_steps += steps
-        if self.schedule is not None:
+        if self.schedule is not None and budget:
             self.schedule.spend(steps)
         row = {"timesteps": n, "wall_time_s": round(time.perf_counter() - self.t_start, 2),
                "eval_return_mean": det["return_mean"], "eval_return_std": det["return_std"],
@@ -231,6 +236,8 @@ class RunLog:
         if "agents" in det:
             row.update(agent_columns(det))
             row.update(agent_columns(sto, suffix="_stochastic"))
+        for extra in self.columns:
+            row.update(extra())
         self.train_returns = []
         self.rows.append(row)
         if det["return_mean"] > self.best:
@@ -259,7 +266,7 @@ class RunLog:
 
 def sb3_callback(log: RunLog, schedule: Schedule, slot_agents: list[str] | None,
                  per_env_step: int, save_checkpoint: Callable[[int], None], stop=None,
-                 update_threads: int = 1):
+                 update_threads: int = 1, on_step: Callable[[int, list], None] | None = None):
     """SB3 callback of the one-learner, scripted and shared modes: episodes (by slot: agent
     ``slot_agents[i % len]``), evaluations, checkpoints, and a stop when ``stop.requested``
     (:class:`~.interrupt.StopSignals`). ``per_env_step``: SB3 timesteps per environment step
@@ -267,7 +274,9 @@ def sb3_callback(log: RunLog, schedule: Schedule, slot_agents: list[str] | None,
     one thread while the envs step (the workers have the other cores) and on
     ``update_threads`` (default 1) for the update in between. The runs keep 1: on the 2-core
     machine under load, PPO's update of reach's 64x64 MLP (320 minibatches of 64) took 4-10 s
-    on one thread and 89-219 s on two (threads spinning against the other processes)."""
+    on one thread and 89-219 s on two (threads spinning against the other processes).
+    ``on_step(n, infos)``: after each vector step's episodes are logged, before a checkpoint or
+    evaluation (a curriculum's :meth:`~.curriculum.CurriculumController.on_step`)."""
     import torch
     from stable_baselines3.common.callbacks import BaseCallback
 
@@ -288,6 +297,8 @@ def sb3_callback(log: RunLog, schedule: Schedule, slot_agents: list[str] | None,
                 if ep is not None:
                     agent = slot_agents[i % len(slot_agents)] if slot_agents else None
                     log.episode(n, agent, float(ep["r"]), int(ep["l"]), info.get("is_success"))
+            if on_step is not None:
+                on_step(n, self.locals.get("infos", ()))
             if log.bar is not None:
                 log.bar.update(n - log.bar.n)
             if stop is not None and stop.requested:

@@ -58,7 +58,9 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           algo_kwargs: Mapping[str, Any] | None = None, verbose: int = 0,
           mode: str | None = None, n_envs: int | None = None, n_cpus: int | None = None,
           normalize_obs: bool | None = None, flat_obs: bool = False, frame_stack: int = 1,
-          worker_timeout: float = 600.0, normalize_reward: bool = False) -> dict:
+          worker_timeout: float = 600.0, normalize_reward: bool = False,
+          curriculum=None, bc_episodes: int = 0, bc_epochs: int = 20,
+          bc_kwargs: Mapping[str, Any] | None = None) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
     time). See the module docstring for what it writes.
 
@@ -78,7 +80,12 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     ``normalize_reward``: the learner's rewards scaled by SB3's ``VecNormalize`` (a running
     estimate of the discounted return's spread, with the algorithm's ``gamma``; observations
     untouched: ``normalize_obs`` does that inside the policy), its statistics saved next to
-    every model (one learner, ``scripted`` and ``shared``; not ``independent``)."""
+    every model (one learner, ``scripted`` and ``shared``; not ``independent``).
+    ``curriculum`` (one learner): a shipped curriculum's name, a .toml / .json file or a dict
+    (:mod:`mimo_social.train.curriculum`); ``bc_episodes`` (one learner): scripted episodes
+    cloned into the policy for ``bc_epochs`` epochs before any RL step, ``bc_kwargs`` the
+    other settings (:mod:`mimo_social.train.demonstrations`); both checked before anything is
+    written."""
     from .hyperparams import resolve, run_options, to_json, to_sb3
 
     mode = check_mode(task, mode)
@@ -116,6 +123,13 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
         raise TrainInputError(f"n_cpus={n_cpus!r}; allowed: 0 (every env in this process) to "
                               f"n_envs={n_envs} (worker processes, each stepping a block of "
                               "the envs)")
+    # a curriculum (every stage's env made once) and the warm start: checked before anything
+    from .curriculum import prepare_curriculum
+    from .demonstrations import check_bc
+    bc = check_bc(task, algo, mode, bc_episodes, bc_epochs, bc_kwargs)
+    cur = prepare_curriculum(curriculum, task, mode, {
+        "flat": bool(flat_obs) or mode in ("shared", "independent"),
+        "frame_stack": int(frame_stack)}, dict(env_kwargs or {}))
     import torch
 
     eval_every = int(eval_every) if eval_every else None
@@ -136,14 +150,17 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
               "algo_kwargs_provenance": provenance, "eval_every": eval_every,
               "eval_episodes": eval_episodes, "checkpoint_every": checkpoint_every,
               "algo_kwargs_given": sorted(algo_kwargs or {})}
+    if bc is not None:
+        config["bc"] = dict(bc)
+    extra = {} if cur is None and bc is None else {"curriculum": cur, "bc": bc}
     if mode is not None:
         return train_multi(task, algo, steps, seed, out, mode=mode, eval_every=eval_every,
                            eval_episodes=eval_episodes, checkpoint_every=checkpoint_every,
                            progress=progress, env_kwargs=env_kwargs, algo_kwargs=kwargs,
                            n_envs=int(n_envs), n_cpus=int(n_cpus), verbose=verbose,
-                           config=config, worker_timeout=float(worker_timeout))
+                           config=config, worker_timeout=float(worker_timeout), **extra)
     return train_single(cls, task, steps, seed, out, eval_every=eval_every,
                         eval_episodes=eval_episodes, checkpoint_every=checkpoint_every,
                         progress=progress, env_kwargs=env_kwargs, algo_kwargs=kwargs,
                         verbose=verbose, config=config, n_envs=int(n_envs),
-                        n_cpus=int(n_cpus), worker_timeout=float(worker_timeout))
+                        n_cpus=int(n_cpus), worker_timeout=float(worker_timeout), **extra)

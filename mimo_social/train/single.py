@@ -13,6 +13,9 @@ SIGINT / SIGTERM stop the run between two steps: it is saved as it stands
 ``--normalize-reward``: the learner's envs in SB3's ``VecNormalize`` (rewards only,
 :func:`reward_normalizer`), its statistics saved next to every model (:func:`model_saver`); the
 episodes logged and the evaluations (a separate, unwrapped env) are the env's own returns.
+``--curriculum`` (env options by stage, :mod:`~mimo_social.train.curriculum`) and
+``--bc-episodes`` (a warm start cloned from the scripted controller before any RL step,
+:mod:`~mimo_social.train.demonstrations`) are this path's and ``--mode scripted``'s.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import sys
 import time
 from pathlib import Path
 
+from .curriculum import CurriculumController, curriculum_envs
 from .envs import make_env
 from .interrupt import StopSignals
 from .progress import write_config
@@ -141,12 +145,39 @@ def learn_and_finish(model, steps: int, per_env_step: int, callback, stop, save,
     return n
 
 
+def curriculum_controller(curriculum, venv, eval_env, config: dict, out: Path):
+    """The :class:`~mimo_social.train.curriculum.CurriculumController` of a run (None without
+    a curriculum): it rewrites config.json and says so on stderr at every stage change."""
+    if curriculum is None:
+        return None
+    return CurriculumController(curriculum, venv, eval_env, config,
+                                lambda: write_config(out, config), warn)
+
+
+def warm_start_run(model, task: str, env, bc: dict, seed: int, config: dict, out: Path, log,
+                   eval_episodes: int) -> None:
+    """The behaviour-cloning warm start of a run before any RL step (on ``env``, the learner's
+    Gymnasium env), recorded in ``config["bc"]``, then an evaluation (progress row 0)."""
+    from .demonstrations import evaluate_after_bc, warm_start
+    config["bc"] = warm_start(model, task, env, bc, seed)
+    b = config["bc"]
+    rate = "n/a" if b["success_rate"] is None else f"{b['success_rate']:.0%}"
+    warn(f"behaviour cloning: {b['episodes']} episodes of {b['controller']} (success {rate}, "
+         f"{b['samples']} pairs), {b['epochs']} epochs: {b['loss']} loss {b['loss_before']:.4g}"
+         f" -> {b['loss_after']:.4g}")
+    evaluate_after_bc(log, eval_episodes)
+    write_config(out, config)
+
+
 def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every: int | None,
                  eval_episodes: int, checkpoint_every: int, progress: bool, env_kwargs: dict,
                  algo_kwargs: dict, verbose: int, config: dict, n_envs: int = 1,
-                 n_cpus: int = 0, worker_timeout: float = 600.0) -> dict:
+                 n_cpus: int = 0, worker_timeout: float = 600.0, curriculum=None,
+                 bc: dict | None = None) -> dict:
     """The one-learner part of :func:`mimo_social.train.runner.train` (arguments checked
-    there); ``cls`` is the SB3 algorithm class. ``eval_every=None``: the budgeted schedule."""
+    there); ``cls`` is the SB3 algorithm class. ``eval_every=None``: the budgeted schedule.
+    ``curriculum``: a checked :class:`~mimo_social.train.curriculum.Curriculum`; ``bc``: the
+    warm start's settings (:func:`~mimo_social.train.demonstrations.check_bc`)."""
     from .hyperparams import to_json     # (torch: not imported by the workers, which import
     from .workers import one_learner_vec_env     # this module for monitored_env)
 
@@ -158,13 +189,16 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
     config.update({"algo_kwargs": to_json(algo_kwargs), "n_envs": int(n_envs),
                    "n_cpus": int(n_cpus), "worker_timeout": float(worker_timeout)})
     observation = dict(config.get("observation", {}))
-    eval_env = make_env(task, **observation, **env_kwargs)
-    venv = one_learner_vec_env(functools.partial(monitored_env, task, dict(env_kwargs),
-                                                 observation), int(n_envs), worker_timeout,
-                               n_workers=int(n_cpus))
+    if curriculum is None:
+        eval_env = make_env(task, **observation, **env_kwargs)
+        env_fn = functools.partial(monitored_env, task, dict(env_kwargs), observation)
+    else:
+        eval_env, env_fn = curriculum_envs(curriculum, task, observation, env_kwargs)
+    venv = one_learner_vec_env(env_fn, int(n_envs), worker_timeout, n_workers=int(n_cpus))
     stop = StopSignals()
     try:
         venv, model, save = build_model(cls, algo, venv, config, algo_kwargs, seed, verbose)
+        control = curriculum_controller(curriculum, venv, eval_env, config, out)
         planned, note = rounding_note(model, algo, steps)
         if note:
             warn(note)
@@ -181,6 +215,11 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
                      lambda k, det: evaluate_policy(model, eval_env, k, eval_seed, det),
                      lambda: save(out / "best_model.zip"), time.perf_counter(), bar,
                      schedule, eval_seed)
+        if control is not None:
+            control.t_start = log.t_start
+            log.columns.append(control.columns)
+        if bc is not None:
+            warm_start_run(model, task, eval_env, bc, seed, config, out, log, eval_episodes)
 
         def checkpoint(n):
             (out / "checkpoints").mkdir(exist_ok=True)
@@ -189,7 +228,8 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         t0 = log.t_start
         try:
             with stop:
-                cb = sb3_callback(log, schedule, None, 1, checkpoint, stop)
+                cb = sb3_callback(log, schedule, None, 1, checkpoint, stop,
+                                  on_step=None if control is None else control.on_step)
                 learn_and_finish(model, steps, 1, cb, stop, save, out, schedule, checkpoint,
                                  bar, log)
         finally:

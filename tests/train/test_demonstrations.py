@@ -1,0 +1,150 @@
+"""Demonstrations and the behaviour-cloning warm start (issue 30,
+mimo_social/train/demonstrations.py): the controller's actions in the learner's form, a cloned
+policy that beats an untrained one before any RL step, expression actions, SAC, the run's
+records, and bad arguments refused before anything is written."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import numpy as np
+import pytest
+import torch
+from gymnasium import spaces
+
+from mimo_social.core.wrappers import ActionDecoder
+from mimo_social.train import TrainInputError, train
+from mimo_social.train.demonstrations import clone, record_demonstrations
+from mimo_social.train.envs import make_env
+from mimo_social.train.rollouts import evaluate_policy
+
+torch.set_num_threads(1)
+
+
+def test_encode_is_the_decoder_s_inverse():
+    box = ActionDecoder(spaces.Box(-1, 1, (3,), np.float32))
+    a = np.array([0.5, -0.25, 1.0], np.float32)
+    assert np.array_equal(box(box.encode(a)), a)
+    both = ActionDecoder(spaces.Dict({"motors": spaces.Box(-1, 1, (2,), np.float32),
+                                      "expression": spaces.Discrete(7)}))
+    flat = both.encode({"motors": np.array([0.1, -0.9], np.float32), "expression": 4})
+    assert flat.shape == both.space.shape and both.space.contains(flat)
+    assert flat[2:].tolist() == [-1, -1, -1, -1, 1, -1, -1]
+    back = both(flat)
+    assert back["expression"] == 4 and np.allclose(back["motors"], [0.1, -0.9])
+    face = ActionDecoder(spaces.Dict({"motors": spaces.Box(-1, 1, (0,), np.float32),
+                                      "expression": spaces.Discrete(7)}))
+    assert face.encode({"motors": np.zeros(0), "expression": 3}) == 3
+    assert face(3)["expression"] == 3
+
+
+def test_a_cloned_policy_beats_an_untrained_one_before_any_rl_step():
+    """Reach: 30 controller episodes cloned into PPO's policy; the mean action then succeeds
+    and returns clearly more than the untrained policy on 10 seeded episodes."""
+    from stable_baselines3 import PPO
+    env = make_env("reach", flat=True)
+    try:
+        demos = record_demonstrations("reach", env, 30, 20_000)
+        assert demos.summary()["success_rate"] == 1.0
+        assert demos.obs.shape == (len(demos), env.observation_space.shape[0])
+        assert demos.actions.shape == (len(demos), 8)
+        model = PPO("MlpPolicy", env, seed=0, device="cpu")
+        untrained = evaluate_policy(model, env, 10, 10_000, True)
+        res = clone(model, demos, 30, seed=0)
+        assert res["loss_after"] < res["loss_before"] / 5
+        cloned = evaluate_policy(model, env, 10, 10_000, True)
+    finally:
+        env.close()
+    assert untrained["success_rate"] == 0.0
+    assert cloned["success_rate"] >= 0.3
+    assert cloned["return_mean"] > untrained["return_mean"] + 100
+
+
+def test_expression_actions_are_cloned_as_logits_and_as_a_choice():
+    from stable_baselines3 import PPO
+    # high five: a Box of 8 motors and 7 expression logits
+    env = make_env("high_five", flat=True, max_steps=40)
+    try:
+        demos = record_demonstrations("high_five", env, 2, 20_000)
+        logits = demos.actions[:, 8:]
+        assert demos.actions.shape[1] == 15
+        assert set(np.unique(logits)) <= {-1.0, 1.0} and (logits == 1).sum(axis=1).tolist() == \
+            [1] * len(demos)
+        model = PPO("MlpPolicy", env, seed=0, device="cpu")
+        res = clone(model, demos, 40, seed=0)
+        assert res["loss"] == "mse" and res["loss_after"] < res["loss_before"] / 3
+        act = model.predict(demos.obs, deterministic=True)[0]
+        assert np.mean(act[:, 8:].argmax(1) == logits.argmax(1)) >= 0.9
+    finally:
+        env.close()
+    # mirror: a face-only learner, a Discrete expression (cross-entropy)
+    env = make_env("mirror", flat=True, max_steps=40)
+    try:
+        demos = record_demonstrations("mirror", env, 2, 20_000)
+        assert demos.actions.dtype.kind == "i" and demos.actions.ndim == 1
+        model = PPO("MlpPolicy", env, seed=0, device="cpu")
+        res = clone(model, demos, 40, seed=0)
+        assert res["loss"] == "cross-entropy" and res["loss_after"] < res["loss_before"] / 3
+        act = model.predict(demos.obs, deterministic=True)[0]
+        assert np.mean(act == demos.actions) >= 0.9
+    finally:
+        env.close()
+
+
+def test_sac_s_actor_and_the_log_std_after_cloning():
+    from stable_baselines3 import PPO, SAC
+    env = make_env("reach", flat=True)
+    try:
+        demos = record_demonstrations("reach", env, 5, 20_000)
+        sac = SAC("MlpPolicy", env, seed=0, device="cpu", buffer_size=1000)
+        res = clone(sac, demos, 20, seed=0)
+        assert res["loss_after"] < res["loss_before"] / 3
+        ppo = PPO("MlpPolicy", env, seed=0, device="cpu")
+        clone(ppo, demos, 1, seed=0, log_std=-1.5)
+        assert torch.allclose(ppo.policy.log_std, torch.full_like(ppo.policy.log_std, -1.5))
+        nll = clone(PPO("MlpPolicy", env, seed=0, device="cpu"), demos, 5, loss="nll")
+        assert nll["loss"] == "nll" and nll["loss_after"] < nll["loss_before"]
+    finally:
+        env.close()
+
+
+def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_path, capfd):
+    out = tmp_path / "run"
+    train("reach", "ppo", 512, 0, out, progress=False, n_envs=2, n_cpus=0, eval_episodes=2,
+          algo_kwargs={"n_steps": 256, "n_epochs": 1, "batch_size": 512},
+          env_kwargs={"max_steps": 100}, bc_episodes=6, bc_epochs=3,
+          bc_kwargs={"log_std": -1.0, "batch_size": 32})
+    bc = json.loads((out / "config.json").read_text())["bc"]
+    assert bc["episodes"] == 6 and bc["seeds"] == [20_000, 20_005] and bc["epochs"] == 3
+    assert bc["success_rate"] == 1.0 and bc["controller"] == "ReachController"
+    assert bc["loss_after"] < bc["loss_before"] and bc["log_std"] == -1.0
+    assert bc["batch_size"] == 32 and bc["samples"] > 0
+    with open(out / "progress.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert rows[0]["timesteps"] == "0" and rows[0]["before_rl"] == "1"
+    assert len(rows) >= 2 and all(r["before_rl"] == "0" for r in rows[1:])
+    assert "behaviour cloning: 6 episodes of ReachController" in capfd.readouterr().err
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"bc_episodes": -1}, ["bc_episodes=-1", "integer >= 0"]),
+    ({"bc_episodes": 2, "bc_epochs": 0}, ["bc_epochs=0", "integer >= 1"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"lr": 0}}, ["lr=0", "number > 0"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"epoch": 3}}, ["epoch", "batch_size, lr, loss, log_std"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"loss": "l1"}}, ["loss='l1'", "mse, nll"]),
+    ({"bc_episodes": 0, "bc_kwargs": {"lr": 0.1}}, ["without bc_episodes"]),
+    ({"bc_episodes": 2, "algo": "sac", "bc_kwargs": {"loss": "nll"}}, ["with sac: mse"]),
+    ({"bc_episodes": 2, "algo": "sac", "bc_kwargs": {"log_std": -1}}, ["log_std=-1", "ppo"]),
+    ({"bc_episodes": 2, "algo": "recurrent_ppo"}, ["recurrent_ppo", "ppo, sac"]),
+    ({"bc_episodes": 2, "task": "high_five"}, ["--mode shared", "one learner"]),
+])
+def test_bad_arguments_are_refused_before_anything_is_written(tmp_path, kwargs, words):
+    kwargs = dict(kwargs)
+    task, algo = kwargs.pop("task", "reach"), kwargs.pop("algo", "ppo")
+    out = tmp_path / "run"
+    with pytest.raises(TrainInputError) as info:
+        train(task, algo, 100, 0, out, progress=False, **kwargs)
+    for w in words:
+        assert w in str(info.value), (w, str(info.value))
+    assert not out.exists()
