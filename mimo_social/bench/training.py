@@ -58,7 +58,7 @@ DEFAULT_WORKERS = (1, 2)
 TARGETS = {"reach": 0.60, "high_five": 0.60, "mirror": 0.40}
 TARGET_WORKERS = 2
 #: the envs per worker the targets are read at: ``train``'s default
-TARGET_ENVS_PER_WORKER = 4
+TARGET_ENVS_PER_WORKER = 1
 #: untimed vector steps of the env alone after its reset
 ENV_WARMUP = 10
 
@@ -296,8 +296,9 @@ def markdown(results: dict) -> str:
         for t in met:
             verdict = ("not measured" if t["met"] is None
                        else f"{t['ratio']:.0%}: {'met' if t['met'] else 'NOT met'}")
-            text.append(f"- `{t['task']}`, {t['workers']} workers x {t['envs_per_worker']} "
-                        "envs: target >= "
+            k = t["envs_per_worker"]
+            text.append(f"- `{t['task']}`, {t['workers']} workers x {k} "
+                        f"env{'s' if k > 1 else ''}: target >= "
                         f"{t['wanted']:.0%} of the env alone; {verdict}")
     if results.get("command"):
         text += ["", "```", results["command"], "```"]

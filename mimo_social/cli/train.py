@@ -355,8 +355,8 @@ def add_parser(subparsers) -> None:
     p.add_argument("--n-envs", type=positive_int, default=None, help="envs stepped together "
                    "(one learner: one-agent tasks, --mode scripted) or worlds (--mode shared: "
                    "one VecEnv slot per agent of each; --mode independent: each agent's model "
-                   "a slot per world), in --n-cpus worker processes. Default: 4 per CPU core "
-                   "(8 on 2 cores)")
+                   "a slot per world), in --n-cpus worker processes. Default: one per CPU "
+                   "core (more per worker: faster, but PPO learnt reach less per step)")
     p.add_argument("--flat-obs", action="store_true", help="a learner with eyes sees one flat "
                    "vector (its images flattened, an MLP) instead of its images through the "
                    "CNN (docs/training_vision.md)")

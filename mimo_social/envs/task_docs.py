@@ -93,8 +93,8 @@ mimo-social compare --task standup --algos ppo,sac --seeds 3 --steps 60000 --out
 `train` uses the hyperparameters shipped for the task and algorithm
 (`mimo_social/train/hyperparams/*.toml`, docs/hyperparameters.md: Stable-Baselines3's defaults
 unless a measurement here says otherwise, each value with its provenance; `--algo-kwargs`
-overrides them key by key and every key is checked before anything runs), CPU, 4 envs per core
-in one worker process per core (`--n-envs`, `--n-cpus`; docs/training.md). A learner with eyes sees its images through a
+overrides them key by key and every key is checked before anything runs), CPU, one env per core,
+each in its own worker process (`--n-envs`, `--n-cpus`; docs/training.md). A learner with eyes sees its images through a
 CNN (docs/training_vision.md; `--flat-obs` for the flat MLP). It shows a progress bar, evaluates
 the deterministic and the sampled policy on a separate env within an evaluation budget (at most
 ~10 % of the training steps, none before the first update; `--eval-every` for fixed intervals;

@@ -67,7 +67,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     ``mode`` (``shared``, ``independent``, ``scripted``; default ``shared``) is for the
     multi-agent tasks (:mod:`mimo_social.train.multi`). ``n_envs``: envs stepped together (one
     learner, ``scripted``) or worlds (``shared``, ``independent``); default
-    :func:`~mimo_social.train.workers.default_n_envs` (4 per core). ``n_cpus``: the spawned
+    :func:`~mimo_social.train.workers.default_n_envs` (one per core). ``n_cpus``: the spawned
     worker processes that step them (each a contiguous block, one after the other); default one
     per core, at most one per env; 0: all in this process. ``eval_every=None``: the budgeted
     evaluation schedule

@@ -109,7 +109,7 @@ def test_the_runner_refuses_more_worker_processes_than_envs(tmp_path):
     assert not (tmp_path / "run").exists()
 
 
-def test_a_run_steps_four_envs_per_core_by_default(tmp_path):
+def test_a_run_steps_one_env_per_core_by_default(tmp_path):
     import json
 
     from mimo_social.train import train
@@ -117,6 +117,6 @@ def test_a_run_steps_four_envs_per_core_by_default(tmp_path):
     res = train("reach", "ppo", 64, 0, tmp_path, progress=False, env_kwargs=SHORT,
                 algo_kwargs={"n_epochs": 1})
     config = json.loads((tmp_path / "config.json").read_text())
-    assert config["n_envs"] == default_n_envs() == 4 * default_workers(10**6)
+    assert config["n_envs"] == default_n_envs() == default_workers(10**6)
     assert config["n_cpus"] == default_workers(config["n_envs"])
     assert res["timesteps"] >= 64
