@@ -120,7 +120,9 @@ def _engine_conflicts(args) -> str | None:
                              ("--curriculum", "curriculum", None),
                              ("--bc-episodes", "bc_episodes", None),
                              ("--bc-epochs", "bc_epochs", None),
-                             ("--bc-kwargs", "bc_kwargs", None))
+                             ("--bc-kwargs", "bc_kwargs", None),
+                             ("--intrinsic", "intrinsic", None),
+                             ("--intrinsic-kwargs", "intrinsic_kwargs", None))
            if given(k, d) and (k != "algo" or args.algo == "recurrent_ppo")]
     if bad:
         return f"{', '.join(bad)}: for --engine sb3 (the default engine)"
@@ -158,6 +160,10 @@ def _sb3_train_kwargs(args) -> dict:
     for key in ("curriculum", "bc_episodes", "bc_epochs", "bc_kwargs"):
         if getattr(args, key, None) is not None:
             kw[key] = getattr(args, key)
+    if getattr(args, "intrinsic", None) is not None:
+        kw["intrinsic"] = {"kind": args.intrinsic, **(args.intrinsic_kwargs or {})}
+    elif getattr(args, "intrinsic_kwargs", None) is not None:
+        kw["intrinsic"] = dict(args.intrinsic_kwargs)    # (refused: no kind)
     return kw
 
 
@@ -386,6 +392,12 @@ def add_parser(subparsers) -> None:
     c.add_argument("--bc-kwargs", type=json_object, default=None,
                    help="JSON settings of the warm start: batch_size (64), lr (1e-3), loss "
                    "(mse or nll), log_std (PPO: the log-std after cloning)")
+    c.add_argument("--intrinsic", choices=("rnd",), default=None,
+                   help="an intrinsic novelty bonus added to the learner's rewards: rnd "
+                   "(random network distillation; not --mode independent)")
+    c.add_argument("--intrinsic-kwargs", type=json_object, default=None,
+                   help='JSON settings of the bonus: coef (0.01), extrinsic (1.0; 0: a '
+                   'reward-free run), lr (1e-3), hidden (64), seed (the run\'s)')
     g = p.add_argument_group("RLlib engine (--engine rllib; needs the rllib extra)")
     g.add_argument("--engine", choices=("sb3", "rllib"), default="sb3",
                    help="sb3 (Stable-Baselines3, the default) or rllib (RLlib on Ray)")

@@ -59,7 +59,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           mode: str | None = None, n_envs: int | None = None, n_cpus: int | None = None,
           normalize_obs: bool | None = None, flat_obs: bool = False, frame_stack: int = 1,
           worker_timeout: float = 600.0, normalize_reward: bool = False,
-          curriculum=None, bc_episodes: int = 0, bc_epochs: int = 20,
+          curriculum=None, bc_episodes: int = 0, bc_epochs: int = 20, intrinsic=None,
           bc_kwargs: Mapping[str, Any] | None = None) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
     time). See the module docstring for what it writes.
@@ -85,7 +85,9 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     (:mod:`mimo_social.train.curriculum`); ``bc_episodes`` (one learner): scripted episodes
     cloned into the policy for ``bc_epochs`` epochs before any RL step, ``bc_kwargs`` the
     other settings (:mod:`mimo_social.train.demonstrations`); both checked before anything is
-    written."""
+    written. ``intrinsic`` (None, ``"rnd"`` or a settings mapping; not ``independent``): an RND
+    novelty bonus added to the learner's rewards (:mod:`mimo_social.train.intrinsic`; with
+    ``{"extrinsic": 0}`` a reward-free run)."""
     from .hyperparams import resolve, run_options, to_json, to_sb3
 
     mode = check_mode(task, mode)
@@ -123,6 +125,14 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
         raise TrainInputError(f"n_cpus={n_cpus!r}; allowed: 0 (every env in this process) to "
                               f"n_envs={n_envs} (worker processes, each stepping a block of "
                               "the envs)")
+    from .intrinsic import check_intrinsic
+    try:
+        intrinsic = check_intrinsic(intrinsic, seed)
+    except ValueError as e:
+        raise TrainInputError(str(e)) from None
+    if intrinsic is not None and mode == "independent":
+        raise TrainInputError("intrinsic: an intrinsic bonus is for one learner (a one-agent "
+                              "task, --mode scripted) and --mode shared, not --mode independent")
     # a curriculum (every stage's env made once) and the warm start: checked before anything
     from .curriculum import prepare_curriculum
     from .demonstrations import check_bc
@@ -152,6 +162,8 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
               "algo_kwargs_given": sorted(algo_kwargs or {})}
     if bc is not None:
         config["bc"] = dict(bc)
+    if intrinsic is not None:
+        config["intrinsic"] = intrinsic
     extra = {} if cur is None and bc is None else {"curriculum": cur, "bc": bc}
     if mode is not None:
         return train_multi(task, algo, steps, seed, out, mode=mode, eval_every=eval_every,

@@ -111,12 +111,17 @@ def finish_config(config: dict, wall: float, timesteps: int, stop: StopSignals,
 def build_model(cls, algo: str, venv, config: dict, algo_kwargs: dict, seed: int,
                 verbose: int):
     """The SB3 model of one policy on ``venv`` (one learner, or the shared / scripted modes):
-    the rewards normalised when the run asks for it (:func:`reward_normalizer`), the policy
+    an intrinsic bonus added to the rewards when ``config["intrinsic"]`` asks for one
+    (:class:`~mimo_social.train.intrinsic.RNDBonus`), the rewards normalised when the run asks
+    for it (:func:`reward_normalizer`), the policy
     :func:`~mimo_social.train.encoders.policy_for` picks for the observation (recorded in
     ``config["policy"]``). Returns ``(venv, model, save)``: the env the model steps, the model
     and its :func:`model_saver`."""
     from .encoders import policy_for     # (torch: lazily, see train_single)
     from .tasks import RECURRENT_ALGOS
+    if config.get("intrinsic"):
+        from .intrinsic import RNDBonus
+        venv = RNDBonus(venv, config["intrinsic"])
     venv, normalizer = reward_normalizer(venv, config, algo_kwargs)
     policy, kw = policy_for(venv.observation_space, algo_kwargs,
                             bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS)
