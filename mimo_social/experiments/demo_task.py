@@ -10,10 +10,12 @@ the next episode is:
     reset: the receiver's right arm hanging (shifted at random, as in the handover), the giver's arm
         where the world starts it, the ball on the floor beside the giver
     success (``is_success`` in the infos): both right hands feel the other agent on their skin and
-        touch each other (as in :mod:`mimo_social.tasks.high_five`); the episode does not end
+        touch each other (as in :mod:`mimo_social.tasks.high_five` with ``success="touch"``); the
+        episode does not end
     scripted agents (:func:`phase_partners`): ``infant_0``:
-        :class:`~mimo_social.tasks.high_five.HighFiveController`; ``infant_1``:
-        ``HandOffer(grip=False, release=None, palm="forward")``
+        :class:`~mimo_social.tasks.high_five.HighFiveController` with the first versions' palm
+        goal (``palm="forward"``); ``infant_1``: ``HandOffer(grip=False, release=None,
+        palm="forward")``
 ``"handover"``:
     reset: the handover's own: the ball in the giver's palm, its fingers closed on it
     success (``is_success`` in the infos): the handover's (the receiver's hand holds the ball, the
@@ -157,6 +159,6 @@ def phase_partners(env, phase: str) -> dict:
     phase = check_choice("demo", "phase", phase, PHASES)
     receiver, giver = env.possible_agents
     if phase == "high_five":
-        return {receiver: HighFiveController(),
+        return {receiver: HighFiveController(palm="forward"),
                 giver: HandOffer(grip=False, release=None, palm="forward")}
     return {receiver: ReceiveController(), giver: scripted_giver(env.task.options)}

@@ -16,7 +16,10 @@ def _state(env):
 
 @pytest.mark.parametrize("kwargs, pattern", [
     ({"push": 0.5}, r"push=0.5"),
-    ({"palm": "down"}, r"palm='down'; allowed: \['up', 'forward', 'posture'\]"),
+    ({"palm": "down"}, r"palm='down'; allowed: \['partner', 'up', 'forward', 'posture'\]"),
+    ({"ready": (0.1, 0.0)}, r"ready=\(0.1, 0.0\); allowed: \(forward, left, up\)"),
+    ({"standoff": -1.0}, r"standoff=-1.0"),
+    ({"wait_steps": -1}, r"wait_steps=-1"),
     ({"replan_steps": 0}, r"replan_steps=0"),
     ({"frequency": -1.0}, r"frequency=-1.0"),
     ({"partner": 3}, r"partner=3; allowed: None or an agent's name"),
@@ -82,13 +85,16 @@ def test_mirror_controller_only_returns_the_partners_face():
         assert env.action_space("infant_0").contains(a) and a["expression"] == face
 
 
-@pytest.mark.parametrize("settings", [{"actuation": "muscle"}, {"hands": "five_fingers"},
-                                      {"task_options": {"distance": 0.45}}])
-def test_high_five_controller_other_bodies_and_actuation(settings):
-    """Muscles, five-fingered hands and the far distance of the first version: a high five
-    within 3 s from seed 1000's start."""
+@pytest.mark.parametrize("settings, controller", [
+    ({"actuation": "muscle"}, {}), ({"hands": "five_fingers"}, {}),
+    ({"task_options": {"distance": 0.4}}, {}),
+    # the far distance of the first version: its rule (any felt touch) and its palm goal
+    ({"task_options": {"distance": 0.45, "success": "touch"}}, {"palm": "forward"})])
+def test_high_five_controller_other_bodies_and_actuation(settings, controller):
+    """Muscles, five-fingered hands, the farthest distance of the palm rule (0.4 m) and the far
+    distance of the first version: a high five within 3 s from seed 1000's start."""
     env = high_five_v0.scripted_env(**settings)
-    c = HighFiveController()
+    c = HighFiveController(**controller)
     obs, _ = env.reset(seed=1000)
     c.reset(env.unwrapped, "infant_0", np.random.default_rng(0))
     for _ in range(300):

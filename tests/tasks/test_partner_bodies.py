@@ -201,12 +201,19 @@ def test_other_ages_meet_in_the_high_five(per_agent):
 
 def test_newborn_learner_meets_the_offered_hand_in_some_episodes():
     """A newborn (0 months) learner reaches the 18-month-old's offered hand at the edge of its
-    reach: 4 of seeds 0-5 (docs/bodies.md); here at least one of seeds 0-2."""
+    reach. Palm to palm (the high five's rule since issue 30) it meets the hand where the first
+    versions' partner offers it (``HandOffer(grip=False, release=None)``: 2 of seeds 0-2), not
+    at the default partner's midline offer, which for so small a learner the 18-month-old can
+    hold no lower than 8-10 cm above the newborn's shoulder, out of a palm-down reach (0 of 3);
+    with the first version's rule (``success="touch"``) it meets the default partner's."""
     per_agent = [{"age_months": 0}, {}]
     env = entry("high_five").parallel_env(per_agent=per_agent)
     assert cross_contacts(env.world) == 0
     env.close()
-    assert run_episodes("high_five", range(3), per_agent=per_agent) >= 1
+    first = HandOffer(grip=False, release=None)
+    assert run_episodes("high_five", range(3), per_agent=per_agent, partner=first) >= 1
+    assert run_episodes("high_five", range(3), per_agent=per_agent,
+                        task_options={"success": "touch"}) >= 1
 
 
 def test_reach_to_offers_any_body_at_the_others_reach():

@@ -57,7 +57,7 @@ def test_the_scripted_toucher_reaches_each_allowed_target_over_the_distance_rang
                                                                                   distance):
     info, _, _ = _episode(SocialTouchController(), 0,
                           task_options={"targets": social_touch.REACHABLE, "target": target,
-                                        "distance": distance})
+                                        "distance": distance, "distance_spread": 0.0})
     assert info["is_success"], info
 
 
@@ -80,9 +80,12 @@ def test_hacks_score_less_over_20_episodes():
         assert np.mean([_episode(hack, s)[1] for s in seeds]) < scripted - 50.0, hack
 
 
+FIXED_START = {"start_spread": 0.0, "partner_spread": 0.0, "distance_spread": 0.0}
+
+
 def test_a_given_target_overrides_the_task_s():
     info, _, _ = _episode(SocialTouchController(target="left_hand"), 1000,
-                          task_options={"target": "upper_body"})
+                          task_options={"target": "upper_body", **FIXED_START})
     assert set(info["first_touch"]) & {"left_hand", "left_fingers"}
     assert info["wrong_touch"] and not info["is_success"]
 

@@ -27,26 +27,49 @@ reward (both):
     with `shaping` (default): `-distance(right palms)` (m) per step (the reward reads the world; it
     is no observation); `+touch_bonus` (100) on a step of success
 success (`is_success`):
-    both right hands feel the partner: each agent's right-hand skin (hand or fingers) senses a force
-    whose source is the other agent, and the two right hands are in contact with each other. The
-    partner's forearm, body or left hand on one's hand does not count (the partner's right hand
-    feels nothing), nor do crossed arms (each right hand on the other's arm)
+    `success="palms"` (default, issue 30): the palms meet, palm side to palm side, and stay
+    together `hold_time` (0.1 s: 10 control steps in a row): each step the two right hands are in
+    contact, both right-hand skins feel the other agent, and one contact between the hands has its
+    normal, from each hand into the other, within 60 deg of that hand's palm normal (the palm and
+    the finger pads count; the back of the hand, its edges and the fingertips' ends do not); a
+    step without it starts the count again. `success="touch"` (the first versions' rule): any
+    contact of the two right hands that both skins feel, one step, any side of the hand. Neither
+    counts the partner's forearm, body or left hand on one's hand (the partner's right hand feels
+    nothing), nor crossed arms (each right hand on the other's arm). Why: under the first rule
+    random bang-bang actions (each motor at a bound, the side drawn every step or held 5 or 20
+    steps) met the partner's hand in 5 / 30, 20 / 30 and 20 / 30 episodes (the first versions'
+    partner) and 15, 25 and 27 / 30 (the default partner): brief slaps (1 step, up to 13 held),
+    at 0.4-5 m/s (the scripted hand: 0.03-0.6 m/s), with any part, the palms mostly facing the
+    same way (the back of one hand on the other); palm side to palm side those flails never lasted
+    5 steps
 termination:
     both, on success (if `end_on_touch`, default); truncation at `max_steps` (500 steps, 5 s)
 infos:
     `is_success`, `hands_touching` (the same, kept for older code), `hand_feels_partner` (this
-    agent's right-hand skin senses the other agent, on any of its parts), `hand_distance` (m), and
-    the skin's `touch` (who touches which part)
+    agent's right-hand skin senses the other agent, on any of its parts), `hand_distance` (m),
+    `palm_contact` (the palms meet this step, palm side to palm side), `palm_contact_time` (s:
+    how long they have, in a row), and the skin's `touch` (who touches which part)
 options:
-    `touch_bonus` (100.0), `end_on_touch` (True), `distance` (0.35 m, 0.25 to 0.6), `start_spread`
-    (0.3, 0 to 1; 0: the same start every episode), `assisted_gaze` (False), `shaping` (True)
+    `touch_bonus` (100.0), `end_on_touch` (True), `distance` (0.35 m, 0.25 to 0.4 with
+    `success="palms"`, to 0.6 with `"touch"`: farther apart the palms do not meet, the scripted high
+    five 10 / 10 at 0.25-0.4 m, 3 / 10 at 0.45 m, 0 / 10 at 0.5 m), `start_spread` (0.3, 0 to 1;
+    0: the same start every episode), `assisted_gaze` (False), `shaping` (True), `success`
+    (`"palms"`; `"touch"`: the first versions' rule), `hold_time` (0.1 s, 0 to 1: how long the
+    palms stay together; 0: one step)
 scripted partner:
-    `high_five_v0.scripted_env()`: `infant_1` is a `HandOffer` (holds its right hand out, fingers
-    open: `HandOffer(grip=False, release=None)`, palm up; `palm="forward"` for a palm facing the
-    learner). The learner's scripted solution: `HighFiveController`
-    (`mimo_social.tasks.high_five.controller`): reads the partner's palm from the world every 50 ms,
-    solves the arm posture that puts its palm there, facing forward (its fingertips where the palm
-    cannot reach), PD + gravity compensation through its own motors
+    `high_five_v0.scripted_env()`: `infant_1` is a `HandOffer` that holds its right hand out, palm
+    up, fingers open, at the midline between the infants (`HandOffer(grip=False, release=None,
+    reach_to=OFFER_AT)`, `OFFER_AT` = 0.195 m forward, 0.105 m left, 0.06 m down from the learner's
+    right shoulder, scaled with its arm; `palm="forward"` for a palm facing the learner; the first
+    versions' partner, `HandOffer(grip=False, release=None)`, holds it 15 cm to the learner's left,
+    where a palm facing down reaches it with the finger pads only). The learner's scripted
+    solution: `HighFiveController` (`mimo_social.tasks.high_five.controller`): reads the partner's
+    palm from the world every 50 ms; holds its hand ready in front of its shoulder until that palm
+    is still, then brings its palm over it, facing it, 4 cm off, then in along its normal, its
+    finger pads on the partner's palm (its fingertips on the partner's fingers where that is out of
+    reach), pressing 2 cm; IK on a scratch copy, PD + gravity compensation through its own motors
+    (`palm="forward"`: the first versions' controller). A flailing policy, for baselines:
+    `BangBang(hold)`
 privileged cues:
     `assisted_gaze` (False): the task points head and eyes at the partner's right hand every control
     step, so the hand's position reaches the learner as its own head and eye angles
@@ -54,28 +77,37 @@ privileged cues:
     observations do not change when only the partner's hand posture changes, until the hands touch
     (tested). The contact reaches the learner only through its skin
 baselines:
-    20 episodes, seeds 1000-1019, `scripted_env()` (partner `HandOffer`, palm up;
-    `docs/social/high_five.md` gives the script): random (uniform actions) 1 / 20 successes, return
-    -139.9 +- 46.6; zero action 0 / 20, -136.5 +- 5.0; scripted `HighFiveController` 20 / 20, 90.0
-    +- 2.6, 38.2 steps to the high five; hacks: `ArmSweep` (sweeps the arm across the front, blind)
-    20 / 20 but less return, 64.9 +- 0.9 (120 steps), a hand held still at the midpoint between the
-    infants (a `HandOffer` as the learner) 0 / 20, -63.5 +- 1.0. Partner palm forward
-    (`HandOffer(grip=False, release=None, palm="forward")`): random 0 / 20, -158.4 +- 11.2; zero 0 /
-    20, -143.2 +- 5.1; scripted 20 / 20, 88.6 +- 4.2, 48.8 steps; `ArmSweep` 0 / 20, -127.5 +- 0.9;
-    midpoint 0 / 20, -74.8 +- 0.9. PPO (SB3 defaults, 2 seeds each; deterministic evaluation, 10
-    episodes every 10k env steps): scripted partner, 60k env steps (7-9 min): seed 0 80 % at 20k, 90
-    % at 61k; seed 1 0 % until 30k, 80 % at 61k; on 20 fresh episodes (seeds 1000-1019) 20 / 20
-    (return 94.0 +- 0.8, 23 steps) and 19 / 20 (85.5 +- 38.5, 20 steps): the scripted level
-    (`mimo-social compare --task high_five --mode scripted --algos ppo --seeds 2 --steps 60000 --out
-    runs/high_five15_scripted --eval-every 10000 --eval-episodes 10`, then `mimo-social baselines
-    high_five --episodes 20 --seed 1000 --run runs/high_five15_scripted/ppo_seed0
-    runs/high_five15_scripted/ppo_seed1`). Shared-parameter PPO, two learners, 50k env steps (5-10
-    min): seed 0 100 % at 51k, seed 1 100 % from 30k; 20 fresh episodes: 100 % for both infants,
-    return 93.4 +- 1.0 (23 steps) and 90.1 +- 4.1 (78 steps) (`mimo-social compare --task high_five
-    --mode shared --algos ppo --seeds 2 --steps 50000 --out runs/high_five15_shared --eval-every
-    10000 --eval-episodes 10`, then `mimo-social eval runs/high_five15_shared/ppo_seed0 --episodes
-    20 --seed 1000`): the two learners agree on a meeting point without the cue; the first version
-    with it reached 100 % from 60k env steps (seed 0)
+    issue 30, 30 episodes, seeds 1000-1029, `scripted_env()` (the default partner, palm up at the
+    midline), success = palms held 0.1 s: random (uniform actions) 0 / 30, return -131.5 +- 12.1;
+    zero action 0 / 30, -131.2 +- 5.0; scripted `HighFiveController` 30 / 30, 78.7 +- 2.6, 117 steps
+    to the high five (`mimo-social baselines high_five --episodes 30 --seed 1000`); random bang-bang
+    (`BangBang`, every step / held 5 / held 20 steps) 0 / 30, -132.8 +- 10.1; 1 / 30, -119.0 +-
+    37.7; 1 / 30, -117.5 +- 23.9; hacks: `ArmSweep` (sweeps the arm across the front, blind) 0 / 30,
+    -96.9 +- 1.1; a hand held still at the midpoint between the infants (a `HandOffer` as the
+    learner) 0 / 30, -36.2 +- 1.3 (the script: `docs/social/high_five.md`). Partner palm forward
+    (`HandOffer(grip=False, release=None, palm="forward", reach_to=OFFER_AT)`): random 0 / 30,
+    -135.9 +- 11.9; zero 0 / 30, -134.0 +- 5.0; scripted 30 / 30, 76.6 +- 3.2, 125 steps; bang-bang
+    0 / 30 each (-136.0, -129.9, -123.9); `ArmSweep` 11 / 30, -39.5 +- 80.0; midpoint 0 / 30, -38.9
+    +- 1.4. The first versions' partner (`HandOffer(grip=False, release=None)`): scripted 30 / 30,
+    72.7 +- 2.8, 139 steps; random, zero, `ArmSweep`, midpoint 0 / 30; bang-bang 0, 0, 1 / 30. With
+    `success="touch"` and the default partner: scripted 30 / 30, random 5 / 30, bang-bang 15, 25, 27
+    / 30. Issue 15, the first versions' rule and partner, 20 episodes, seeds 1000-1019: random 1 /
+    20, -139.9 +- 46.6; zero 0 / 20; scripted 20 / 20, 90.0 +- 2.6, 38 steps; `ArmSweep` 20 / 20,
+    64.9 +- 0.9; PPO (not yet measured with the palm rule; SB3 defaults, 2 seeds each; deterministic
+    evaluation, 10 episodes every 10k env steps): scripted partner, 60k env steps (7-9 min): seed 0
+    80 % at 20k, 90 % at 61k; seed 1 0 % until 30k, 80 % at 61k; on 20 fresh episodes (seeds
+    1000-1019) 20 / 20 (return 94.0 +- 0.8, 23 steps) and 19 / 20 (85.5 +- 38.5, 20 steps): the
+    scripted level (`mimo-social compare --task high_five --mode scripted --algos ppo --seeds 2
+    --steps 60000 --out runs/high_five15_scripted --eval-every 10000 --eval-episodes 10`, then
+    `mimo-social baselines high_five --episodes 20 --seed 1000 --run
+    runs/high_five15_scripted/ppo_seed0 runs/high_five15_scripted/ppo_seed1`). Shared-parameter PPO,
+    two learners, 50k env steps (5-10 min): seed 0 100 % at 51k, seed 1 100 % from 30k; 20 fresh
+    episodes: 100 % for both infants, return 93.4 +- 1.0 (23 steps) and 90.1 +- 4.1 (78 steps)
+    (`mimo-social compare --task high_five --mode shared --algos ppo --seeds 2 --steps 50000 --out
+    runs/high_five15_shared --eval-every 10000 --eval-episodes 10`, then `mimo-social eval
+    runs/high_five15_shared/ppo_seed0 --episodes 20 --seed 1000`): the two learners agree on a
+    meeting point without the cue; the first version with it reached 100 % from 60k env steps (seed
+    0)
 sources:
     not in the MIMo paper: a social task of this package; rationale (touch games, contingency) and
     figures: `docs/social/high_five.md`
@@ -89,7 +121,12 @@ version history:
     (`tasks/dyad.py`, docs/bodies.md "As a partner in the social tasks"): placed by their measured
     reach, each in its own posture, held heads and eyes on the partner's face; an adult partner
     (`per_agent=[{}, {"body": "adult", "posture": "kneeling"}]`) kneels leaning 15 deg and its
-    `HandOffer` holds its palm where the infant reaches; two 18-month-olds unchanged
+    `HandOffer` holds its palm where the infant reaches; two 18-month-olds unchanged; v0, issue 30:
+    success is the palms meeting palm side to palm side for `hold_time` (0.1 s), random bang-bang
+    no longer succeeds (the first rule: `success="touch"`); `distance` up to 0.4 m with it; the
+    default partner holds its palm at the midline (`OFFER_AT`; the adult and other bodies too);
+    `HighFiveController` meets palm to palm (`palm="partner"`, default; ready, over, in); infos
+    `palm_contact`, `palm_contact_time`; the flailing policy `BangBang`
 
 Success is read from the same skin that the agents observe (:mod:`mimo_social.senses.touch`), so
 what ends the episode is what both infants perceive. The skin must cover the right hand
@@ -108,7 +145,7 @@ density.
 
 from .task import (parallel_env, env, scripted_env, default_partner, HighFive, hand_touch,
                    HighFiveOptions)
-from .controller import ArmSweep, HighFiveController
+from .controller import ArmSweep, BangBang, HighFiveController
 
 __all__ = ["parallel_env", "env", "scripted_env", "default_partner", "HighFive", "hand_touch",
-           "ArmSweep", "HighFiveController", "HighFiveOptions"]
+           "ArmSweep", "BangBang", "HighFiveController", "HighFiveOptions"]

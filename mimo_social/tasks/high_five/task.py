@@ -28,12 +28,30 @@ from ..dyad import held_angles, tables_of, task_plan
 from ...core.factory import make_aec, make_parallel
 
 __all__ = ["parallel_env", "env", "scripted_env", "default_partner", "HighFive", "hand_touch",
-           "HighFiveOptions"]
+           "HighFiveOptions", "OFFER_AT", "PALM_COS", "SUCCESS"]
 
 # 0.35 m: the right hands meet with the arms forward, half stretched; at 0.45 m (the first
 # version's distance) only the outstretched fingers meet, and PPO takes many times longer
 DISTANCE = 0.35
 DISTANCE_RANGE = (0.25, 0.6)
+#: what counts as the high five (task option ``success``): ``"palms"`` (default): the palms meet,
+#: palm side to palm side, held ``hold_time``; ``"touch"``: the first version's rule (the right
+#: hands touch and both skins feel the partner, one step, any side of the hand)
+SUCCESS = ("palms", "touch")
+#: where the default scripted partner holds its palm centre: (forward, left, up) m from the
+#: learner's right shoulder in the learner's heading frame (an 18-month-old's; scaled with the
+#: learner's arm), at the midline between the infants, 6 cm below the shoulder, where the
+#: learner's palm comes down onto it. The first versions' partner (``HandOffer(grip=False,
+#: release=None)``) held it 15 cm to the learner's left, across its body, where a palm facing
+#: down reaches it with the finger pads only
+OFFER_AT = (0.195, 0.105, -0.06)
+#: m: the farthest apart two 18-month-olds stand with ``success="palms"``: the scripted palm to
+#: palm meets 10 / 10 at 0.25-0.4 m, 3 / 10 at 0.45 m, 0 / 10 at 0.5 m
+PALMS_DISTANCE = 0.4
+#: a contact is on a hand's palm side when the contact normal (from the hand into the other)
+#: lies within 60 deg of the palm's normal (the hand segment's -y): the palm and the finger pads
+#: facing the other hand, not its back, edges or fingertips' ends
+PALM_COS = 0.5
 
 
 def hand_touch(hands: str = "mitten", density: float = HAND_TOUCH_DENSITY,
@@ -78,7 +96,9 @@ START_TRIES = 50   # random start postures tried until the hands touch nothing
 @dataclass(frozen=True)
 class HighFiveOptions(TaskOptions):
     """Bonus for the felt high five, whether it ends the episode, the distance between the
-    infants (m) and the spread of the random start postures (fraction of each joint's range)."""
+    infants (m), the spread of the random start postures (fraction of each joint's range), what
+    counts as the high five (``success``: :data:`SUCCESS`) and how long (s) the palms must stay
+    together (``hold_time``, with ``success="palms"``)."""
 
     task = "high_five"
     privileged: ClassVar[tuple[str, ...]] = ("assisted_gaze",)
@@ -88,6 +108,8 @@ class HighFiveOptions(TaskOptions):
     start_spread: float = 0.3
     assisted_gaze: bool = False
     shaping: bool = True
+    success: str = "palms"
+    hold_time: float = 0.1
 
     def __post_init__(self):
         self._number("touch_bonus")
@@ -96,6 +118,13 @@ class HighFiveOptions(TaskOptions):
         self._number("start_spread", 0.0, 1.0)
         self._bool("assisted_gaze")
         self._bool("shaping")
+        self._choice("success", SUCCESS)
+        self._number("hold_time", 0.0, 1.0)
+        if self.success == "palms" and self.distance > PALMS_DISTANCE:
+            raise ConfigError(f"high_five: task option distance={self.distance!r} not allowed "
+                              f"with success='palms'; allowed: a number from "
+                              f"{DISTANCE_RANGE[0]} to {PALMS_DISTANCE} (farther apart the palms "
+                              f"do not meet), or success='touch' (up to {DISTANCE_RANGE[1]})")
 
 
 GAP_CAP = 0.1   # m: the hand gap plot's top (the hands' surfaces are not measured farther)
@@ -148,6 +177,13 @@ class HighFive(Task):
                        for i in range(2)]
         self._hand_mask = np.zeros(w.model.ngeom, bool)
         self._hand_mask[np.concatenate(hands)] = True
+        # whose right hand a geom is (0, 1; -1: no right hand) and each hand's segment (palm side
+        # -y), for the palm-to-palm rule
+        self._hand_of = np.full(w.model.ngeom, -1, np.int8)
+        for i in range(2):
+            self._hand_of[hands[i]] = i
+        self._hand_bodies = np.array([w.model.site_bodyid[p] for p in self._palms], np.intp)
+        self._hold_steps = max(1, int(round(self.options.hold_time / env.dt)))
         # each arm's joints: qpos/dof addresses, the standing pose's angles (rad) and ranges
         self._arms = []
         rest = w.initial_qpos
@@ -170,7 +206,8 @@ class HighFive(Task):
             g1, g2 = d.contact.geom1[:n], d.contact.geom2[:n]
             if not np.any((self._hand_mask[g1] | self._hand_mask[g2]) & (d.contact.dist[:n] < 0)):
                 break
-        self._touching = False
+        self._touching = self._palm_contact = False
+        self._held = 0
         self._felt = [False, False]
         self._distance = float("nan")
         self.before_physics(env)
@@ -186,11 +223,36 @@ class HighFive(Task):
         p = d.site_xpos[self._palms]
         dist = float(np.linalg.norm(p[0] - p[1]))
         self._felt = [bool(f(d)) for f in self._feels]
-        self._touching = self._felt[0] and self._felt[1] and self._hands_meet(d)
+        meet = self._felt[0] and self._felt[1] and self._hands_meet(d)
+        self._palm_contact = meet and self.palms_meet(d)
+        self._held = self._held + 1 if self._palm_contact else 0
+        # "palms": palm side to palm side, held hold_time; "touch" (the first version): any
+        # touch of the right hands that both skins feel
+        self._touching = meet if self.options.success == "touch" \
+            else self._held >= self._hold_steps
         r = (-dist if self.options.shaping else 0.0) \
             + (self.options.touch_bonus if self._touching else 0.0)
         self._distance = dist
         return np.array([r, r])
+
+    def palms_meet(self, data) -> bool:
+        """Whether the two right hands touch palm side to palm side this step: a contact
+        between them whose normal, from each hand into the other, lies within 60 deg of that
+        hand's palm normal (:data:`PALM_COS`; the palm and the finger pads count, the back of the
+        hand, its edges and the fingertips' ends do not). One gather over the contacts."""
+        n = data.ncon
+        if n == 0:
+            return False
+        c = data.contact
+        g1, g2 = c.geom1[:n], c.geom2[:n]
+        o1, o2 = self._hand_of[g1], self._hand_of[g2]
+        keep = (o1 >= 0) & (o2 >= 0) & (o1 != o2) & (c.dist[:n] <= 0.0)
+        if not keep.any():
+            return False
+        # each contact's normal from infant_0's hand into infant_1's
+        normal = c.frame[:n, :3][keep] * np.where(o1[keep] == 0, 1.0, -1.0)[:, None]
+        palms = -data.xmat[self._hand_bodies][:, [1, 4, 7]]   # each hand's -y (world)
+        return bool(np.any((normal @ palms[0] >= PALM_COS) & (normal @ palms[1] <= -PALM_COS)))
 
     def plots(self):
         """The shared reward (one line), the distance between the right palms' centres (the
@@ -213,12 +275,15 @@ class HighFive(Task):
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
         return {"is_success": "number", "hands_touching": "number",
-                "hand_feels_partner": "number", "hand_distance": "number"}
+                "hand_feels_partner": "number", "hand_distance": "number",
+                "palm_contact": "number", "palm_contact_time": "number"}
 
     def terminations(self, env):
         done = self._touching and self.options.end_on_touch
+        held = self._held * env.dt
         infos = [{"is_success": self._touching, "hands_touching": self._touching,
-                  "hand_feels_partner": self._felt[i], "hand_distance": self._distance}
+                  "hand_feels_partner": self._felt[i], "hand_distance": self._distance,
+                  "palm_contact": self._palm_contact, "palm_contact_time": held}
                  for i in range(2)]
         return np.array([done, done]), infos
 
@@ -234,11 +299,12 @@ def env(**kwargs):
 
 
 def default_partner():
-    """The scripted partner of :func:`scripted_env`: ``HandOffer(grip=False, release=None)``,
-    which brings its right hand to an offer position in front of its body, fingers open, and
-    holds it there."""
+    """The scripted partner of :func:`scripted_env`: ``HandOffer(grip=False, release=None,
+    reach_to=OFFER_AT)``, which brings its right hand, palm up and fingers open, to the midline
+    between the infants (:data:`OFFER_AT` from the learner's right shoulder, where the learner's
+    palm comes down onto it) and holds it there."""
     from ...partners.hand_offer import HandOffer
-    return HandOffer(grip=False, release=None)
+    return HandOffer(grip=False, release=None, reach_to=OFFER_AT)
 
 
 def scripted_env(partner=None, **kwargs):

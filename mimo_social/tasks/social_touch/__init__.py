@@ -14,9 +14,17 @@ body:
 scene:
     the floor only: the target is a part of the partner's body
 reset:
-    the toucher's right arm starts out to its side, touching nothing; the touched infant's hands
-    rest on its legs; the target part is drawn uniformly from `targets` with the env's seeded
-    generator (task option `target` fixes it)
+    each episode starts from its own seeded draw (`reset(seed=...)`, the env's generator): the
+    distance, `distance` + U(-1, 1) x `distance_spread` (0.02 m), within 0.35-0.40 m (other bodies
+    shifted by as much: the touched infant's hip is moved along the line between the two); the
+    toucher's right arm (its motors' joints: 8 with mitten hands) at its start posture (out to its
+    side, elbow a little bent) plus U(-1/2, 1/2) x `start_spread` (0.2) x each joint's range; the
+    touched infant's arms (16 joints with mitten hands; its hands resting on its legs) plus U(-1/2,
+    1/2) x `partner_spread` (0.1) x each range; drawn again (up to 50 times) until the toucher's arm
+    touches nothing and the two infants do not touch. 100 seeds give 100 distinct starts (tested;
+    the first versions had one start posture, 6 distinct episodes over 60 seeds); all spreads 0: the
+    first versions' start. The target part is drawn uniformly from `targets` (task option `target`
+    fixes it); the same seed, the same start
 action:
     `infant_0`: the right arm's motors (mitten hands: 8, shoulder 3, elbow, wrist 3, fingers; five
     fingers: 29) in [-1, 1]; `infant_1`: both arms' motors (16; 58), zero in the scripted env
@@ -53,7 +61,10 @@ options:
     `targets` (None: :data:`DEFAULT_TARGETS`, 6 parts, those of them in the partner's body; only
     parts of :data:`REACHABLE`, the 6 and the left thigh: others raise an error), `target` (None),
     `success_reward` (100.0), `end_on_touch` (True), `distance` (0.37 m, 0.35 to 0.40), `shaping`
-    (True), `assisted_gaze` (False)
+    (True), `assisted_gaze` (False), `start_spread` (0.2, 0 to 1: the toucher's arm at the start,
+    a fraction of each joint's range), `partner_spread` (0.1, 0 to 1: the touched infant's arms),
+    `distance_spread` (0.02 m, 0 to 0.05: the episode's distance either way of `distance`, within
+    0.35-0.40 m); all three 0: the first versions' fixed start
 privileged cues:
     `target` one-hot (always: the instruction, the task's "name" of the part; it does not say where
     the part is); `assisted_gaze` (default False): the task aims the toucher's eyes at the target
@@ -61,16 +72,21 @@ privileged cues:
     toucher's right palm; off, each looks at the other's face (eye angles set once per reset, the
     same for every target); the touch itself only through the skins
 baselines:
-    scripted env, `Still` partner, 20 episodes, seeds 1000-1019: `SocialTouchController`
-    (`mimo_social.tasks.social_touch.controller`) 20 / 20, return 82.6 +- 7.1, 132 steps to success
-    (seeds 0-29: 30 / 30, 85.2 +- 3.9, 127 steps); random 0 / 20, -98.7 +- 26.0 (seeds 0-29: 1 / 30,
-    -86.0 +- 32.2); zero 0 / 20, -194.8 +- 28.0; hacks: `NearestPartToucher` (the listed part
-    nearest its hand, whatever the target) 3 / 20, -65.7 +- 67.9; `ArmSweep` (the arm swung across
-    in front of the partner) 0 / 20, -105.4 +- 34.6; PPO (2 seeds, 400k env steps, 24 min): 0 / 20,
-    -74.3 +- 7.6 and 2 / 20, -71.5 +- 58.6: above random in return, barely in success, far from the
-    scripted level (`mimo-social compare --task social_touch --mode scripted --algos ppo --seeds 2
-    --steps 400000 --out runs/social_touch15 --eval-every 25000 --eval-episodes 10 --jobs 2`, then
-    `mimo-social baselines social_touch --episodes 20 --seed 1000 --run
+    issue 30 (random starts), scripted env, `Still` partner, 30 episodes, seeds 1000-1029:
+    `SocialTouchController` (`mimo_social.tasks.social_touch.controller`) 29 / 30, return 77.9 +-
+    39.3, 121 steps to success; random 1 / 30, -94.2 +- 32.4; zero 0 / 30, -190.7 +- 33.8
+    (`mimo-social baselines social_touch --episodes 30 --seed 1000`); seeds 0-99: scripted 99 / 100,
+    83.7 +- 16.5, 114 steps; random (uniform) 4 / 100, -91.4 +- 40.3; zero 0 / 100, -192.4 +- 34.9;
+    hacks (seeds 1000-1029): `NearestPartToucher` (the listed part nearest its hand, whatever the
+    target) 5 / 30, -54.5 +- 66.3; `ArmSweep` (the arm swung across in front of the partner) 0 / 30,
+    -100.3 +- 31.0 (the script: `docs/social/social_touch.md`). Issue 15 (the fixed start), seeds
+    1000-1019: scripted 20 / 20, 82.6 +- 7.1, 132 steps; random 0 / 20, -98.7 +- 26.0; zero 0 / 20,
+    -194.8 +- 28.0; `NearestPartToucher` 3 / 20, -65.7 +- 67.9; `ArmSweep` 0 / 20, -105.4 +- 34.6;
+    PPO (2 seeds, 400k env steps, 24 min, the fixed start; not yet measured with the random starts):
+    0 / 20, -74.3 +- 7.6 and 2 / 20, -71.5 +- 58.6: above random in return, barely in success, far
+    from the scripted level (`mimo-social compare --task social_touch --mode scripted --algos ppo
+    --seeds 2 --steps 400000 --out runs/social_touch15 --eval-every 25000 --eval-episodes 10 --jobs
+    2`, then `mimo-social baselines social_touch --episodes 20 --seed 1000 --run
     runs/social_touch15/ppo_seed0 runs/social_touch15/ppo_seed1`; details
     `docs/social/social_touch.md`)
 sources:
@@ -88,7 +104,10 @@ version history:
     policies; v0, issue 18: partners of other bodies (`tasks/dyad.py`, docs/bodies.md): the floor
     between the two kept as for two 18-month-olds, each in its own posture, the partner's head
     turned to the toucher's face; an adult partner offers the parts the toucher reaches
-    (`ADULT_REACHABLE`: kneeling, its left forearm, hand and thigh); two 18-month-olds unchanged
+    (`ADULT_REACHABLE`: kneeling, its left forearm, hand and thigh); two 18-month-olds unchanged;
+    v0, issue 30: start randomness: the distance (`distance_spread`, 0.02 m), the toucher's arm
+    posture (`start_spread`, 0.2) and the touched infant's arms (`partner_spread`, 0.1), seeded,
+    touching nothing (the first versions: one start posture, only the target drawn)
 
 Targets by default are the partner's parts within reach of the toucher's right hand over the whole
 distance range: upper and lower trunk, the partner's left arm (upper arm, lower arm, hand with its

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
+import mujoco
 import numpy as np
 from gymnasium import spaces
 
@@ -76,6 +77,8 @@ DEFAULT_TARGETS = tuple(p for p in REACHABLE if p != "left_upper_leg")
 #: infant's reach; sitting cross-legged, its shins are in front of everything else.
 ADULT_REACHABLE = {"kneeling": ("left_lower_arm", "left_hand", "left_upper_leg"),
                    "sitting": ("left_lower_leg",)}
+#: random start postures tried until the arms touch nothing they should not
+START_TRIES = 50
 #: a hand contact is made with the back of the hand (which does not count) when the contact
 #: normal (from the hand into the partner) has a component at or below this along the palm's
 #: normal (-0.5: more than 120 deg from it); palm, finger pads, fingertips and edges count
@@ -88,7 +91,9 @@ class SocialTouchOptions(TaskOptions):
     drawn each episode), the reward for touching the target first, whether the first touch ends
     the episode, the distance between the infants (m), the per-step distance shaping, and
     whether the task aims the eyes (the toucher's at the target, the touched infant's at the
-    toucher's hand: a privileged cue)."""
+    toucher's hand: a privileged cue), and the start's randomness: the spread of the toucher's
+    right-arm start posture and of the touched infant's arms (fractions of each joint's range)
+    and of the distance (m, either way)."""
 
     task = "social_touch"
     privileged: ClassVar[tuple[str, ...]] = ("assisted_gaze",)
@@ -99,6 +104,9 @@ class SocialTouchOptions(TaskOptions):
     distance: float = DISTANCE
     shaping: bool = True
     assisted_gaze: bool = False
+    start_spread: float = 0.2
+    partner_spread: float = 0.1
+    distance_spread: float = 0.02
 
     def __post_init__(self):
         self._names("targets", "body part names of the partner")
@@ -108,6 +116,9 @@ class SocialTouchOptions(TaskOptions):
         self._number("distance", *DISTANCE_RANGE)
         self._bool("shaping")
         self._bool("assisted_gaze")
+        self._number("start_spread", 0.0, 1.0)
+        self._number("partner_spread", 0.0, 1.0)
+        self._number("distance_spread", 0.0, DISTANCE_RANGE[1] - DISTANCE_RANGE[0])
 
 
 class SocialTouch(Task):
@@ -257,6 +268,25 @@ class SocialTouch(Task):
         self._source = toucher.name
         self._touch = env.systems.get("touch")
         self._geom_body = m.geom_bodyid.copy()
+        # the start's randomness: each agent's actuated joints (the toucher's right arm, the
+        # touched infant's arms) around their start angles, and the touched infant's hip along
+        # the line between the two (its root body hangs from the world: body_pos)
+        start = w.initial_qpos.copy()
+        start[self._arm_qpos] = self._arm_start
+        self._spread_joints = []
+        for a in (toucher, touched):
+            k = a.actuated_joint_idx
+            lo, hi = a.joint_range[k, 0], a.joint_range[k, 1]
+            self._spread_joints.append((a.qpos_adr[k], start[a.qpos_adr[k]].copy(), lo, hi))
+        self._root = int(touched.root_body)
+        xy = [np.array(st.position, float) for st in w.agent_setups]
+        self._root_xy = xy[TOUCHED]
+        self._axis = (xy[TOUCHED] - xy[TOUCHER]) / max(np.linalg.norm(xy[TOUCHED]
+                                                                      - xy[TOUCHER]), 1e-9)
+        self._geom_agent = w.geom_agent
+        #: the episode's distance (m, hip to hip for two 18-month-olds; other bodies are moved
+        #: by as much from where they were placed)
+        self.distance = self.options.distance
 
     def reset(self, env, rng):
         m, d = env.world.model, env.world.data
@@ -264,6 +294,7 @@ class SocialTouch(Task):
         fixed = self.options.target
         self._target = (self.targets.index(fixed) if fixed is not None
                         else int(rng.integers(len(self.targets))))
+        self._randomise_start(m, d, rng)
         self._onehot = np.zeros(len(self.targets), np.float32)
         self._onehot[self._target] = 1.0
         self._success = self._wrong = self._felt = False
@@ -277,6 +308,36 @@ class SocialTouch(Task):
                 g(m, d, "site", self._head[1 - j])
             self._held_eyes = [d.qpos[q].copy() for q in self._eyes]
         self.before_physics(env)
+
+    def _randomise_start(self, m, d, rng) -> None:
+        """The episode's distance (``distance`` + U(-1, 1) x ``distance_spread``, within
+        0.35-0.40 m for two 18-month-olds; other bodies shifted by the same amount) and arm
+        postures (each actuated joint at its start angle + U(-1/2, 1/2) x spread x its range),
+        drawn again until the toucher's right arm touches nothing and the two infants do not
+        touch each other (seeded by ``reset(seed=...)``)."""
+        o = self.options
+        lo_d, hi_d = DISTANCE_RANGE
+        dist = float(np.clip(o.distance + rng.uniform(-1.0, 1.0) * o.distance_spread, lo_d, hi_d))
+        m.body_pos[self._root, :2] = self._root_xy + (dist - o.distance) * self._axis
+        self.distance = dist
+        spreads = (o.start_spread, o.partner_spread)
+        for _ in range(START_TRIES):
+            for (q, mid, lo, hi), spread in zip(self._spread_joints, spreads):
+                u = rng.uniform(-0.5, 0.5, len(q))
+                d.qpos[q] = np.clip(mid + u * spread * (hi - lo), lo, hi)
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_collision(m, d)
+            n = d.ncon
+            g1, g2 = d.contact.geom1[:n], d.contact.geom2[:n]
+            a1, a2 = self._geom_agent[g1], self._geom_agent[g2]
+            pressed = d.contact.dist[:n] < 0.0
+            across = (a1 >= 0) & (a2 >= 0) & (a1 != a2)
+            arm = (self._arm[g1] > 0) ^ (self._arm[g2] > 0)
+            if not np.any(pressed & (across | arm)):
+                break
+        else:   # no clear draw: the fixed start (which touches nothing)
+            for q, mid, _, _ in self._spread_joints:
+                d.qpos[q] = mid
 
     @property
     def target(self) -> str:
