@@ -16,7 +16,8 @@ __all__ = ["REACH_TO", "REACH_LIMIT", "REF_ARM", "SIZE_TOLERANCE", "reach_target
 
 #: where an adult offers its palm centre by default: (forward, left, up) m from the other
 #: agent's right shoulder, in that agent's heading frame: where the high five's scripted partner
-#: (an 18-month-old, 0.35 m away) holds its palm for the other 18-month-old (measured on
+#: (an 18-month-old, 0.35 m away) held its palm for the other 18-month-old before issue 30 moved
+#: the high five's default offer to the midline (measured then on
 #: ``high_five_v0.scripted_env()``: HandOffer.target_position minus infant_0's shoulder)
 REACH_TO = (0.205, 0.152, -0.099)
 
