@@ -605,7 +605,8 @@ def high_five(tmp_path_factory):
     hands meet (the task's reward bonus says when), recorded with a chosen scalar."""
     from mimo_social.envs import high_five_v0
 
-    env = high_five_v0.parallel_env(task_options={"end_on_touch": False, "distance": 0.3},
+    env = high_five_v0.parallel_env(task_options={"end_on_touch": False, "distance": 0.3,
+                                                  "success": "touch"},   # any touch of the hands
                                     touch=True)
     path = tmp_path_factory.mktemp("hf") / "high_five.rrd"
     u = np.zeros(8, np.float32)
