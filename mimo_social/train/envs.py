@@ -36,7 +36,8 @@ from ..envs.catalog import entry, register_envs
 from .tasks import check_task, task_module
 
 __all__ = ["run_observation", "PolicyInput", "make_env", "make_parallel_env", "make_scripted_env",
-           "make_sb3_single", "with_render", "world_vec_env", "call_world", "vec_worker"]
+           "make_sb3_single", "with_render", "world_vec_env", "call_world", "vec_worker",
+           "stop_workers"]
 
 
 def with_render(env_kwargs: Mapping[str, Any], render_mode: str | None) -> dict:
@@ -145,6 +146,37 @@ def make_sb3_single(env_id_or_env, *, flat: bool = False, frame_stack: int = 1,
     elif not isinstance(env.action_space, spaces.Box):
         env = FlatActionWrapper(env)
     return env
+
+
+def stop_workers(conns, procs, broken=()) -> None:
+    """End spawned worker processes: ask each live one to close (``("close", None)``), then wait
+    for their answers together (10 s each at most), join them (5 s) and terminate any still
+    running; workers whose index is in ``broken`` are terminated without asking. Closes every
+    connection."""
+    asked = []
+    for p, (conn, proc) in enumerate(zip(conns, procs)):
+        if p in broken:
+            proc.terminate()
+            continue
+        try:
+            if proc.is_alive():
+                conn.send(("close", None))
+                asked.append(conn)
+        except OSError:
+            pass
+    for conn in asked:
+        try:
+            if conn.poll(10):
+                conn.recv()
+        except (OSError, EOFError):
+            pass
+    for proc in procs:
+        proc.join(5)
+        if proc.is_alive():
+            proc.terminate()
+            proc.join(1)
+    for conn in conns:
+        conn.close()
 
 
 # -- worker side of ``vector.SpawnConcatVecEnv`` ------------------------------------------------

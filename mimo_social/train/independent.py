@@ -30,7 +30,7 @@ from typing import Any, Callable, Mapping, Sequence
 import cloudpickle
 import numpy as np
 
-from .envs import call_world, make_parallel_env
+from .envs import call_world, make_parallel_env, stop_workers
 from .interrupt import Interrupted, workers_ignore_sigint
 from .lockstep import LockstepError, VecLockstep, run_lockstep
 from .progress import write_config
@@ -326,30 +326,7 @@ class WorldBatch:
         self.closed = True
         if self.local is not None:
             self.local.close()
-        asked = []
-        for p, (conn, proc) in enumerate(zip(self.conns, self.procs)):
-            if p in self.broken:
-                proc.terminate()
-                continue
-            try:
-                if proc.is_alive():
-                    conn.send(("close", None))
-                    asked.append(conn)
-            except OSError:
-                pass
-        for conn in asked:
-            try:
-                if conn.poll(10):
-                    conn.recv()
-            except (OSError, EOFError):
-                pass
-        for proc in self.procs:
-            proc.join(5)
-            if proc.is_alive():
-                proc.terminate()
-                proc.join(1)
-        for conn in self.conns:
-            conn.close()
+        stop_workers(self.conns, self.procs, self.broken)
         self.conns, self.procs = [], []
 
 

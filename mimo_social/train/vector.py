@@ -55,7 +55,7 @@ from stable_baselines3.common.vec_env import VecEnv, VecEnvWrapper
 from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices
 from supersuit.vector.sb3_vector_wrapper import SB3VecEnvWrapper
 
-from .envs import call_world, vec_worker, world_vec_env
+from .envs import call_world, stop_workers, vec_worker, world_vec_env
 
 # Worker processes run ``envs.vec_worker``: importing that module pulls in neither SB3 nor
 # torch, so a spawned worker starts (and exits) in about a second instead of several.
@@ -196,27 +196,7 @@ class SpawnConcatVecEnv(gymnasium.vector.VectorEnv):
         return value[0]
 
     def close_extras(self, **kwargs) -> None:
-        asked = []
-        for conn, proc in zip(self._conns, self._procs):  # ask every worker first ...
-            try:
-                if proc.is_alive():
-                    conn.send(("close", None))
-                    asked.append(conn)
-            except OSError:
-                pass
-        for conn in asked:  # ... then wait for them together
-            try:
-                if conn.poll(10):
-                    conn.recv()
-            except (OSError, EOFError):
-                pass
-        for proc in self._procs:
-            proc.join(5)
-            if proc.is_alive():
-                proc.terminate()
-                proc.join(1)
-        for conn in self._conns:
-            conn.close()
+        stop_workers(self._conns, self._procs)
         self._conns, self._procs = [], []
 
     def close(self, **kwargs) -> None:
