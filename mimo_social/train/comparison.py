@@ -23,7 +23,7 @@ from .runner import train
 from .tasks import (ALGOS, COMPARED_ALGOS, TrainInputError, check_algo, check_mode, check_task,
                     task_module)
 
-__all__ = ["compare", "parse_steps_per_algo", "value_per_algo", "kwargs_keyed_by_algo"]
+__all__ = ["compare", "train_all", "finished", "parse_steps_per_algo", "value_per_algo", "kwargs_keyed_by_algo"]
 
 
 def _train_quiet(kwargs):
@@ -82,6 +82,43 @@ def parse_steps_per_algo(text: str) -> dict[str, int]:
     return out
 
 
+def finished(run: Mapping[str, Any]) -> bool:
+    """Whether the run ``train(**run)`` would make is already there: ``model.zip`` and a
+    ``config.json`` of the same task, algorithm, steps, seed and recipe, not interrupted."""
+    out = Path(run["out"])
+    if not (out / "model.zip").exists() or not (out / "config.json").exists():
+        return False
+    import json
+    config = json.loads((out / "config.json").read_text())
+    return ("wall_time_s" in config and not config.get("interrupted")
+            and all(config.get(k) == run.get(k) for k in ("task", "algo", "steps", "seed",
+                                                           "recipe")))
+
+
+def train_all(runs: list[dict], jobs: int = 1, desc: str = "train",
+              progress: bool = True, skip_finished: bool = False) -> None:
+    """Train every run (``train``'s keyword arguments each): one after another with ``jobs=1``,
+    else up to ``jobs`` at a time, each in its own spawned process (one bar over the runs).
+    ``skip_finished``: leave out runs already there (:func:`finished`)."""
+    if skip_finished:
+        runs = [kw for kw in runs if not finished(kw)]
+    if int(jobs) <= 1:
+        for kw in runs:
+            train(**kw)
+        return
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    from tqdm import tqdm
+    runs = [{**kw, "progress": False} for kw in runs]   # (one bar over the runs instead)
+    with ProcessPoolExecutor(max_workers=int(jobs), mp_context=mp.get_context("spawn")) as ex, \
+            tqdm(total=len(runs), unit="run", desc=desc, disable=not progress,
+                 dynamic_ncols=True) as bar:
+        for path, secs in ex.map(_train_quiet, runs):
+            bar.write(f"done {path} in {secs:.0f} s")
+            bar.update(1)
+
+
 def compare(task: str, algos=COMPARED_ALGOS, seeds: int = 3,
             steps: int | Mapping[str, int] = 50_000,
             out: str | Path = "runs/compare", *, jobs: int = 1, plot_only: bool = False,
@@ -112,20 +149,5 @@ def compare(task: str, algos=COMPARED_ALGOS, seeds: int = 3,
         for a in algos:   # every algorithm's keyword arguments checked before any run starts
             resolve(task, a, kwargs[a], mode=mode, steps=steps[a])
         out.mkdir(parents=True, exist_ok=True)
-        if jobs <= 1:
-            for kw in runs:
-                train(**kw)
-        else:
-            import multiprocessing as mp
-            from concurrent.futures import ProcessPoolExecutor
-            for kw in runs:
-                kw["progress"] = False   # (one bar over the runs instead)
-            from tqdm import tqdm
-            with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as ex, \
-                    tqdm(total=len(runs), unit="run", desc=f"compare {task}",
-                         disable=not train_kwargs.get("progress", True),
-                         dynamic_ncols=True) as bar:
-                for path, secs in ex.map(_train_quiet, runs):
-                    bar.write(f"done {path} in {secs:.0f} s")
-                    bar.update(1)
+        train_all(runs, jobs, f"compare {task}", train_kwargs.get("progress", True))
     return plot_compare(out, task)

@@ -60,7 +60,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           normalize_obs: bool | None = None, flat_obs: bool = False, frame_stack: int = 1,
           worker_timeout: float = 600.0, normalize_reward: bool = False,
           curriculum=None, bc_episodes: int = 0, bc_epochs: int = 20, intrinsic=None,
-          bc_kwargs: Mapping[str, Any] | None = None) -> dict:
+          bc_kwargs: Mapping[str, Any] | None = None, recipe: str | None = None) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
     time). See the module docstring for what it writes.
 
@@ -87,7 +87,8 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     other settings (:mod:`mimo_social.train.demonstrations`); both checked before anything is
     written. ``intrinsic`` (None, ``"rnd"`` or a settings mapping; not ``independent``): an RND
     novelty bonus added to the learner's rewards (:mod:`mimo_social.train.intrinsic`; with
-    ``{"extrinsic": 0}`` a reward-free run)."""
+    ``{"extrinsic": 0}`` a reward-free run). ``recipe``: the name of the shipped recipe the
+    run follows (:mod:`mimo_social.train.recipes`), recorded in ``config.json``."""
     from .hyperparams import resolve, run_options, to_json, to_sb3
 
     mode = check_mode(task, mode)
@@ -160,6 +161,8 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
               "algo_kwargs_provenance": provenance, "eval_every": eval_every,
               "eval_episodes": eval_episodes, "checkpoint_every": checkpoint_every,
               "algo_kwargs_given": sorted(algo_kwargs or {})}
+    if recipe is not None:
+        config["recipe"] = str(recipe)
     if bc is not None:
         config["bc"] = dict(bc)
     if intrinsic is not None:
