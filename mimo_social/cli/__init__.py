@@ -13,13 +13,13 @@ import errno
 import os
 import sys
 
-from . import (baselines, bench, calibrate, compliance, demo, docs, figure, paradigm, recipe,
-               replay, train)
+from . import (baselines, bench, calibrate, compliance, demo, docs, fig8, figure, paradigm,
+               recipe, replay, train)
 
 #: the modules of the top-level commands (the measurements are under ``bench``:
 #: :data:`.bench.MEASUREMENTS`)
 SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, figure, docs, baselines,
-               paradigm, recipe)
+               paradigm, recipe, fig8)
 
 
 class UsageError(SystemExit):

@@ -19,9 +19,10 @@ import numpy as np
 
 from .progress import PROGRESS_FIELDS, progress_agents, read_progress
 
-__all__ = ["COLORS", "plot_learning_curve", "plot_compare"]
+__all__ = ["COLORS", "plot_learning_curve", "plot_compare", "plot_fig8", "runs_by_group"]
 
-COLORS = {"ppo": "tab:red", "sac": "tab:blue"}
+COLORS = {"ppo": "tab:red", "sac": "tab:blue", "ppo recipe": "tab:green",
+          "sac recipe": "tab:purple"}
 
 
 
@@ -180,6 +181,28 @@ def _curves(ax, runs, xkey: str, xscale: float, key: str, scale: float, color, l
                     alpha=0.15, lw=0)
 
 
+def group_name(config: dict) -> str:
+    """The curve a run belongs to: its algorithm, ``"<algo> recipe"`` for a recipe's run."""
+    return config["algo"] + (" recipe" if config.get("recipe") else "")
+
+
+def _label(group: str) -> str:
+    algo, _, rest = group.partition(" ")
+    return f"{algo.upper()} {rest}".strip()
+
+
+def runs_by_group(out: str | Path) -> dict[str, list]:
+    """Every ``*_seed*`` run below ``out`` with a ``progress.csv``: ``{group: [(config,
+    progress), ...]}`` (:func:`group_name`)."""
+    by: dict[str, list] = {}
+    for run in sorted(Path(out).glob("*_seed*")):
+        if not (run / "progress.csv").exists():
+            continue
+        config = json.loads((run / "config.json").read_text())
+        by.setdefault(group_name(config), []).append((config, read_progress(run / "progress.csv")))
+    return by
+
+
 def plot_compare(out: str | Path, task: str | None = None) -> Path:
     """``compare.png`` / ``compare.csv`` from every ``<algo>_seed<k>`` run below ``out``.
 
@@ -192,12 +215,7 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
     import matplotlib.pyplot as plt
 
     out = Path(out)
-    by_algo: dict[str, list] = {}
-    for run in sorted(out.glob("*_seed*")):
-        if not (run / "progress.csv").exists():
-            continue
-        config = json.loads((run / "config.json").read_text())
-        by_algo.setdefault(config["algo"], []).append((config, read_progress(run / "progress.csv")))
+    by_algo = runs_by_group(out)
     if not by_algo:
         raise FileNotFoundError(f"no runs with a progress.csv below {out}")
     all_runs = [p for runs in by_algo.values() for _, p in runs]
@@ -222,9 +240,9 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
         for i, (key, scale, _) in enumerate(ys):
             for j, (xkey, xscale, _) in enumerate(xaxes):
                 _curves(axes[i, j], runs, xkey, xscale, key, scale, color,
-                        f"{algo.upper()} ({len(runs)} seeds), mean action")
+                        f"{_label(algo)} ({len(runs)} seeds), mean action")
                 _curves(axes[i, j], runs, xkey, xscale, key + "_stochastic", scale, color,
-                        f"{algo.upper()}, sampled actions", ls="--")
+                        f"{_label(algo)}, sampled actions", ls="--")
         for config, p in runs:
             for k in range(len(p["timesteps"])):
                 rows.append({"algo": algo, "seed": config["seed"],
@@ -257,4 +275,47 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
         w.writeheader()
         for r in rows:
             w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    return png
+
+
+def plot_fig8(out: str | Path, tasks, png: str | Path | None = None) -> Path:
+    """The paper's Fig. 8 from ``OUT/<task>/<group>_seed<k>`` runs: a row per task, the
+    evaluation return against environment steps (left) and wall time (right); per algorithm (and
+    recipe) a thin line per seed, the mean over seeds (solid: mean action; dashed: sampled
+    actions) and the min-max band."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out)
+    groups = {t: runs_by_group(out / t) for t in tasks if (out / t).is_dir()}
+    groups = {t: g for t, g in groups.items() if g}
+    if not groups:
+        raise FileNotFoundError(f"no runs with a progress.csv below {out}/<task>")
+    fig, axes = plt.subplots(len(groups), 2, figsize=(11, 3.6 * len(groups)), squeeze=False)
+    for i, (task, by) in enumerate(groups.items()):
+        runs = [r for rs in by.values() for r in rs]
+        unit, secs = _wall_unit(max(p["wall_time_s"][-1] for _, p in runs))
+        for j, (xkey, xscale, xlabel) in enumerate((("timesteps", 1.0, "environment steps"),
+                                                    ("wall_time_s", secs, f"wall time ({unit})"))):
+            ax = axes[i, j]
+            for group, rs in sorted(by.items()):
+                color = COLORS.get(group)
+                _curves(ax, rs, xkey, xscale, "eval_return_mean", 1.0, color,
+                        f"{_label(group)} ({len(rs)} seeds)")
+                _curves(ax, rs, xkey, xscale, "eval_return_mean_stochastic", 1.0, color,
+                        None, ls="--")
+            ax.set_title(f"{task}: evaluation return", fontsize=10)
+            ax.set_xlabel(xlabel)
+            if j == 0:
+                _steps_axis(ax)
+            ax.set_ylabel("episode return")
+            ax.grid(alpha=0.3)
+        axes[i, 0].legend(loc="best", fontsize=8)
+    fig.suptitle("mean over seeds and min-max band; solid: mean action, dashed: sampled actions",
+                 fontsize=10)
+    fig.tight_layout()
+    png = Path(png) if png else out / "fig8.png"
+    fig.savefig(png, dpi=100)
+    plt.close(fig)
     return png

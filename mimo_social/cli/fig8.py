@@ -1,0 +1,55 @@
+"""``mimo-social fig8``: the paper's Fig. 8 (PPO and SAC on reach, stand-up, self-body and catch,
+several seeds) in one command, the shipped recipes beside them with ``--recipes``.
+
+``mimo-social fig8 --seeds 5 --jobs 2 --out runs/fig8`` trains every run (finished ones reused:
+an interrupted reproduction goes on), then writes ``OUT/fig8.png``, ``OUT/fig8.md`` and per task
+``compare.png`` and ``baselines.md`` (:mod:`mimo_social.train.fig8`).
+"""
+
+from __future__ import annotations
+
+from ..train.fig8 import FIG8_STEPS, FIG8_TASKS, fig8
+from ._args import comma_choices, output_dir, positive_int, seed
+
+__all__ = ["add_parser"]
+
+
+def _main(args) -> int:
+    steps = {t: {k: v for k, v in (("ppo", args.ppo_steps), ("sac", args.sac_steps)) if v}
+             for t in args.tasks}
+    png = fig8(args.out, args.seeds, args.tasks, steps=steps, jobs=args.jobs,
+               eval_episodes=args.eval_episodes, recipes=args.recipes,
+               recipe_steps=args.recipe_steps, episodes=args.episodes, eval_seed=args.eval_seed,
+               plot_only=args.plot_only, progress=not args.no_progress)
+    print(f"wrote {png} and {args.out}/fig8.md")
+    return 0
+
+
+def add_parser(subparsers) -> None:
+    budgets = "; ".join(f"{t} PPO {b['ppo']:,}, SAC {b['sac']:,}" for t, b in FIG8_STEPS.items())
+    p = subparsers.add_parser(
+        "fig8", help="the paper's Fig. 8: PPO and SAC on its four tasks, several seeds",
+        description="Train PPO and SAC (SB3 defaults, one env per run) with several seeds on "
+        "reach, standup, selfbody and catch (and the shipped recipes with --recipes), then plot "
+        "the learning curves over environment steps and wall time and evaluate the final "
+        f"models. Default budgets: {budgets}.")
+    p.add_argument("--out", type=output_dir, required=True, help="output directory")
+    p.add_argument("--seeds", type=positive_int, default=5, help="seeds per algorithm (0..n-1)")
+    p.add_argument("--tasks", type=comma_choices(FIG8_TASKS, "task"), default=list(FIG8_TASKS),
+                   help="comma-separated subset of " + ",".join(FIG8_TASKS))
+    p.add_argument("--jobs", type=positive_int, default=1, help="runs trained at a time")
+    p.add_argument("--ppo-steps", type=positive_int, default=None,
+                   help="PPO's budget on every task (default: the table above)")
+    p.add_argument("--sac-steps", type=positive_int, default=None,
+                   help="SAC's budget on every task (default: the table above)")
+    p.add_argument("--recipes", action="store_true", help="train the shipped recipes too")
+    p.add_argument("--recipe-steps", type=positive_int, default=None,
+                   help="the recipes' budget (default: each recipe's own)")
+    p.add_argument("--eval-episodes", type=positive_int, default=3,
+                   help="episodes per evaluation during training")
+    p.add_argument("--episodes", type=positive_int, default=10,
+                   help="episodes per policy in the final table")
+    p.add_argument("--eval-seed", type=seed, default=1000, help="seed of the first of them")
+    p.add_argument("--plot-only", action="store_true", help="plot and tabulate existing runs")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    p.set_defaults(func=_main)

@@ -1,0 +1,118 @@
+"""``fig8``: the paper's Fig. 8 in one call: PPO and SAC with SB3's defaults on reach, stand-up,
+self-body and catch, several seeds, and (``recipes=True``) the shipped recipes beside them.
+
+Every run goes to ``OUT/<task>/<algo>_seed<k>`` (a recipe's to ``OUT/<task>/recipe_seed<k>``),
+one env each and no worker process (``jobs`` runs train at a time, each in its own process), so
+that seeds and algorithms compete for the machine alike; runs already finished are reused, so an
+interrupted reproduction goes on where it stopped. Then, per task, ``compare.png`` /
+``compare.csv`` (:func:`~.plots.plot_compare`: return and success over steps and wall time) and
+the final models on the same seeded episodes beside random, zero and scripted
+(:func:`~.baselines.baselines`, ``baselines.md`` / ``.json``); over all tasks ``fig8.png``
+(:func:`~.plots.plot_fig8`) and ``fig8.md``, a table per task with the budgets and the machine.
+
+The budgets (:data:`FIG8_STEPS`) are what this project's 2-core machine affords: SAC makes a
+gradient step per environment step and trains at a tenth to a twentieth of PPO's speed here, so
+it gets a tenth of PPO's steps (docs/baselines.md).
+"""
+
+from __future__ import annotations
+
+import json
+import platform
+from pathlib import Path
+from typing import Mapping, Sequence
+
+from .tasks import TrainInputError
+
+__all__ = ["FIG8_TASKS", "FIG8_STEPS", "fig8"]
+
+#: the paper's four learning tasks (its Fig. 8 a-d)
+FIG8_TASKS = ("reach", "standup", "selfbody", "catch")
+#: environment steps per algorithm and task (see the module docstring)
+FIG8_STEPS = {"reach": {"ppo": 200_000, "sac": 20_000},
+              "standup": {"ppo": 100_000, "sac": 10_000},
+              "selfbody": {"ppo": 100_000, "sac": 10_000},
+              "catch": {"ppo": 100_000, "sac": 10_000}}
+ALGOS = ("ppo", "sac")
+
+
+def _runs(tasks, seeds: int, steps, out: Path, eval_episodes: int, recipes: bool,
+          recipe_steps: int | None) -> list[dict]:
+    from .recipes import load_recipe, validate_recipe
+    runs = []
+    for task in tasks:
+        for algo in ALGOS:
+            runs += [dict(task=task, algo=algo, steps=int(steps[task][algo]), seed=s,
+                          out=str(out / task / f"{algo}_seed{s}"), n_envs=1, n_cpus=0,
+                          eval_episodes=eval_episodes) for s in range(seeds)]
+        if recipes:
+            r = load_recipe(task)
+            validate_recipe(r)
+            runs += [r.train_kwargs(s, out / task / f"recipe_seed{s}", recipe_steps)
+                     for s in range(seeds)]
+    return runs
+
+
+def _machine() -> str:
+    import os
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
+
+
+def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = FIG8_TASKS, *,
+         steps: Mapping[str, Mapping[str, int]] | None = None, jobs: int = 1,
+         eval_episodes: int = 3, recipes: bool = False, recipe_steps: int | None = None,
+         episodes: int = 10, eval_seed: int = 1000, plot_only: bool = False,
+         progress: bool = True) -> Path:
+    """Train (unless ``plot_only``), plot and tabulate; returns ``OUT/fig8.png``. ``steps``:
+    ``{task: {"ppo": n, "sac": m}}`` over :data:`FIG8_STEPS`; ``episodes``: the final models'
+    evaluation episodes per policy (seeds ``eval_seed ..``)."""
+    from .baselines import baselines, markdown_table, write_json
+    from .comparison import train_all
+    from .plots import plot_compare, plot_fig8
+
+    tasks = list(tasks)
+    bad = [t for t in tasks if t not in FIG8_TASKS]
+    if bad or not tasks:
+        raise TrainInputError(f"tasks {bad or tasks}: allowed: {', '.join(FIG8_TASKS)} (the "
+                              "paper's four)")
+    seeds, jobs = int(seeds), int(jobs)
+    if seeds < 1 or jobs < 1:
+        raise TrainInputError(f"seeds={seeds}, jobs={jobs}; allowed: positive integers")
+    budget = {t: {**FIG8_STEPS[t], **dict((steps or {}).get(t, {}))} for t in tasks}
+    out = Path(out)
+    runs = _runs(tasks, seeds, budget, out, int(eval_episodes), recipes, recipe_steps)
+    if not plot_only:
+        out.mkdir(parents=True, exist_ok=True)
+        train_all(runs, jobs, "fig8", progress, skip_finished=True)
+    lines = ["# The paper's Fig. 8 on this machine", "",
+             f"Machine: {_machine()}. {seeds} seeds per algorithm; SB3 defaults, one env per "
+             "run, " + (f"{jobs} runs at a time" if jobs > 1 else "one run at a time") + ".", "",
+             f"![Fig. 8]({(out / 'fig8.png').name})", ""]
+    for task in tasks:
+        done = [r["out"] for r in runs if r["task"] == task
+                and (Path(r["out"]) / "model.zip").exists()]
+        if not done:
+            continue
+        plot_compare(out / task, task)
+        res = baselines(task, episodes, eval_seed, done, progress=progress)
+        write_json(res, out / task / "baselines.json")
+        table = markdown_table(res)
+        (out / task / "baselines.md").write_text(table)
+        b = budget[task]
+        lines += [f"## {task}", "", f"Budget: PPO {b['ppo']:,}, SAC {b['sac']:,} environment "
+                  "steps" + (f"; recipe {recipe_steps or 'its own budget'}" if recipes else "")
+                  + f". Curves: `{task}/compare.png`.", "", table]
+    png = plot_fig8(out, tasks)
+    (out / "fig8.md").write_text("\n".join(lines) + "\n")
+    (out / "fig8.json").write_text(json.dumps({"seeds": seeds, "steps": budget,
+                                               "recipes": recipes, "machine": _machine()},
+                                              indent=1))
+    return png

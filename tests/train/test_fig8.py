@@ -1,0 +1,48 @@
+"""``mimo-social fig8``: the paper's Fig. 8 in one command (issue 30): every run trained into
+``OUT/<task>/<algo>_seed<k>`` (a recipe's: ``recipe_seed<k>``), finished runs reused, one
+figure over the tasks, a compare plot and a baselines table per task."""
+
+import json
+import os
+
+import pytest
+
+from mimo_social.cli import main
+from mimo_social.train.fig8 import fig8
+from mimo_social.train.plots import runs_by_group
+from mimo_social.train.tasks import TrainInputError
+
+
+def test_fig8_trains_plots_tabulates_and_reuses_finished_runs(tmp_path):
+    out = tmp_path / "f8"
+    # PPO's smallest rollout is 2048 steps; SAC before learning_starts makes no gradient step
+    png = fig8(out, 1, ["reach"], steps={"reach": {"ppo": 2048, "sac": 64}}, episodes=1,
+               eval_episodes=1, recipes=True, recipe_steps=2048, progress=False)
+    assert png == out / "fig8.png" and png.stat().st_size > 10_000
+    task = out / "reach"
+    for run, algo in (("ppo_seed0", "ppo"), ("sac_seed0", "sac"), ("recipe_seed0", "ppo")):
+        config = json.loads((task / run / "config.json").read_text())
+        assert config["algo"] == algo and config["seed"] == 0
+        assert config.get("recipe") == ("reach" if run.startswith("recipe") else None)
+    assert json.loads((task / "ppo_seed0" / "config.json").read_text())["n_envs"] == 1
+    assert set(runs_by_group(task)) == {"ppo", "sac", "ppo recipe"}
+    assert (task / "compare.png").exists() and (task / "compare.csv").exists()
+    table = (task / "baselines.md").read_text()
+    for row in ("random", "zero", "scripted", "ppo_seed0", "sac_seed0", "recipe_seed0"):
+        assert row in table
+    text = (out / "fig8.md").read_text()
+    assert "## reach" in text and "PPO 2,048, SAC 64" in text and "cores" in text
+    stamp = os.stat(task / "sac_seed0" / "model.zip").st_mtime_ns
+    fig8(out, 1, ["reach"], steps={"reach": {"ppo": 2048, "sac": 64}}, episodes=1,
+         eval_episodes=1, recipes=True, recipe_steps=2048, progress=False)
+    assert os.stat(task / "sac_seed0" / "model.zip").st_mtime_ns == stamp
+
+
+def test_fig8_refuses_other_tasks_and_bad_counts(tmp_path, capsys):
+    with pytest.raises(TrainInputError, match="mirror"):
+        fig8(tmp_path, 1, ["mirror"])
+    with pytest.raises(TrainInputError, match="seeds=0"):
+        fig8(tmp_path, 0, ["reach"])
+    with pytest.raises(SystemExit) as e:
+        main(["fig8", "--out", str(tmp_path), "--tasks", "reach,juggle"])
+    assert e.value.code == 2 and "unknown task 'juggle'" in capsys.readouterr().err
