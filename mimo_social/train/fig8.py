@@ -12,7 +12,8 @@ the final models on the same seeded episodes beside random, zero and scripted
 
 The budgets (:data:`FIG8_STEPS`) are what this project's 2-core machine affords: SAC makes a
 gradient step per environment step and trains at a tenth to a twentieth of PPO's speed here, so
-it gets a tenth of PPO's steps (docs/baselines.md).
+it gets a fifteenth to a twentieth of PPO's steps (docs/baselines.md). Five seeds of both
+algorithms on the four tasks take about two and a half hours of one core here.
 """
 
 from __future__ import annotations
@@ -29,10 +30,10 @@ __all__ = ["FIG8_TASKS", "FIG8_STEPS", "fig8"]
 #: the paper's four learning tasks (its Fig. 8 a-d)
 FIG8_TASKS = ("reach", "standup", "selfbody", "catch")
 #: environment steps per algorithm and task (see the module docstring)
-FIG8_STEPS = {"reach": {"ppo": 200_000, "sac": 20_000},
-              "standup": {"ppo": 100_000, "sac": 10_000},
-              "selfbody": {"ppo": 100_000, "sac": 10_000},
-              "catch": {"ppo": 100_000, "sac": 10_000}}
+FIG8_STEPS = {"reach": {"ppo": 150_000, "sac": 10_000},
+              "standup": {"ppo": 100_000, "sac": 5_000},
+              "selfbody": {"ppo": 100_000, "sac": 5_000},
+              "catch": {"ppo": 100_000, "sac": 5_000}}
 ALGOS = ("ppo", "sac")
 
 
