@@ -4,8 +4,11 @@
 --seed 1000 --markdown sf.md --json sf.json`` runs each learner on the same seeded episodes of
 the paradigm (``still_face``: per phase; ``contingency``: per condition, in blocks of a live, a
 replay and a non-contingent episode; ``imitation``: per demonstrated action) and prints one
-markdown table, a column per learner; :mod:`mimo_social.train.paradigms` says what each
-learner and measure is (the measures are the task modules' own summaries).
+markdown table, a column per learner, and for still face and contingency a second one of the
+paradigm's effect (still face: the still phase's drop of smiling and gaze, their reunion
+recovery, the rise of self-touch; contingency: live minus replay and live minus non-contingent);
+:mod:`mimo_social.train.paradigms` says what each learner and measure is (the measures and
+effects are the task modules' own).
 """
 
 from __future__ import annotations
@@ -56,11 +59,14 @@ def _main(args) -> int:
 
 def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
-        "paradigm", help="a paradigm's per-phase / per-condition / per-action measures for "
-        "several learners side by side",
+        "paradigm", help="a paradigm's per-phase / per-condition / per-action measures and its "
+        "effect for several learners side by side",
         description="Run a paradigm (still_face: per phase; contingency: per condition; "
         "imitation: per demonstrated action) with each learner on the same seeded episodes and "
-        "print its measures as one markdown table, a column per learner. Learners: scripted (the "
+        "print its measures as one markdown table, a column per learner, and for still_face "
+        "and contingency a table of the paradigm's effect (still face: still-phase drop and "
+        "reunion recovery of smiling and gaze, rise of self-touch; contingency: live minus "
+        "replay, live minus non-contingent). Learners: scripted (the "
         "task's scripted infant baseline), random, zero (the resting action) or a run folder of "
         "'mimo-social train' / 'compare' (--mode scripted) on the same task.")
     p.add_argument("task", choices=PARADIGMS, help="the paradigm (a catalogue task)")

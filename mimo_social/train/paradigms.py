@@ -15,6 +15,14 @@ computed by the task's measures (``mimo_social/tasks/<task>/measures.py``, the c
 * ``imitation``: per demonstrated action the success rate, the mean return and which act the
   learner answered with.
 
+Still face and contingency also report the paradigm's effect, a difference within the same
+episodes (the task's ``measures.effects``, whose episodes give the summary above too: they are
+run once): still face, per episode, the still phase's drop of smiling and of gaze at the face,
+their recovery in reunion and the rise of self-touch; contingency, per block, live minus replay
+and live minus non-contingent of smiling, smile rate, gaze, contingency index and shared
+smiling; mean and sd over episodes (blocks). Imitation has no such effect (its measures are per
+demonstrated action, with no condition to set against another).
+
 A learner (:func:`make_learner`) is ``"scripted"`` (the catalogue's controller of the task: the
 scripted infant baseline), ``"random"`` (uniform samples of the learner's action space, seeded
 per episode), ``"zero"`` (the resting action: no motor command, the neutral face) or the folder
@@ -197,8 +205,11 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
     ``episodes``: episodes per learner (contingency: blocks of a live, a replay and a
     non-contingent episode); seeds ``seed``, ``seed + 1``, ... Returns ``task``, ``episodes``,
     ``seed``, ``env_kwargs`` and ``learners``: a list of ``{"learner", "spec", "summary"}``,
-    the summary being the task module's (see the module docstring). ``deterministic``: see
-    :func:`make_learner` (runs only)."""
+    the summary being the task module's (see the module docstring), with ``"effects"`` for
+    still face (``{name: (mean, sd)}``, the task's ``EFFECTS``) and contingency
+    (``{"live_minus_replay": {measure: (mean, sd)}, "live_minus_non_contingent": ...}``): the
+    task's ``measures.effects`` of the learner. ``deterministic``: see :func:`make_learner`
+    (runs only)."""
     if task not in PARADIGMS:
         raise TrainInputError(f"task {task!r} not allowed; allowed: {', '.join(PARADIGMS)}")
     episodes, seed = int(episodes), int(seed)
@@ -212,18 +223,27 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
         check_learner(task, s)
     kw = _env_kwargs(task, specs, env_kwargs)
     measures = entry(task).measures
+    effects = getattr(measures, "effects", None)   # still face, contingency
     results = []
     from tqdm import tqdm
     for spec in tqdm(specs, desc=f"paradigm {task}", unit="learner", disable=not progress,
                      dynamic_ncols=True):
-        env = entry(task).scripted_env(**kw)   # the learner's spaces, and its episodes
+        env = entry(task).scripted_env(**kw)   # the learner's spaces (and imitation's episodes)
         try:
             learner = make_learner(task, spec, env, model, deterministic)
-            summ = measures.run(learner, episodes, seed, env)
+            if effects is None:
+                summ = measures.run(learner, episodes, seed, env)
         finally:
             env.close()
-        results.append({"learner": getattr(learner, "name", type(learner).__name__),
-                        "spec": spec, "summary": summ})
+        row = {"learner": getattr(learner, "name", type(learner).__name__), "spec": spec}
+        if effects is None:
+            row["summary"] = summ
+        else:   # the same episodes as measures.run, their summary and the effect
+            eff = effects(learner, episodes, seed, kw)
+            row["summary"] = eff["summary"]
+            rest = {k: v for k, v in eff.items() if k not in ("summary", "return", "episodes")}
+            row["effects"] = rest.get("effects", rest)   # still face's are under "effects"
+        results.append(row)
     return {"task": task, "episodes": episodes, "seed": seed, "env_kwargs": kw,
             "deterministic": bool(deterministic), "learners": results}
 
@@ -231,7 +251,9 @@ def run_paradigm(task: str, learners: Sequence[str] = LEARNER_NAMES, episodes: i
 # -- tables -----------------------------------------------------------------------------------
 def side_by_side(result: Mapping[str, Any]) -> str:
     """:func:`run_paradigm`'s result as a markdown table: a row per measure (per phase,
-    condition or demonstrated action), a column per learner (mean +- sd over episodes)."""
+    condition or demonstrated action), a column per learner (mean +- sd over episodes); for
+    still face and contingency a second one of the paradigm's effect (a row per effect, nested
+    ones labelled ``live minus replay: <measure>``); for imitation a line saying it has none."""
     task = result["task"]
     names = [r["learner"] for r in result["learners"]]
     summaries = [r["summary"] for r in result["learners"]]
@@ -242,7 +264,27 @@ def side_by_side(result: Mapping[str, Any]) -> str:
              "", "| measure | " + " | ".join(names) + " |",
              "|---" * (len(names) + 1) + "|"]
     lines += [f"| {label} | " + " | ".join(cells) + " |" for label, cells in rows]
+    effects = [r.get("effects") for r in result["learners"]]
+    if not hasattr(measures, "effects"):
+        lines += ["", f"{task}: no paradigm effect (no condition to set against another)"]
+    if not hasattr(measures, "effects") or any(e is None for e in effects):
+        return "\n".join(lines) + "\n"
+    flat = [dict(_flat(e)) for e in effects]
+    lines += ["", f"{task}: the paradigm's effect, within each of the same "
+              f"{unit.split(' (')[0]}, mean +- sd",
+              "", "| effect | " + " | ".join(names) + " |", "|---" * (len(names) + 1) + "|"]
+    lines += [f"| {label} | " + " | ".join(f"{f[label][0]:+.3f} +- {f[label][1]:.3f}"
+                                           for f in flat) + " |" for label in flat[0]]
     return "\n".join(lines) + "\n"
+
+
+def _flat(effects: Mapping[str, Any], prefix: str = ""):
+    """(label, (mean, sd)) of an effects mapping, nested ones labelled ``outer: inner``."""
+    for key, value in effects.items():
+        if isinstance(value, Mapping):
+            yield from _flat(value, f"{prefix}{key.replace('_', ' ')}: ")
+        else:
+            yield prefix + key, value
 
 
 def to_json(result: Mapping[str, Any]) -> str:

@@ -9,6 +9,9 @@ import json
 import pytest
 
 from mimo_social import cli
+from mimo_social.envs.catalog import entry
+from mimo_social.tasks.still_face import measures as still_face_measures
+from mimo_social.tasks.still_face.controller import StillFaceInfantController
 from mimo_social.train.paradigms import run_paradigm, side_by_side
 from mimo_social.train.tasks import TrainInputError
 
@@ -22,7 +25,7 @@ def _col(result, k):
 
 
 def test_still_face_scripted_shows_the_pattern_zero_shows_nothing():
-    res = run_paradigm("still_face", ["scripted", "zero"], episodes=1, seed=0,
+    res = run_paradigm("still_face", ["scripted", "zero", "random"], episodes=2, seed=0,
                        env_kwargs=SHORT_SF)
     scripted, zero = _col(res, 0)["phases"], _col(res, 1)["phases"]
     assert scripted["interaction"]["smile"][0] > 0.9 > 0.1 > scripted["still"]["smile"][0]
@@ -32,6 +35,22 @@ def test_still_face_scripted_shows_the_pattern_zero_shows_nothing():
     table = side_by_side(res)
     assert "| still: smile | 0.00 +- 0.00 | 0.00 +- 0.00 |" in table
     assert "scripted (StillFaceInfantController)" in table
+    # the paradigm's effect (the task's measures.effects, on the same episodes), per learner
+    scripted, zero, random = (res["learners"][k]["effects"] for k in range(3))
+    assert set(scripted) == set(still_face_measures.EFFECTS)
+    # measured: smile drop 1.00, recovery 1.00; gaze drop 0.52; self-touch rise 0.44
+    assert scripted["smile_still_drop"][0] > 0.9 and scripted["smile_reunion_recovery"][0] > 0.9
+    assert scripted["gaze_still_drop"][0] > 0.3 and scripted["self_touch_still_rise"][0] > 0.3
+    assert all(v == (0.0, 0.0) for v in zero.values())
+    assert all(abs(m) < 0.3 for m, _ in random.values())      # measured within 0.00-0.22
+    assert "| smile_still_drop | +1.000 +- 0.000 | +0.000 +- 0.000 |" in table
+    # the summary is measures.run's, on the same episodes
+    env = entry("still_face").scripted_env(**SHORT_SF)
+    try:
+        again = still_face_measures.run(StillFaceInfantController(), 2, 0, env)
+    finally:
+        env.close()
+    assert again == _col(res, 0)
 
 
 def test_contingency_per_condition_and_imitation_per_action():
@@ -41,13 +60,21 @@ def test_contingency_per_condition_and_imitation_per_action():
         assert list(_col(res, k)) == ["live", "replay", "non_contingent"]
     assert _col(res, 0)["live"]["smiling_fraction"][0] > 0.3
     assert _col(res, 1)["live"]["smiling_fraction"][0] == 0.0
-    assert "| replay: contingency_index |" in side_by_side(res)
+    table = side_by_side(res)
+    assert "| replay: contingency_index |" in table
+    scripted, zero = (res["learners"][k]["effects"] for k in (0, 1))
+    assert list(scripted) == ["live_minus_replay", "live_minus_non_contingent"]
+    assert scripted["live_minus_non_contingent"]["smiling_fraction"][0] > 0.1   # measured 0.29
+    assert all(v == (0.0, 0.0) for d in zero.values() for v in d.values())
+    assert "| live minus non contingent: smiling_fraction | +0.292 +- 0.000 |" in table
 
     res = run_paradigm("imitation", ["scripted", "zero"], episodes=2, seed=0)
     scripted, zero = _col(res, 0), _col(res, 1)
     assert scripted["all"]["success"] == 1.0 and zero["all"]["success"] == 0.0
     assert zero["all"]["responses"]["none"] == 2
     assert "| all: success | 100 % of 2 | 0 % of 2 |" in side_by_side(res)
+    assert "imitation: no paradigm effect" in side_by_side(res)
+    assert "effects" not in res["learners"][0]
 
 
 def test_a_trained_run_is_a_learner_with_its_env_settings(tmp_path, capsys):
@@ -66,6 +93,10 @@ def test_a_trained_run_is_a_learner_with_its_env_settings(tmp_path, capsys):
     data = json.loads(out.read_text())
     assert data["env_kwargs"] == TINY_SF            # the run's settings, for every learner
     assert [r["spec"] for r in data["learners"]] == ["random", str(run)]
+    assert "| effect | random | sf (PPO) |" in text and "| gaze_reunion_recovery |" in text
+    effect = data["learners"][1]["effects"]       # the trained policy's still-face effect
+    assert set(effect) == set(still_face_measures.EFFECTS)
+    assert all(len(v) == 2 and -1.0 <= v[0] <= 1.0 for v in effect.values())
     # sampled actions (as in training), seeded per episode: the same twice
     a, b = (run_paradigm("still_face", [str(run)], episodes=2, seed=3, deterministic=False)
             for _ in range(2))
