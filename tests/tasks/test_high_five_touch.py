@@ -9,10 +9,10 @@ from mimo_social.core.config import ConfigError
 from mimo_social.tasks.high_five import hand_touch
 from mimo_social.core.kinematics import reach_sites
 from mimo_social.partners import Still
-from mimo_social.partners.base import zero_action
 from mimo_social.partners.hand_offer import HandOffer
 from mimo_social.tasks.high_five.controller import ArmSweep, HighFiveController
 from mimo_social.tasks.high_five.task import OFFER_AT
+from learner_episodes import learner_episode  # this folder is on the path (rootdir-less)
 
 HAND = {"right_hand", "right_fingers"}
 CLOSE = 0.35  # m between the infants in tests that put the hands together by hand
@@ -313,29 +313,6 @@ def test_without_shaping_the_reward_is_only_the_bonus():
 
 
 # -- the scripted solution, random, zero and hack policies ---------------------------------------
-def _episode(env, policy, seed):
-    """One episode of the scripted env, the learner driven by ``policy`` (a Partner, "random"
-    or "zero"); returns (success, return, steps)."""
-    obs, _ = env.reset(seed=seed)
-    inner = env.unwrapped
-    space = env.action_space("infant_0")
-    space.seed(seed)
-    if not isinstance(policy, str):
-        policy.reset(inner, "infant_0", np.random.default_rng(seed))
-    total, k = 0.0, 0
-    while env.agents:
-        if policy == "random":
-            a = space.sample()
-        elif policy == "zero":
-            a = zero_action(space)
-        else:
-            a = policy.act(inner, "infant_0", obs["infant_0"])
-        obs, r, term, trunc, info = env.step({"infant_0": a})
-        total += r["infant_0"]
-        k += 1
-    return bool(info["infant_0"]["is_success"]), total, k
-
-
 PARTNERS = {"palm_up": high_five_v0.default_partner,
             "palm_forward": lambda: HandOffer(grip=False, release=None, palm="forward",
                                               reach_to=OFFER_AT)}
@@ -344,12 +321,12 @@ PARTNERS = {"palm_up": high_five_v0.default_partner,
 @pytest.mark.parametrize("palm", list(PARTNERS))
 def test_scripted_high_five_succeeds_and_beats_zero_and_hacks(palm):
     env = high_five_v0.scripted_env(partner=PARTNERS[palm](), expressions=False)
-    ok, ret, steps = _episode(env, HighFiveController(), 1000)
+    ok, ret, steps = learner_episode(env, HighFiveController(), 1000)
     assert ok and steps < 200 and ret > 60.0
-    assert _episode(env, "zero", 1000)[:2] < (True, ret)
+    assert learner_episode(env, "zero", 1000)[:2] < (True, ret)
     for hack in (ArmSweep(), HandOffer(grip=False, release=None, palm="forward",
                                        target=(0.195, 0.105, 0.0))):   # hand in the middle
-        assert _episode(env, hack, 1000)[1] < ret - 10.0
+        assert learner_episode(env, hack, 1000)[1] < ret - 10.0
 
 
 @pytest.mark.slow
@@ -359,7 +336,7 @@ def test_twenty_episodes_scripted_random_zero_hacks(palm):
     zero in <= 15 %; the sweeping arm and the hand waiting in the middle earn less return."""
     env = high_five_v0.scripted_env(partner=PARTNERS[palm]())
     seeds = range(1000, 1020)
-    res = {name: [_episode(env, p, s) for s in seeds] for name, p in [
+    res = {name: [learner_episode(env, p, s) for s in seeds] for name, p in [
         ("scripted", HighFiveController()), ("random", "random"), ("zero", "zero"),
         ("sweep", ArmSweep()),
         ("middle", HandOffer(grip=False, release=None, palm="forward", target=(0.195, 0.105, 0)))]}

@@ -20,34 +20,15 @@ import numpy as np
 import pytest
 
 from mimo_social.envs import high_five_v0, social_touch_v0
-from mimo_social.partners.base import zero_action
 from mimo_social.partners.hand_offer import HandOffer
 from mimo_social.tasks.high_five import ArmSweep, BangBang, HighFiveController
 from mimo_social.tasks.high_five.controller import palm_depth, palm_posture
 from mimo_social.tasks.social_touch import SocialTouchController
+from learner_episodes import learner_episode  # this folder is on the path (rootdir-less)
 
 SEEDS = range(1000, 1030)
 UP = np.array([0.0, 0.0, 1.0])
 MEET = np.array([0.19, 0.0, 0.55])   # where the hands are put together (world, m)
-
-
-def _episode(env, policy, seed):
-    """One episode of a one-learner env, ``infant_0`` driven by ``policy`` (a Partner, or
-    "random" / "zero"); returns (success, return, steps)."""
-    obs, _ = env.reset(seed=seed)
-    inner = env.unwrapped
-    space = env.action_space("infant_0")
-    space.seed(seed)
-    if not isinstance(policy, str):
-        policy.reset(inner, "infant_0", np.random.default_rng(seed))
-    total, steps = 0.0, 0
-    while env.agents:
-        a = (space.sample() if policy == "random" else zero_action(space) if policy == "zero"
-             else policy.act(inner, "infant_0", obs["infant_0"]))
-        obs, r, _, _, info = env.step({"infant_0": a})
-        total += r["infant_0"]
-        steps += 1
-    return bool(info["infant_0"]["is_success"]), total, steps
 
 
 # -- high five: flailing fails, the scripted high five succeeds ------------------------------------
@@ -56,7 +37,7 @@ def test_random_bang_bang_rarely_makes_a_high_five(hold):
     """Each motor at a bound, the side drawn at random every ``hold`` steps, against the default
     scripted partner: at most 15 % of 30 episodes (measured: 0, 1 and 1 / 30 for 1, 5, 20)."""
     env = high_five_v0.scripted_env()
-    wins = sum(_episode(env, BangBang(hold), s)[0] for s in SEEDS)
+    wins = sum(learner_episode(env, BangBang(hold), s)[0] for s in SEEDS)
     assert wins <= 4, wins
 
 
@@ -65,14 +46,14 @@ def test_the_first_versions_rule_lets_flailing_through():
     skins feel, one step) the same bang-bang, held 5 steps, meets the partner's hand in most
     episodes (measured 25 / 30)."""
     env = high_five_v0.scripted_env(task_options={"success": "touch"})
-    wins = sum(_episode(env, BangBang(5), s)[0] for s in SEEDS)
+    wins = sum(learner_episode(env, BangBang(5), s)[0] for s in SEEDS)
     assert wins >= 10, wins
 
 
 def test_the_scripted_high_five_meets_palm_to_palm():
     env = high_five_v0.scripted_env()
     for seed in range(1000, 1004):
-        ok, ret, steps = _episode(env, HighFiveController(), seed)
+        ok, ret, steps = learner_episode(env, HighFiveController(), seed)
         assert ok and ret > 60.0 and steps < 250, (seed, ret, steps)
     assert env.unwrapped.task.options.success == "palms"
 
@@ -82,7 +63,7 @@ def test_thirty_episodes_scripted_random_bang_bang_and_hacks():
     """Seeds 1000-1029: the scripted high five >= 80 % (measured 100 %), random, zero and
     bang-bang <= 15 %; every other policy earns less return than the scripted one."""
     env = high_five_v0.scripted_env()
-    res = {name: [_episode(env, p(), s) for s in SEEDS] for name, p in [
+    res = {name: [learner_episode(env, p(), s) for s in SEEDS] for name, p in [
         ("scripted", HighFiveController), ("random", lambda: "random"),
         ("zero", lambda: "zero"), ("bang-bang", BangBang), ("bang-bang 5", lambda: BangBang(5)),
         ("sweep", ArmSweep),
@@ -313,7 +294,7 @@ def test_the_moved_partner_pickles_and_continues_exactly():
 
 def test_the_scripted_toucher_succeeds_from_random_starts():
     env = social_touch_v0.scripted_env()
-    wins = sum(_episode(env, SocialTouchController(), s)[0] for s in range(1000, 1008))
+    wins = sum(learner_episode(env, SocialTouchController(), s)[0] for s in range(1000, 1008))
     assert wins >= 7, wins
 
 
@@ -321,14 +302,14 @@ def test_random_and_zero_touchers_fail_from_random_starts():
     """Seeds 1000-1029: at most 15 % each (measured: random 1 / 30, zero 0 / 30)."""
     env = social_touch_v0.scripted_env()
     for policy in ("random", "zero"):
-        wins = sum(_episode(env, policy, s)[0] for s in SEEDS)
+        wins = sum(learner_episode(env, policy, s)[0] for s in SEEDS)
         assert wins <= 4, (policy, wins)
 
 
 @pytest.mark.slow
 def test_thirty_episodes_scripted_toucher_from_random_starts():
     env = social_touch_v0.scripted_env()
-    wins = sum(_episode(env, SocialTouchController(), s)[0] for s in SEEDS)
+    wins = sum(learner_episode(env, SocialTouchController(), s)[0] for s in SEEDS)
     assert wins >= 24, wins                                        # measured 29 / 30
 
 
