@@ -1,4 +1,8 @@
-"""The contingency paradigm (live, replay, non-contingent caregiver) through its public API."""
+"""The contingency paradigm (live, replay, non-contingent caregiver) through its public API.
+
+By default (``gaze_free``) the learner's head and eyes are its own (9 motors): the test learners
+here keep them at rest (a zero motor command) unless they look at the caregiver's face.
+"""
 
 import numpy as np
 import pytest
@@ -6,18 +10,21 @@ import pytest
 from mimo_social.envs import contingency_v0
 from mimo_social.expressions.faces import EXPRESSIONS
 from mimo_social.partners import Partner
+from mimo_social.partners.base import zero_action
+from mimo_social.partners.gaze import GazeAtTarget
 from mimo_social.tasks.contingency.controller import ContingencyDetectorController
 from mimo_social.tasks.contingency import CONDITIONS
 from mimo_social.tasks.contingency.measures import condition_summary
 from mimo_social.util.checks import ConfigError
 
 HAPPY = EXPRESSIONS.index("happy")
-NO_MOTORS = np.zeros(0, np.float32)
 FAST = {"per_agent": [{"vision": False}, {}]}     # the measures need no rendering
+HELD = {"gaze_free": False}                       # the held variant: head and eyes on the face
 
 
-def act(face):
-    return {"motors": NO_MOTORS, "expression": np.int64(face)}
+def act(env, agent, face):
+    """The face ``face`` and a zero motor command (head and eyes at rest, if free)."""
+    return dict(zero_action(env.action_space(agent)), expression=np.int64(face))
 
 
 class Pulses(Partner):
@@ -31,7 +38,7 @@ class Pulses(Partner):
 
     def act(self, env, agent, observation):
         self.t += 1
-        return act(HAPPY if (self.t + self.offset) % self.period < self.on else 0)
+        return act(env, agent, HAPPY if (self.t + self.offset) % self.period < self.on else 0)
 
 
 class Random(Partner):
@@ -39,7 +46,25 @@ class Random(Partner):
         self.rng = np.random.default_rng(7)
 
     def act(self, env, agent, observation):
-        return act(int(self.rng.integers(len(EXPRESSIONS))))
+        return act(env, agent, int(self.rng.integers(len(EXPRESSIONS))))
+
+
+class LooksAtFace(Partner):
+    """``face_of``'s face, head and eyes turned to the caregiver's face with their own motors
+    (:class:`GazeAtTarget`): a face-only strategy under the default free gaze."""
+
+    def __init__(self, face_of):
+        self.face_of = face_of
+        self.gaze = GazeAtTarget(targets=["infant_1/head_centre"], hold_s=(3600.0, 3600.0),
+                                 head_share=1.0)
+
+    def reset(self, env, agent, rng):
+        self.face_of.reset(env, agent, rng)
+        self.gaze.reset(env, agent, np.random.default_rng(0))
+
+    def act(self, env, agent, observation):
+        face = self.face_of.act(env, agent, observation)["expression"]
+        return dict(self.gaze.act(env, agent, observation), expression=face)
 
 
 def run(env, learner, condition, seed=0, rng_seed=0):
@@ -70,9 +95,15 @@ def test_options_conditions_and_bodies():
     assert (cfg[0].body, cfg[0].posture, cfg[1].body, cfg[1].posture) == \
         ("infant", "standing", "adult", "kneeling")
     space = env.observation_space("infant_0")
-    assert space["eye_left"].shape == (64, 64, 3) and space["proprioception"].shape == (0,)
-    assert env.action_space("infant_0")["motors"].shape == (0,)
+    # by default the learner's head and eyes are free: 9 motors, 54 proprioceptive floats
+    assert space["eye_left"].shape == (64, 64, 3) and space["proprioception"].shape == (54,)
+    motors = env.action_space("infant_0")["motors"]
+    assert motors.shape == (9,) and (motors.low == -1).all() and (motors.high == 1).all()
     assert env.action_space("infant_0")["expression"].n == len(EXPRESSIONS)
+    # held (gaze_free=False): no motor, no proprioception
+    held = contingency_v0.parallel_env(task_options=HELD)
+    assert held.observation_space("infant_0")["proprioception"].shape == (0,)
+    assert held.action_space("infant_0")["motors"].shape == (0,)
     # an infant caregiver stands; the scripted caregiver has no eyes
     s = contingency_v0.scripted_env(per_agent=[{}, {"body": "infant"}]).unwrapped
     assert (s.agent_configs[1].body, s.agent_configs[1].posture) == ("infant", "standing")
@@ -156,7 +187,8 @@ def test_scripted_detector_smiles_more_and_detects_contingency_in_live():
 
 def test_success_and_reward_free():
     """Live: the detector succeeds, the zero action (neutral) and a random face do not; with
-    reward_free every reward is 0 and the measures are the same."""
+    reward_free every reward is 0 and the measures are the same; the gaze measure tells the
+    detector, which looks at the face, from the others."""
     finals = {}
     for free in (False, True):
         env = contingency_v0.scripted_env(task_options={"reward_free": free}, **FAST)
@@ -175,18 +207,25 @@ def test_success_and_reward_free():
     assert finals[False, "detector"]["is_success"]
     assert not finals[False, "zero"]["is_success"] and not finals[False, "random"]["is_success"]
     assert finals[False, "random"]["shared_fraction"] < 0.16
+    # the gaze measure is the learner's (free gaze, the default): the detector turns to the
+    # caregiver's face, the zero action and a random face with head and eyes at rest do not
+    assert finals[False, "detector"]["gaze_fraction"] > 0.95
+    assert finals[False, "zero"]["gaze_fraction"] == finals[False, "random"]["gaze_fraction"] == 0
     for name in ("detector", "zero", "random"):
         assert finals[False, name] == finals[True, name]
 
 
-def hack_figures(episodes=20, seed=1000):
+def hack_figures(episodes=20, seed=1000, held=False):
     """Live, seeds ``seed ..``: per policy (successes, return mean, return sd); the learner's
-    eyes off (no policy here reads them)."""
+    eyes off (no policy here reads them). The face hacks turn head and eyes to the caregiver's
+    face (the detector does so itself); ``held``: the held variant, every gaze on the face."""
     from mimo_social.tasks.mirror.controller import MirrorController
-    policies = {"always happy": Pulses(10, 10), "copies the caregiver": MirrorController(),
-                "1-step dip every 0.5 s": Pulses(50, 49),
+    looks = (lambda p: p) if held else LooksAtFace
+    policies = {"always happy": looks(Pulses(10, 10)),
+                "copies the caregiver": looks(MirrorController()),
+                "1-step dip every 0.5 s": looks(Pulses(50, 49)),
                 "detector": ContingencyDetectorController()}
-    env = contingency_v0.scripted_env(**FAST)
+    env = contingency_v0.scripted_env(task_options={"gaze_free": not held}, **FAST)
     out = {}
     for name, policy in policies.items():
         finals = [run(env, policy, "live", seed=s, rng_seed=s)[1]
@@ -202,9 +241,12 @@ def test_hacks_score_less_than_the_detector():
     figures = hack_figures()
     assert figures["always happy"][0] == figures["copies the caregiver"][0] == 0
     assert figures["detector"][0] >= 16
-    assert figures["always happy"][1] < figures["detector"][1] < figures["1-step dip every 0.5 s"][1]
+    dips = figures["1-step dip every 0.5 s"][1]
+    assert figures["always happy"][1] < figures["detector"][1] < dips
 
 
-if __name__ == "__main__":   # the hack figures of the task's table
-    for name, (ok, mean, sd) in hack_figures().items():
-        print(f"{name}: {ok} / 20 successes, return {mean:.1f} +- {sd:.1f}")
+if __name__ == "__main__":   # the hack figures of the task's table (default, then held)
+    for held in (False, True):
+        print("held (gaze_free=False)" if held else "default (gaze_free)")
+        for name, (ok, mean, sd) in hack_figures(held=held).items():
+            print(f"  {name}: {ok} / 20 successes, return {mean:.1f} +- {sd:.1f}")

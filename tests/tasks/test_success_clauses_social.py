@@ -53,7 +53,7 @@ still_face (the engaged steps reach ``success_fraction`` of the interaction and 
 contingency (the shared-smile steps reach ``success_fraction`` of ``max_steps``):
   - a shared step needs the learner's smile (existing: the detector's live run) and the
     caregiver's: ``test_contingency_a_shared_smile_needs_both_faces_happy``;
-  - and the learner's gaze on the face (``gaze_free``):
+  - and the learner's gaze on the face (``gaze_free``, the default):
     ``test_contingency_a_shared_smile_needs_the_learners_gaze_on_the_face``;
   - ``success_fraction`` of ``max_steps``, "reach":
     ``test_contingency_success_is_the_shared_share_of_max_steps``;
@@ -385,13 +385,18 @@ def _dips(env):
 
 
 class Faces(Partner):
-    """A learner without motors (the held gaze) that shows ``face(env)``."""
+    """A learner that shows ``face(env)``, its motors (if any) at rest; with the held gaze
+    (``HELD``) it has none."""
 
     def __init__(self, face):
         self.face = face
 
     def act(self, env, agent, observation):
         return dict(zero_action(env.action_space(agent)), expression=np.int64(self.face(env)))
+
+
+#: the held variant (``gaze_free=False``): the learner's head and eyes held on the face
+HELD = {"gaze_free": False}
 
 
 def _contingency(learner, max_steps, **options):
@@ -411,33 +416,33 @@ def _contingency(learner, max_steps, **options):
 
 
 def test_contingency_a_shared_smile_needs_both_faces_happy():
-    """Clauses 'the learner smiles' and 'the caregiver smiles' (the gaze held on the face): a
+    """Clauses 'the learner smiles' and 'the caregiver smiles' (held gaze): a
     learner that bids with 0.2-s smiles every second shares exactly the steps on which both
     faces are happy (the caregiver's answers outlast its smiles: steps with one face happy
     alone, either one, are not shared); a learner that smiles all the time is answered once
     (1 s of 10, the caregiver answering every onset here) and fails, though it smiles on every
     step."""
-    steps = _contingency(Faces(lambda env: HAPPY if env.unwrapped.steps % 100 < 20 else 0), 1000)
+    steps = _contingency(Faces(lambda env: HAPPY if env.unwrapped.steps % 100 < 20 else 0), 1000,
+                         **HELD)
     shared = [i["shared"] for i, _ in steps]
     assert shared == [a and b for _, (a, b) in steps]
     assert steps[-1][0]["shared_steps"] == sum(shared) > 0
     assert any(a and not b for _, (a, b) in steps) and any(b and not a for _, (a, b) in steps)
-    steps = _contingency(Faces(lambda env: HAPPY), 1000, response_probability=1.0)
+    steps = _contingency(Faces(lambda env: HAPPY), 1000, response_probability=1.0, **HELD)
     last = steps[-1][0]
     assert all(a for _, (a, _) in steps) and last["smiling_fraction"] == 1.0
     assert 0 < last["shared_steps"] <= 110 and not last["is_success"]
 
 
 def test_contingency_a_shared_smile_needs_the_learners_gaze_on_the_face():
-    """Clause 'the learner's gaze on the caregiver's face' (``gaze_free``: the learner's own
-    head and eyes): the same smiles, renewed every 0.5 s, looking at the caregiver's face share
-    most steps and succeed; looking at its own hand they share none and fail, though both faces
-    are happy on most steps."""
-    free = {"gaze_free": True}
-    looks = _contingency(Looks("infant_1/head_centre", _dips), 300, **free)
+    """Clause 'the learner's gaze on the caregiver's face' (``gaze_free``, the default: the
+    learner's own head and eyes): the same smiles, renewed every 0.5 s, looking at the
+    caregiver's face share most steps and succeed; looking at its own hand they share none and
+    fail, though both faces are happy on most steps."""
+    looks = _contingency(Looks("infant_1/head_centre", _dips), 300)
     assert looks[-1][0]["gaze_fraction"] > 0.8 and looks[-1][0]["shared_fraction"] > 0.6
     assert looks[-1][0]["is_success"]
-    away = _contingency(Looks("infant_0/right_hand", _dips), 300, **free)
+    away = _contingency(Looks("infant_0/right_hand", _dips), 300)
     assert sum(a and b for _, (a, b) in away) > 150
     assert away[-1][0]["gaze_fraction"] == 0.0 and away[-1][0]["shared_steps"] == 0
     assert not any(i["is_success"] for i, _ in away)
@@ -448,7 +453,7 @@ def test_contingency_success_is_the_shared_share_of_max_steps(max_steps, fractio
     """Clause 'the shared-smile steps reach success_fraction of the episode's max_steps':
     ``is_success`` turns True on the step on which they reach ceil(fraction x max_steps), not
     one step before."""
-    steps = _contingency(Faces(_dips), max_steps, success_fraction=fraction)
+    steps = _contingency(Faces(_dips), max_steps, success_fraction=fraction, **HELD)
     need = math.ceil(fraction * max_steps)
     assert steps[-1][0]["shared_steps"] > need + 10
     for i, _ in steps:

@@ -10,7 +10,7 @@ estimates:
     before) in which the other begins to smile; with prior counts (1 of 2 smiles answered, 1 of 4
     windows hit: an estimate of 0.25 at the start)
 looks:
-    with head and eye motors (the task option ``gaze_free``) at the other's face, all the time:
+    with head and eye motors (the task option ``gaze_free``, on by default) at the other's face:
     :class:`~mimo_social.partners.gaze.GazeAtTarget`'s PD law on its head and eye motors, target
     the other's ``head_centre`` site (its other motors, if any, at rest); without them its gaze
     is the task's to hold

@@ -38,7 +38,7 @@ class ContingencyOptions(TaskOptions):
     """The condition (live, replay, non-contingent), the distance between the faces (m), the
     scripted caregiver's response delay (s) and probability, the contingency index's window (s),
     the share of shared-smile steps for success, reward-free mode, whether the learner's head
-    and eyes are free (``gaze_free``) and whether ``infant_1`` is the scripted caregiver (no
+    and eyes are free (``gaze_free``, on) and whether ``infant_1`` is the scripted caregiver (no
     eyes, no reward)."""
 
     task = "contingency"
@@ -51,7 +51,7 @@ class ContingencyOptions(TaskOptions):
     window_s: float = 1.5
     success_fraction: float = 0.2
     reward_free: bool = False
-    gaze_free: bool = False
+    gaze_free: bool = True
     scripted_partner: bool = False
 
     def __post_init__(self):
