@@ -106,6 +106,12 @@ BAD = [
     (["paradigm", "still_face", "--env-kwargs", '{"bogus": 1}'], "--env-kwargs"),
     (["paradigm", "still_face", "--model", "worst"], "--model"),
     (["paradigm", "still_face", "--json", "{file}/x.json"], "--json"),
+    (["recipe", "reach", "--jobs", "0", "--out", "{dir}/r"], "--jobs"),
+    (["recipe", "reach", "--episodes", "0", "--out", "{dir}/r"], "--episodes"),
+    (["recipe", "reach", "--out", "{file}/x"], "--out"),
+    (["fig8", "--out", "{dir}/f", "--seeds", "0"], "--seeds"),
+    (["fig8", "--out", "{dir}/f", "--tasks", "mirror"], "--tasks"),
+    (["fig8", "--out", "{dir}/f", "--sac-steps", "-5"], "--sac-steps"),
 ]
 
 
