@@ -176,7 +176,8 @@ def _curves(ax, runs, xkey: str, xscale: float, key: str, scale: float, color, l
     end = min(p[xkey][-1] for _, p in runs)
     grid = np.unique(np.concatenate([p[xkey][p[xkey] <= end] for _, p in runs]))
     ys = np.array([np.interp(grid, p[xkey], p[key]) for _, p in runs]) * scale
-    ax.plot(grid / xscale, np.nanmean(ys, axis=0), color=color, lw=2, label=label, ls=ls)
+    ax.plot(grid / xscale, np.nanmean(ys, axis=0), color=color, lw=2, label=label, ls=ls,
+            marker="o", ms=3)   # (a marker: a run evaluated once is a point, not a line)
     ax.fill_between(grid / xscale, np.nanmin(ys, axis=0), np.nanmax(ys, axis=0), color=color,
                     alpha=0.15, lw=0)
 
