@@ -25,7 +25,8 @@ The modules, each one concern (each imports only those above it in this list):
 ``lockstep``    one ParallelEnv stepped by one learner thread per agent
 ``single``      one learner; ``independent`` / ``multi``: the multi-agent modes
 ``runner``      :func:`train`, the entry point; ``evaluation``: :func:`evaluate`;
-``comparison``  :func:`compare`
+``comparison``  :func:`compare`; ``recipes``: the shipped per-task recipes and their check;
+``fig8``        the paper's Fig. 8 (PPO and SAC on its four tasks, several seeds) in one call
 ``vector``      SB3 vector envs with parameter sharing (imports SB3; not imported here)
 ``obs_norm``    ``RunningNorm``, input normalisation inside the policy (imports torch)
 
