@@ -9,7 +9,7 @@ an interrupted reproduction goes on), then writes ``OUT/fig8.png``, ``OUT/fig8.m
 from __future__ import annotations
 
 from ..train.fig8 import FIG8_STEPS, FIG8_TASKS, fig8
-from ._args import comma_choices, output_dir, positive_int, seed
+from ._args import comma_choices, non_negative_int, output_dir, positive_int, seed
 
 __all__ = ["add_parser"]
 
@@ -47,8 +47,9 @@ def add_parser(subparsers) -> None:
                    help="the recipes' budget (default: each recipe's own)")
     p.add_argument("--eval-episodes", type=positive_int, default=3,
                    help="episodes per evaluation during training")
-    p.add_argument("--episodes", type=positive_int, default=10,
-                   help="episodes per policy in the final table")
+    p.add_argument("--episodes", type=non_negative_int, default=10,
+                   help="episodes per policy in the final table (0: each run's last evaluation "
+                   "during training instead)")
     p.add_argument("--eval-seed", type=seed, default=1000, help="seed of the first of them")
     p.add_argument("--plot-only", action="store_true", help="plot and tabulate existing runs")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")

@@ -67,6 +67,26 @@ def _machine() -> str:
     return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
+def _final_table(folder: Path, runs: list[dict], task: str) -> str:
+    """Each finished run's last evaluation (its progress.csv), a markdown table."""
+    import csv
+    lines = ["| run | steps | wall time | evaluation episodes | success, mean action | "
+             "success, sampled | return, mean action |", "|---|---|---|---|---|---|---|"]
+    for r in runs:
+        run = Path(r["out"])
+        if r["task"] != task or not (run / "progress.csv").exists():
+            continue
+        with open(run / "progress.csv") as f:
+            last = list(csv.DictReader(f))[-1]
+        pct = {k: (f"{float(last[k]):.0%}" if last.get(k) not in (None, "", "nan") else "n/a")
+               for k in ("eval_success_rate", "eval_success_rate_stochastic")}
+        lines.append(f"| {run.name} | {int(float(last['timesteps'])):,} | "
+                     f"{float(last['wall_time_s']) / 60:.1f} min | {last.get('eval_episodes', '')} "
+                     f"| {pct['eval_success_rate']} | {pct['eval_success_rate_stochastic']} | "
+                     f"{float(last['eval_return_mean']):.1f} |")
+    return "\n".join(lines) + "\n"
+
+
 def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = FIG8_TASKS, *,
          steps: Mapping[str, Mapping[str, int]] | None = None, jobs: int = 1,
          eval_episodes: int = 3, recipes: bool = False, recipe_steps: int | None = None,
@@ -74,7 +94,8 @@ def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = F
          progress: bool = True) -> Path:
     """Train (unless ``plot_only``), plot and tabulate; returns ``OUT/fig8.png``. ``steps``:
     ``{task: {"ppo": n, "sac": m}}`` over :data:`FIG8_STEPS`; ``episodes``: the final models'
-    evaluation episodes per policy (seeds ``eval_seed ..``)."""
+    evaluation episodes per policy (seeds ``eval_seed ..``; 0: no such table, each run's last
+    evaluation during training instead)."""
     from .baselines import baselines, markdown_table, write_json
     from .comparison import train_all
     from .plots import plot_compare, plot_fig8
@@ -103,10 +124,12 @@ def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = F
         if not done:
             continue
         plot_compare(out / task, task)
-        res = baselines(task, episodes, eval_seed, done, progress=progress)
-        write_json(res, out / task / "baselines.json")
-        table = markdown_table(res)
-        (out / task / "baselines.md").write_text(table)
+        table = _final_table(out / task, runs, task)
+        if episodes > 0:
+            res = baselines(task, episodes, eval_seed, done, progress=progress)
+            write_json(res, out / task / "baselines.json")
+            table = markdown_table(res)
+            (out / task / "baselines.md").write_text(table)
         b = budget[task]
         lines += [f"## {task}", "", f"Budget: PPO {b['ppo']:,}, SAC {b['sac']:,} environment "
                   "steps" + (f"; recipe {recipe_steps or 'its own budget'}" if recipes else "")

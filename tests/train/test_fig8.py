@@ -36,6 +36,14 @@ def test_fig8_trains_plots_tabulates_and_reuses_finished_runs(tmp_path):
     fig8(out, 1, ["reach"], steps={"reach": {"ppo": 2048, "sac": 64}}, episodes=1,
          eval_episodes=1, recipes=True, recipe_steps=2048, progress=False)
     assert os.stat(task / "sac_seed0" / "model.zip").st_mtime_ns == stamp
+    # --episodes 0: no evaluation run, each run's last evaluation during training tabulated
+    (task / "baselines.md").unlink()
+    fig8(out, 1, ["reach"], steps={"reach": {"ppo": 2048, "sac": 64}}, episodes=0,
+         eval_episodes=1, recipes=True, recipe_steps=2048, plot_only=True, progress=False)
+    assert not (task / "baselines.md").exists()
+    text = (out / "fig8.md").read_text()
+    for row in ("| ppo_seed0 | 2,048 |", "| sac_seed0 | 64 |", "| recipe_seed0 | 2,048 |"):
+        assert row in text
 
 
 def test_fig8_refuses_other_tasks_and_bad_counts(tmp_path, capsys):
