@@ -45,7 +45,7 @@ def _main(args) -> int:
         raise ValueError("give a recipe (a task name or a .toml file) and --out DIR, or --list")
     res = check_recipe(args.recipe, _seeds(args.seeds), args.out, jobs=args.jobs,
                        episodes=args.episodes, eval_seed=args.eval_seed, steps=args.steps,
-                       progress=not args.no_progress)
+                       model=args.model, progress=not args.no_progress)
     print(recipe_markdown(res), end="")
     print(f"wrote {args.out}/recipe.md and {args.out}/recipe.json")
     return 0
@@ -72,6 +72,9 @@ def add_parser(subparsers) -> None:
                    help="evaluation episodes per policy (default 30)")
     p.add_argument("--eval-seed", type=seed, default=1000,
                    help="seed of the first evaluation episode (default 1000)")
+    p.add_argument("--model", choices=("final", "best"), default=None,
+                   help="judge each run's final model or its best evaluated one (default: the "
+                   "recipe's 'model', final unless it says best)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.set_defaults(func=_main)
 

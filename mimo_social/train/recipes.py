@@ -11,13 +11,16 @@ task, ``mimo_social/train/recipes/<task>.toml``::
     steps = 600000
     mode = "scripted"            # a social task: one learner, the partner scripted
     status = "2/2 seeds at 100 % (docs/baselines.md)"   # what was measured, where
+    model = "final"              # or "best": the model judged (best_model.zip: best evaluation)
     [train]                      # train()'s keyword arguments
     n_envs = 1
     curriculum = "selfbody"
 
 Every key is checked before anything runs (:func:`load_recipe`; ``[train]`` keys against
 ``train``'s own, with the closest one named). :func:`check_recipe` is the issue's test of a
-recipe: train it with each seed (runs already there are reused), then run every final model on
+recipe: train it with each seed (runs already there are reused), then run every final model (or,
+with ``model = "best"``, each run's ``best_model.zip``: the best mean evaluation return during
+training, early stopping by evaluation) on
 the same ``episodes`` seeded episodes, deterministically and with sampled actions, beside the
 task's scripted controller, random and zero (:func:`~.baselines.baselines`); a seed passes when
 its success rate reaches ``share`` (0.8) of the scripted controller's. It writes
@@ -42,7 +45,9 @@ __all__ = ["Recipe", "DIRECTORY", "shipped_recipes", "load_recipe", "recipe_runs
 
 #: where the shipped recipes live (package data)
 DIRECTORY = Path(__file__).parent / "recipes"
-TOP_KEYS = ("task", "description", "algo", "steps", "mode", "status", "train")
+TOP_KEYS = ("task", "description", "algo", "steps", "mode", "status", "model", "train")
+#: the model a recipe is judged by: the final one, or the best evaluated during training
+MODELS = ("final", "best")
 #: ``train`` keywords a recipe does not set (the command's own, or the top-level keys)
 NOT_RECIPE = ("task", "algo", "steps", "seed", "out", "progress", "verbose", "mode", "recipe")
 #: a seed passes when its success reaches this share of the scripted controller's (issue 30)
@@ -60,6 +65,7 @@ class Recipe:
     description: str = ""
     status: str = ""
     source: str = ""
+    model: str = "final"
 
     def train_kwargs(self, seed: int, out: str | Path, steps: int | None = None,
                      progress: bool = True) -> dict:
@@ -122,6 +128,11 @@ def load_recipe(spec: str | Path) -> Recipe:
         mode = check_mode(task, raw.get("mode"))
     except TrainInputError as e:
         raise TrainInputError(f"{where}: {e}") from None
+    model = raw.get("model", "final")
+    if model not in MODELS:
+        raise TrainInputError(f"{where}: model={model!r}; allowed: {', '.join(MODELS)} (the "
+                              "final model, or best_model.zip: the best mean evaluation return "
+                              "during training)")
     train = raw.get("train", {})
     if not isinstance(train, dict):
         raise TrainInputError(f"{where}: [train] must be a table of train()'s keyword arguments")
@@ -132,7 +143,7 @@ def load_recipe(spec: str | Path) -> Recipe:
     return Recipe(name=path.stem if path.parent == DIRECTORY else str(path), task=task,
                   algo=algo, steps=steps, mode=mode, train=dict(train),
                   description=str(raw.get("description", "")), status=str(raw.get("status", "")),
-                  source=str(path))
+                  source=str(path), model=model)
 
 
 def validate_recipe(recipe: Recipe) -> None:
@@ -168,10 +179,10 @@ def _wall(run: Path) -> float:
 def check_recipe(spec: str | Path, seeds: Sequence[int] = (0, 1), out: str | Path = "runs/recipe",
                  *, jobs: int = 1, episodes: int = 30, eval_seed: int = 1000,
                  steps: int | None = None, share: float = PASS_SHARE,
-                 progress: bool = True) -> dict:
+                 model: str | None = None, progress: bool = True) -> dict:
     """Train the recipe with every seed (runs already in ``OUT/seed<k>`` reused), evaluate the
     final models beside the scripted controller and write ``OUT/recipe.md`` and ``.json``;
-    returns what it wrote."""
+    returns what it wrote. ``model``: ``final`` or ``best`` (default: the recipe's own)."""
     from .baselines import baselines
     from .comparison import finished, train_all
 
@@ -190,7 +201,11 @@ def check_recipe(spec: str | Path, seeds: Sequence[int] = (0, 1), out: str | Pat
                                   f"{run['steps']} steps; give another --out")
     out.mkdir(parents=True, exist_ok=True)
     train_all(runs, jobs, f"recipe {recipe.name}", progress, skip_finished=True)
-    res = baselines(recipe.task, episodes, eval_seed, [r["out"] for r in runs], progress=progress)
+    model = model or recipe.model
+    if model not in MODELS:
+        raise TrainInputError(f"model={model!r}; allowed: {', '.join(MODELS)}")
+    res = baselines(recipe.task, episodes, eval_seed, [r["out"] for r in runs], model=model,
+                    progress=progress)
     scripted = next((p for p in res["policies"] if p["kind"] == "scripted"), None)
     target = share * scripted["success_rate"] if scripted else float("nan")
     rows = []
@@ -200,7 +215,7 @@ def check_recipe(spec: str | Path, seeds: Sequence[int] = (0, 1), out: str | Pat
             Path(run["out"])), "success": det, "success_sampled": sampled,
             "return": p["return_mean"], "return_sampled": p["stochastic"]["return_mean"],
             "passes": bool(det >= target), "passes_sampled": bool(sampled >= target)})
-    result = {"recipe": recipe.name, "task": recipe.task, "algo": recipe.algo,
+    result = {"recipe": recipe.name, "task": recipe.task, "algo": recipe.algo, "model": model,
               "mode": recipe.mode, "train": recipe.train, "episodes": episodes,
               "eval_seeds": res["seeds"], "scripted_success": scripted["success_rate"]
               if scripted else None, "target": target, "share": share, "seeds": rows,
@@ -224,7 +239,8 @@ def recipe_markdown(result: Mapping[str, Any]) -> str:
                (False, True): "passes with sampled actions only",
                (False, False): "does not pass"}[(result["passes"], result["passes_sampled"])]
     lines = [f"Recipe `{result['recipe']}` ({result['task']}, {result['algo'].upper()}"
-             + (f", mode {result['mode']}" if result["mode"] else "") + f"): {verdict}. "
+             + (f", mode {result['mode']}" if result["mode"] else "")
+             + f", {result.get('model', 'final')} model): {verdict}. "
              f"Target: {_pct(result['target'])} success ({result['share']:.0%} of the scripted "
              f"controller's {_pct(result['scripted_success'])}), {result['episodes']} episodes "
              f"(seeds {result['eval_seeds'][0]}..{result['eval_seeds'][1]}).", "",

@@ -42,6 +42,7 @@ def _write(tmp_path, text, name="r.toml"):
     ('algo = "ppo"\nsteps = 10\ntask = "reach"\nmode = "scripted"\n', ["mode"]),
     ('algo = "ppo"\nsteps = 10\ntask = "juggle"\n', ["juggle"]),
     ('algo = "ppo"\nsteps = 10\ntask = "reach"\n[train]\nmode = "x"\n', ["'mode'"]),
+    ('algo = "ppo"\nsteps = 10\ntask = "reach"\nmodel = "last"\n', ["model='last'", "best"]),
 ])
 def test_a_bad_recipe_is_refused_naming_the_key_and_what_is_allowed(tmp_path, text, words):
     with pytest.raises(TrainInputError) as e:
@@ -92,6 +93,9 @@ def test_check_recipe_trains_each_seed_judges_it_and_reuses_finished_runs(tmp_pa
     again = check_recipe(spec, [0], out, episodes=3, eval_seed=1000, progress=False)
     assert os.stat(out / "seed0" / "model.zip").st_mtime_ns == stamp
     assert again["seeds"][0]["success"] == res["seeds"][0]["success"]
+    best = check_recipe(spec, [0], out, episodes=3, eval_seed=1000, model="best", progress=False)
+    assert best["model"] == "best" and "best model" in (out / "recipe.md").read_text()
+    assert best["baselines"]["policies"][-1]["model"].endswith("best_model.zip")
     # another budget in the same folder is another run: refused, not overwritten
     with pytest.raises(TrainInputError, match="another --out"):
         check_recipe(spec, [0], out, steps=192, episodes=1, progress=False)
