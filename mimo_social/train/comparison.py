@@ -14,6 +14,7 @@ one set for every algorithm or one per algorithm (``{"ppo": {"n_steps": 512}, "s
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 from typing import Any, Mapping
@@ -104,7 +105,10 @@ def train_all(runs: list[dict], jobs: int = 1, desc: str = "train",
         runs = [kw for kw in runs if not finished(kw)]
     if int(jobs) <= 1:
         for kw in runs:
-            train(**kw)
+            if train(**kw).get("interrupted"):   # Ctrl-C / SIGTERM: the run saved, stop here
+                print(f"{desc}: interrupted in {kw['out']}; the runs after it not started",
+                      file=sys.stderr)
+                return
         return
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor

@@ -108,3 +108,19 @@ def test_the_command_lists_the_recipes_and_refuses_bad_seeds(capsys):
         assert f"| {name} |" in text
     assert main(["recipe", "reach", "--seeds", "x", "--out", "/tmp/r"]) == 2
     assert "'x' is not a seed" in capsys.readouterr().err
+
+
+def test_an_interrupted_run_stops_the_runs_after_it(monkeypatch, capsys):
+    """Ctrl-C / SIGTERM during one run of a sequential ``train_all`` (compare, fig8, recipe):
+    that run saves itself (``train`` returns ``interrupted``) and no later run starts."""
+    from mimo_social.train import comparison
+    started = []
+
+    def fake_train(**kw):
+        started.append(kw["out"])
+        return {"interrupted": kw["out"] == "b"}
+
+    monkeypatch.setattr(comparison, "train", fake_train)
+    comparison.train_all([{"out": o} for o in "abc"], jobs=1, desc="fig8")
+    assert started == ["a", "b"]
+    assert "fig8: interrupted in b" in capsys.readouterr().err
