@@ -91,9 +91,14 @@ baselines:
     +- 1.4. The first versions' partner (`HandOffer(grip=False, release=None)`): scripted 30 / 30,
     72.7 +- 2.8, 139 steps; random, zero, `ArmSweep`, midpoint 0 / 30; bang-bang 0, 0, 1 / 30. With
     `success="touch"` and the default partner: scripted 30 / 30, random 5 / 30, bang-bang 15, 25, 27
-    / 30. Issue 15, the first versions' rule and partner, 20 episodes, seeds 1000-1019: random 1 /
+    / 30. Under the palm rule, the shipped recipe (`mimo-social recipe high_five --seeds 0,1`: a
+    behaviour-cloning warm start from 100 scripted episodes, then PPO with its learning rate
+    decaying to 0 over 600k steps, partner scripted; issue 30): seeds 0 and 1, 30 episodes (seeds
+    1000-1029), 100 % / 100 % and 97 % / 93 % (mean action / sampled), return 91.6 and 86.9, 18-24
+    min a seed (docs/baselines.md); PPO without the warm start: 20 % at 100k steps (seed 0).
+    Issue 15, the first versions' rule and partner, 20 episodes, seeds 1000-1019: random 1 /
     20, -139.9 +- 46.6; zero 0 / 20; scripted 20 / 20, 90.0 +- 2.6, 38 steps; `ArmSweep` 20 / 20,
-    64.9 +- 0.9; PPO (not yet measured with the palm rule; SB3 defaults, 2 seeds each; deterministic
+    64.9 +- 0.9; PPO (the first rule; SB3 defaults, 2 seeds each; deterministic
     evaluation, 10 episodes every 10k env steps): scripted partner, 60k env steps (7-9 min): seed 0
     80 % at 20k, 90 % at 61k; seed 1 0 % until 30k, 80 % at 61k; on 20 fresh episodes (seeds
     1000-1019) 20 / 20 (return 94.0 +- 0.8, 23 steps) and 19 / 20 (85.5 +- 38.5, 20 steps): the
