@@ -316,16 +316,16 @@ class Smiles(Partner):
         return dict(zero_action(env.action_space(agent)), expression=np.int64(HAPPY))
 
 
-def _episode(env, learner):
-    """One episode of a one-learner env (seed 0), ``infant_0`` driven by ``learner``: its info
-    of every step."""
+def _episode(env, learner, record=lambda inner, info: info):
+    """One episode of a one-learner env (seed 0), ``infant_0`` driven by ``learner``: per step,
+    ``record(inner env, the learner's info)`` (by default the info itself)."""
     obs, _ = env.reset(seed=0)
     inner = env.unwrapped
     learner.reset(inner, "infant_0", np.random.default_rng(0))
     out = []
     while env.agents:
         obs, _, _, _, info = env.step({"infant_0": learner.act(inner, "infant_0", obs["infant_0"])})
-        out.append(info["infant_0"])
+        out.append(record(inner, info["infant_0"]))
     return out
 
 
@@ -404,15 +404,8 @@ def _contingency(learner, max_steps, **options):
     caregiver: happy or not)."""
     env = contingency_v0.scripted_env(max_steps=max_steps, task_options=options,
                                       per_agent=NO_EYES)
-    obs, _ = env.reset(seed=0)
-    inner = env.unwrapped
-    learner.reset(inner, "infant_0", np.random.default_rng(0))
-    out = []
-    while env.agents:
-        obs, _, _, _, info = env.step({"infant_0": learner.act(inner, "infant_0", obs["infant_0"])})
-        faces = [inner.world.expression_of(i) == HAPPY for i in (0, 1)]
-        out.append((info["infant_0"], faces))
-    return out
+    return _episode(env, learner, lambda inner, info: (
+        info, [inner.world.expression_of(i) == HAPPY for i in (0, 1)]))
 
 
 def test_contingency_a_shared_smile_needs_both_faces_happy():
