@@ -391,7 +391,8 @@ def add_parser(subparsers) -> None:
                    help="epochs over the demonstrations (default 20)")
     c.add_argument("--bc-kwargs", type=json_object, default=None,
                    help="JSON settings of the warm start: batch_size (64), lr (1e-3), loss "
-                   "(mse or nll), log_std (PPO: the log-std after cloning)")
+                   "(mse or nll), log_std (PPO: the log-std after cloning), critic_epochs (PPO: "
+                   "epochs fitting the value function to the demonstrations' returns; 0)")
     c.add_argument("--intrinsic", choices=("rnd",), default=None,
                    help="an intrinsic novelty bonus added to the learner's rewards: rnd "
                    "(random network distillation; not --mode independent)")

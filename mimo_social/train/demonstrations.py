@@ -23,10 +23,23 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
 * ``log_std`` (PPO with a Gaussian, optional): the policy's log-std set to this value after
   cloning (SB3's initial value is 0: std 1 on actions in [-1, 1]; e.g. -1 keeps the cloned
   mean from being drowned by the sampling noise in the first rollouts);
-* ``batch_size`` (64), ``lr`` (1e-3; its own optimiser, the algorithm's is untouched).
+* ``batch_size`` (64), ``lr`` (1e-3; its own optimiser, the algorithm's is untouched);
+* ``critic_epochs`` (PPO, default 0: none): after the actor, the value function is fitted for
+  that many epochs to the demonstrations' discounted returns-to-go (PPO's ``gamma``; each
+  episode's last step taken as its end, a truncated one too), through the value layers only
+  (a features extractor shared with the actor, e.g. the eyes' CNN, is left as cloned). Without
+  it PPO's critic starts from scratch and its first updates are driven by advantages of an
+  untrained value function: measured on social touch (issue 30), the cloned policy's 60 %
+  success fell to 0 % within the first 10k steps whatever the log-std (-1, -2).
 
-The value function is not trained (PPO's critic starts from scratch). ``RecurrentPPO`` is
-refused (its policy needs the LSTM states over whole sequences).
+* ``keep_updates`` (default 0: none) and ``keep_until`` (0.5): the cloning goes on during RL
+  (:class:`KeepCloning`, an SB3 callback): after each of the algorithm's updates, that many
+  minibatches of the same cloning loss (its own Adam, ``lr``), falling linearly with the run's
+  progress to none at ``keep_until`` of its steps; the demonstrations hold the policy near the
+  controller while RL's first, noisy updates would pull it away (the regularisation of
+  demonstration-augmented policy gradient, Rajeswaran et al. 2018, as alternating updates).
+
+``RecurrentPPO`` is refused (its policy needs the LSTM states over whole sequences).
 ``config.json["bc"]`` records the episodes, their seeds, the demonstrations' success rate and
 mean return, the samples, the settings, the loss before and after cloning and the time taken;
 an evaluation right after cloning (before any RL step) is the first row of ``progress.csv``
@@ -54,10 +67,12 @@ from ..envs.catalog import entry
 from .tasks import TrainInputError
 
 __all__ = ["BC_DEFAULTS", "BC_ALGOS", "DEMO_SEED", "Demonstrations", "Demonstrator",
-           "check_bc", "record_demonstrations", "clone", "warm_start", "evaluate_after_bc"]
+           "check_bc", "record_demonstrations", "Cloner", "clone", "keep_cloning",
+           "returns_to_go", "fit_critic", "warm_start", "evaluate_after_bc"]
 
 #: the settings of ``bc_kwargs`` and their defaults (``epochs``: ``bc_epochs``)
-BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None}
+BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None,
+               "critic_epochs": 0, "keep_updates": 0, "keep_until": 0.5}
 BC_LOSSES = ("mse", "nll")
 BC_ALGOS = ("ppo", "sac")
 #: the demonstrations' first seed is this plus the run's seed (training: seed + i; the
@@ -113,6 +128,18 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
                            or not isinstance(ls, (int, float)) or not math.isfinite(ls)):
         raise TrainInputError(f"bc_kwargs: log_std={ls!r}; allowed: None, or with ppo a finite "
                               "number (the Gaussian's log-std after cloning)")
+    ce = s["critic_epochs"]
+    if isinstance(ce, bool) or not isinstance(ce, int) or ce < 0 or (ce and algo != "ppo"):
+        raise TrainInputError(f"bc_kwargs: critic_epochs={ce!r}; allowed: an integer >= 0 "
+                              "(> 0 with ppo only: epochs fitting its value function to the "
+                              "demonstrations' returns)")
+    ku, kt = s["keep_updates"], s["keep_until"]
+    if isinstance(ku, bool) or not isinstance(ku, int) or ku < 0:
+        raise TrainInputError(f"bc_kwargs: keep_updates={ku!r}; allowed: an integer >= 0 "
+                              "(behaviour-cloning minibatches after each RL update; 0: none)")
+    if isinstance(kt, bool) or not isinstance(kt, (int, float)) or not 0 < kt <= 1:
+        raise TrainInputError(f"bc_kwargs: keep_until={kt!r}; allowed: a number in (0, 1] (the "
+                              "share of the run over which keep_updates falls to 0)")
     return s
 
 
@@ -123,6 +150,10 @@ class Demonstrations:
 
     obs: Any
     actions: np.ndarray
+    rewards: np.ndarray
+    """each pair's reward (the step's, after the action)"""
+    ends: np.ndarray
+    """True on each episode's last pair"""
     seeds: list[int]
     returns: list[float]
     lengths: list[int]
@@ -159,6 +190,11 @@ class Demonstrator:
         self.core = None
         self.obs: list = []
         self.actions: list = []
+        self.rewards: list = []
+
+    def on_step(self, env, obs, rewards, terminations, truncations, infos) -> None:
+        """``run_episode``'s hook: the reward of the action just recorded."""
+        self.rewards.append(float(next(iter(rewards.values()))))
 
     def reset(self, env, agent: str, rng) -> None:
         self.core = self.env.unwrapped.parallel.unwrapped
@@ -183,7 +219,7 @@ def record_demonstrations(task: str, env, episodes: int, seed: int) -> Demonstra
     demo = Demonstrator(controller, env)
     seeds, returns, lengths, successes = [], [], [], []
     for k in range(int(episodes)):
-        ep = run_episode(env, demo, seed + k)
+        ep = run_episode(env, demo, seed + k, on_step=demo.on_step)
         agent = next(iter(ep.returns))
         seeds.append(seed + k)
         returns.append(float(ep.returns[agent]))
@@ -191,11 +227,122 @@ def record_demonstrations(task: str, env, episodes: int, seed: int) -> Demonstra
         successes.append(ep.success(agent))
     obs = ({k: np.stack([o[k] for o in demo.obs]) for k in demo.obs[0]}
            if isinstance(demo.obs[0], dict) else np.stack(demo.obs))
-    return Demonstrations(obs, np.stack(demo.actions), seeds, returns, lengths, successes)
+    ends = np.zeros(len(demo.actions), bool)
+    ends[np.cumsum(lengths) - 1] = True
+    return Demonstrations(obs, np.stack(demo.actions), np.asarray(demo.rewards, np.float32),
+                          ends, seeds, returns, lengths, successes)
+
+
+def returns_to_go(rewards: np.ndarray, ends: np.ndarray, gamma: float) -> np.ndarray:
+    """Each step's discounted return to its episode's end (``ends``: True on last steps)."""
+    out = np.zeros(len(rewards), np.float64)
+    acc = 0.0
+    for i in range(len(rewards) - 1, -1, -1):
+        acc = float(rewards[i]) + (0.0 if ends[i] else gamma * acc)
+        out[i] = acc
+    return out.astype(np.float32)
+
+
+def fit_critic(model, demos: Demonstrations, epochs: int, batch_size: int = 64,
+               lr: float = 1e-3, seed: int = 0) -> dict:
+    """Fits PPO's value function (its value layers only) to the demonstrations' discounted
+    returns-to-go: first its last layer by least squares on the value features (the returns'
+    scale, tens to hundreds, is reached at once), then ``epochs`` epochs of Adam on every value
+    layer. Returns the explained variance of the returns before, after the first step and at
+    the end."""
+    import torch
+
+    policy = model.policy
+    target = returns_to_go(demos.rewards, demos.ends, float(model.gamma))
+    chunks = np.array_split(np.arange(len(demos)), max(1, -(-len(demos) // 1024)))
+
+    def latent(idx):
+        features = policy.extract_features(policy.obs_to_tensor(demos.take(idx))[0])
+        vf = features if policy.share_features_extractor else features[1]
+        return policy.mlp_extractor.forward_critic(vf)
+
+    def explained() -> float:
+        with torch.no_grad():
+            v = np.concatenate([policy.value_net(latent(i)).flatten().cpu().numpy()
+                                for i in chunks])
+        var = float(np.var(target))
+        return float(1.0 - np.var(target - v) / var) if var > 0 else float("nan")
+
+    policy.set_training_mode(False)
+    before = explained()
+    with torch.no_grad():          # the last layer: ridge regression on the value features
+        h = np.concatenate([latent(i).cpu().numpy() for i in chunks]).astype(np.float64)
+        x = np.hstack([h, np.ones((len(h), 1))])
+        reg = 1e-3 * len(h) * np.eye(x.shape[1])
+        reg[-1, -1] = 0.0
+        coef = np.linalg.solve(x.T @ x + reg, x.T @ target.astype(np.float64))
+        policy.value_net.weight.copy_(torch.as_tensor(coef[None, :-1]))
+        policy.value_net.bias.fill_(float(coef[-1]))
+    linear = explained()
+    params = (list(policy.mlp_extractor.value_net.parameters())
+              + list(policy.value_net.parameters()))
+    optimiser = torch.optim.Adam(params, lr=lr)
+    rng = np.random.default_rng(seed + 1)
+    tgt = torch.as_tensor(target, device=policy.device)
+    for _ in range(int(epochs)):
+        order = rng.permutation(len(demos))
+        for start in range(0, len(demos), int(batch_size)):
+            idx = order[start:start + int(batch_size)]
+            optimiser.zero_grad()
+            value = policy.value_net(latent(idx)).flatten()
+            torch.mean((value - tgt[idx]) ** 2).backward()
+            optimiser.step()
+    return {"critic_epochs": int(epochs), "critic_explained_variance_before": before,
+            "critic_explained_variance_linear": linear,
+            "critic_explained_variance_after": explained(),
+            "return_to_go_mean": float(np.mean(target))}
 
 
 def _is_sac(policy) -> bool:
     return hasattr(policy, "actor") and not hasattr(policy, "action_net")
+
+
+class Cloner:
+    """The cloning loss of ``model``'s policy on ``demos`` (module docstring) and its own Adam
+    optimiser: ``step(idx)`` one update on the pairs ``idx``, ``mean_loss()`` over all."""
+
+    def __init__(self, model, demos: Demonstrations, lr: float = 1e-3, loss: str = "mse"):
+        import torch
+
+        self.torch, self.demos, self.loss_name = torch, demos, loss
+        policy = self.policy = model.policy
+        self.sac = _is_sac(policy)
+        self.discrete = isinstance(model.action_space, spaces.Discrete)
+        self.kind = "cross-entropy" if self.discrete else ("mse" if self.sac else loss)
+        params = list(policy.actor.parameters()) if self.sac else list(policy.parameters())
+        self.optimiser = torch.optim.Adam(params, lr=lr)
+        self.targets = policy.scale_action(demos.actions) if self.sac else demos.actions
+
+    def loss(self, idx):
+        torch, policy = self.torch, self.policy
+        obs = policy.obs_to_tensor(self.demos.take(idx))[0]
+        act = torch.as_tensor(np.asarray(self.targets[idx]), device=policy.device)
+        if self.sac:
+            return torch.mean((policy.actor(obs, deterministic=True) - act.float()) ** 2)
+        dist = policy.get_distribution(obs)
+        if self.discrete:
+            return -dist.log_prob(act.long()).mean()
+        if self.loss_name == "nll":
+            return -dist.log_prob(act.float()).mean()
+        return torch.mean((dist.mode() - act.float()) ** 2)
+
+    def step(self, idx) -> None:
+        self.optimiser.zero_grad()
+        self.loss(idx).backward()
+        self.optimiser.step()
+
+    def mean_loss(self) -> float:
+        n = len(self.demos)
+        self.policy.set_training_mode(False)
+        with self.torch.no_grad():
+            parts = [(float(self.loss(idx)), len(idx))
+                     for idx in np.array_split(np.arange(n), max(1, -(-n // 1024)))]
+        return float(sum(v * k for v, k in parts) / n)
 
 
 def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: float = 1e-3,
@@ -204,69 +351,83 @@ def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: f
     all pairs before and after, the updates made and the kind of loss."""
     import torch
 
-    policy = model.policy
-    sac = _is_sac(policy)
-    discrete = isinstance(model.action_space, spaces.Discrete)
-    kind = "cross-entropy" if discrete else ("mse" if sac else loss)
-    params = list(policy.actor.parameters()) if sac else list(policy.parameters())
-    optimiser = torch.optim.Adam(params, lr=lr)
-    targets = (policy.scale_action(demos.actions) if sac else demos.actions)
-
-    def batch_loss(idx):
-        obs = policy.obs_to_tensor(demos.take(idx))[0]
-        act = torch.as_tensor(np.asarray(targets[idx]), device=policy.device)
-        if sac:
-            return torch.mean((policy.actor(obs, deterministic=True) - act.float()) ** 2)
-        dist = policy.get_distribution(obs)
-        if discrete:
-            return -dist.log_prob(act.long()).mean()
-        if loss == "nll":
-            return -dist.log_prob(act.float()).mean()
-        return torch.mean((dist.mode() - act.float()) ** 2)
-
-    def mean_loss() -> float:
-        policy.set_training_mode(False)
-        with torch.no_grad():
-            parts = [(float(batch_loss(idx)), len(idx))
-                     for idx in np.array_split(np.arange(len(demos)),
-                                               max(1, -(-len(demos) // 1024)))]
-        return float(sum(v * k for v, k in parts) / len(demos))
-
-    before = mean_loss()
+    cloner = Cloner(model, demos, lr, loss)
+    before = cloner.mean_loss()
     rng = np.random.default_rng(seed)
     updates = 0
-    policy.set_training_mode(True)
+    cloner.policy.set_training_mode(True)
     for _ in range(int(epochs)):
         order = rng.permutation(len(demos))
         for start in range(0, len(demos), int(batch_size)):
-            idx = order[start:start + int(batch_size)]
-            optimiser.zero_grad()
-            value = batch_loss(idx)
-            value.backward()
-            optimiser.step()
+            cloner.step(order[start:start + int(batch_size)])
             updates += 1
-    after = mean_loss()
+    after = cloner.mean_loss()
     if log_std is not None:
         with torch.no_grad():
-            policy.log_std.fill_(float(log_std))
-    policy.set_training_mode(False)
-    return {"loss": kind, "loss_before": before, "loss_after": after, "updates": updates}
+            cloner.policy.log_std.fill_(float(log_std))
+    cloner.policy.set_training_mode(False)
+    return {"loss": cloner.kind, "loss_before": before, "loss_after": after, "updates": updates}
 
 
-def warm_start(model, task: str, env, settings: Mapping[str, Any], seed: int) -> dict:
+def keep_cloning(model, demos: Demonstrations, settings: Mapping[str, Any], total_steps: int,
+                 seed: int):
+    """The SB3 callback that goes on cloning during RL (``keep_updates`` minibatches after each
+    update, falling linearly to none at ``keep_until`` of ``total_steps`` SB3 timesteps); None
+    when ``keep_updates`` is 0. Its ``updates`` counts the minibatches made."""
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    if not int(settings.get("keep_updates", 0)):
+        return None
+    cloner = Cloner(model, demos, float(settings["lr"]), str(settings["loss"]))
+    rng = np.random.default_rng(seed + 2)
+    per_update, until = int(settings["keep_updates"]), float(settings["keep_until"])
+    batch = int(settings["batch_size"])
+
+    class KeepCloning(BaseCallback):
+        updates = 0
+        rollouts = 0
+
+        def _on_rollout_start(self) -> None:     # after each update (the first: before any)
+            self.rollouts += 1
+            if self.rollouts == 1:
+                return
+            share = max(0.0, 1.0 - self.model.num_timesteps / (until * max(1, total_steps)))
+            n = int(round(per_update * share))
+            if n == 0:
+                return
+            mode = cloner.policy.training
+            cloner.policy.set_training_mode(True)
+            for _ in range(n):
+                cloner.step(rng.integers(0, len(demos), batch))
+            cloner.policy.set_training_mode(mode)
+            self.updates += n
+
+        def _on_step(self) -> bool:
+            return True
+
+    return KeepCloning()
+
+
+def warm_start(model, task: str, env, settings: Mapping[str, Any],
+               seed: int) -> tuple[dict, Demonstrations]:
     """Records ``settings["episodes"]`` controller episodes on ``env`` (seeds from
     ``DEMO_SEED + seed``) and clones them into ``model`` (:func:`clone`); returns what
-    config.json records under ``bc``."""
+    config.json records under ``bc``, and the demonstrations."""
     t0 = time.perf_counter()
     demos = record_demonstrations(task, env, int(settings["episodes"]), DEMO_SEED + int(seed))
     t1 = time.perf_counter()
     res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
                 float(settings["lr"]), str(settings["loss"]), int(seed), settings["log_std"])
+    if int(settings.get("critic_epochs", 0)):
+        res.update(fit_critic(model, demos, int(settings["critic_epochs"]),
+                              int(settings["batch_size"]), float(settings["lr"]), int(seed)))
     return {**demos.summary(), "controller": entry(task).controller.__name__,
             "epochs": int(settings["epochs"]), "batch_size": int(settings["batch_size"]),
-            "lr": float(settings["lr"]), "log_std": settings["log_std"], **res,
+            "lr": float(settings["lr"]), "log_std": settings["log_std"],
+            "keep_updates": int(settings.get("keep_updates", 0)),
+            "keep_until": float(settings.get("keep_until", 0.5)), **res,
             "record_time_s": round(t1 - t0, 1),
-            "clone_time_s": round(time.perf_counter() - t1, 1)}
+            "clone_time_s": round(time.perf_counter() - t1, 1)}, demos
 
 
 def evaluate_after_bc(log, episodes: int) -> dict:

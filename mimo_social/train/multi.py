@@ -215,20 +215,26 @@ def _train_one_policy(cls, algo, algo_kwargs, module, task, mode, env_kwargs, st
         if control is not None:
             control.t_start = log.t_start
             log.columns.append(control.columns)
+        keep = None
         if bc is not None:   # on the learner's Gymnasium env, with the evaluated stage's kwargs
             demo_env = make_env(task, **config.get("observation", {}),
                                 **(env_kwargs if curriculum is None
                                    else curriculum.stages[-1].kwargs(env_kwargs)))
             try:
-                warm_start_run(model, task, demo_env, bc, seed, config, out, log,
-                               schedule.episodes)
+                keep = warm_start_run(model, task, demo_env, bc, seed, config, out, log,
+                                      schedule.episodes, steps * per_env_step)
             finally:
                 demo_env.close()
         try:
             cb = sb3_callback(log, schedule, agents, per_env_step, checkpoint, stop,
                               on_step=None if control is None else control.on_step)
+            if keep is not None:
+                from stable_baselines3.common.callbacks import CallbackList
+                cb = CallbackList([cb, keep])
             learn_and_finish(model, steps, per_env_step, cb, stop, save, out, schedule,
                              checkpoint, bar, log)
+            if keep is not None:
+                config["bc"]["keep_updates_made"] = int(keep.updates)
         finally:
             log.close()
     finally:

@@ -138,6 +138,10 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     from .curriculum import prepare_curriculum
     from .demonstrations import check_bc
     bc = check_bc(task, algo, mode, bc_episodes, bc_epochs, bc_kwargs)
+    if bc is not None and bc["critic_epochs"] and normalize_reward:
+        raise TrainInputError("bc_kwargs: critic_epochs with --normalize-reward: the critic would "
+                              "be fitted to raw returns before the reward scale is known; "
+                              "allowed: one of the two")
     cur = prepare_curriculum(curriculum, task, mode, {
         "flat": bool(flat_obs) or mode in ("shared", "independent"),
         "frame_stack": int(frame_stack)}, dict(env_kwargs or {}))

@@ -160,18 +160,23 @@ def curriculum_controller(curriculum, venv, eval_env, config: dict, out: Path):
 
 
 def warm_start_run(model, task: str, env, bc: dict, seed: int, config: dict, out: Path, log,
-                   eval_episodes: int) -> None:
+                   eval_episodes: int, total_steps: int):
     """The behaviour-cloning warm start of a run before any RL step (on ``env``, the learner's
-    Gymnasium env), recorded in ``config["bc"]``, then an evaluation (progress row 0)."""
-    from .demonstrations import evaluate_after_bc, warm_start
-    config["bc"] = warm_start(model, task, env, bc, seed)
+    Gymnasium env), recorded in ``config["bc"]``, then an evaluation (progress row 0). Returns
+    the callback that goes on cloning during RL (None: ``keep_updates`` 0)."""
+    from .demonstrations import evaluate_after_bc, keep_cloning, warm_start
+    config["bc"], demos = warm_start(model, task, env, bc, seed)
     b = config["bc"]
     rate = "n/a" if b["success_rate"] is None else f"{b['success_rate']:.0%}"
     warn(f"behaviour cloning: {b['episodes']} episodes of {b['controller']} (success {rate}, "
          f"{b['samples']} pairs), {b['epochs']} epochs: {b['loss']} loss {b['loss_before']:.4g}"
-         f" -> {b['loss_after']:.4g}")
+         f" -> {b['loss_after']:.4g}" + (
+             f"; critic fitted to the returns, {b['critic_epochs']} epochs: explained variance "
+             f"{b['critic_explained_variance_before']:.2f} -> "
+             f"{b['critic_explained_variance_after']:.2f}" if b.get("critic_epochs") else ""))
     evaluate_after_bc(log, eval_episodes)
     write_config(out, config)
+    return keep_cloning(model, demos, bc, total_steps, seed)
 
 
 def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every: int | None,
@@ -223,8 +228,10 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         if control is not None:
             control.t_start = log.t_start
             log.columns.append(control.columns)
+        keep = None
         if bc is not None:
-            warm_start_run(model, task, eval_env, bc, seed, config, out, log, eval_episodes)
+            keep = warm_start_run(model, task, eval_env, bc, seed, config, out, log,
+                                  eval_episodes, steps)
 
         def checkpoint(n):
             (out / "checkpoints").mkdir(exist_ok=True)
@@ -235,11 +242,16 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
             with stop:
                 cb = sb3_callback(log, schedule, None, 1, checkpoint, stop,
                                   on_step=None if control is None else control.on_step)
+                if keep is not None:
+                    from stable_baselines3.common.callbacks import CallbackList
+                    cb = CallbackList([cb, keep])
                 learn_and_finish(model, steps, 1, cb, stop, save, out, schedule, checkpoint,
                                  bar, log)
         finally:
             log.close()
         wall = time.perf_counter() - t0
+        if keep is not None:
+            config["bc"]["keep_updates_made"] = int(keep.updates)
         write_config(out, finish_config(config, wall, model.num_timesteps, stop, log.eval_steps))
     finally:
         venv.close()

@@ -303,11 +303,15 @@ def test_mode_scripted_takes_a_curriculum_and_a_warm_start(tmp_path):
     out = tmp_path / "run"
     train("high_five", "ppo", 512, 0, out, mode="scripted", curriculum=spec, progress=False,
           n_envs=2, n_cpus=0, eval_episodes=1, env_kwargs={"max_steps": 40}, bc_episodes=1,
-          bc_epochs=1, algo_kwargs={"n_steps": 64, "n_epochs": 1, "batch_size": 128})
+          bc_epochs=1, algo_kwargs={"n_steps": 64, "n_epochs": 1, "batch_size": 128},
+          bc_kwargs={"keep_updates": 4})
     config = json.loads((out / "config.json").read_text())
     hist = config["curriculum"]["history"]
     assert [h["stage"] for h in hist] == [0, 1] and hist[1]["step"] >= 256
     assert config["bc"]["episodes"] == 1
+    # rollouts of 128 steps start at 0, 128, 256, 384: the cloning goes on after the first
+    # update only (4 x (1 - 128 / 256) = 2; none from half the run on)
+    assert config["bc"]["keep_updates_made"] == 2
     episodes = _rows(out / "episodes.csv")
     assert max(int(e["length"]) for e in episodes if int(e["timesteps"]) <= hist[1]["step"]) == 20
     assert max(int(e["length"]) for e in episodes) == 40

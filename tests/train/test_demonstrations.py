@@ -131,11 +131,19 @@ def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_pa
     ({"bc_episodes": -1}, ["bc_episodes=-1", "integer >= 0"]),
     ({"bc_episodes": 2, "bc_epochs": 0}, ["bc_epochs=0", "integer >= 1"]),
     ({"bc_episodes": 2, "bc_kwargs": {"lr": 0}}, ["lr=0", "number > 0"]),
-    ({"bc_episodes": 2, "bc_kwargs": {"epoch": 3}}, ["epoch", "batch_size, lr, loss, log_std"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"epoch": 3}},
+     ["epoch", "batch_size, lr, loss, log_std, critic_epochs, keep_updates"]),
     ({"bc_episodes": 2, "bc_kwargs": {"loss": "l1"}}, ["loss='l1'", "mse, nll"]),
     ({"bc_episodes": 0, "bc_kwargs": {"lr": 0.1}}, ["without bc_episodes"]),
     ({"bc_episodes": 2, "algo": "sac", "bc_kwargs": {"loss": "nll"}}, ["with sac: mse"]),
     ({"bc_episodes": 2, "algo": "sac", "bc_kwargs": {"log_std": -1}}, ["log_std=-1", "ppo"]),
+    ({"bc_episodes": 2, "algo": "sac", "bc_kwargs": {"critic_epochs": 3}},
+     ["critic_epochs=3", "with ppo only"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"critic_epochs": -1}}, ["critic_epochs=-1", ">= 0"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"keep_updates": 1.5}}, ["keep_updates=1.5", ">= 0"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"keep_until": 0}}, ["keep_until=0", "(0, 1]"]),
+    ({"bc_episodes": 2, "normalize_reward": True, "bc_kwargs": {"critic_epochs": 2}},
+     ["critic_epochs with --normalize-reward"]),
     ({"bc_episodes": 2, "algo": "recurrent_ppo"}, ["recurrent_ppo", "ppo, sac"]),
     ({"bc_episodes": 2, "task": "high_five"}, ["--mode shared", "one learner"]),
 ])
@@ -148,3 +156,72 @@ def test_bad_arguments_are_refused_before_anything_is_written(tmp_path, kwargs, 
     for w in words:
         assert w in str(info.value), (w, str(info.value))
     assert not out.exists()
+
+
+def test_returns_to_go_stop_at_each_episode_end():
+    from mimo_social.train.demonstrations import returns_to_go
+    r = np.array([1.0, 1.0, 2.0, 5.0, 1.0], np.float32)
+    ends = np.array([False, False, True, False, True])
+    np.testing.assert_allclose(returns_to_go(r, ends, 0.5), [2.0, 2.0, 2.0, 5.5, 1.0])
+
+
+def test_the_critic_fitted_to_the_demonstrations_explains_their_returns():
+    from stable_baselines3 import PPO
+    from mimo_social.train.demonstrations import fit_critic, returns_to_go
+    env = make_env("reach", flat=True, max_steps=100)
+    try:
+        demos = record_demonstrations("reach", env, 4, 20_000)
+        assert len(demos.rewards) == len(demos) and demos.ends.sum() == 4
+        assert demos.ends[np.cumsum(demos.lengths) - 1].all()
+        # the rewards recorded are the episodes' rewards: each episode's sum is its return
+        starts = np.concatenate([[0], np.cumsum(demos.lengths)[:-1]])
+        np.testing.assert_allclose([demos.rewards[a:a + n].sum() for a, n in
+                                    zip(starts, demos.lengths)], demos.returns, rtol=1e-4)
+        ppo = PPO("MlpPolicy", env, seed=0, device="cpu")
+        actor = [p.detach().clone() for p in ppo.policy.action_net.parameters()]
+        res = fit_critic(ppo, demos, 60, seed=0)
+        assert res["critic_explained_variance_after"] > 0.8 > res[
+            "critic_explained_variance_before"]
+        assert res["return_to_go_mean"] == pytest.approx(
+            float(np.mean(returns_to_go(demos.rewards, demos.ends, ppo.gamma))))
+        for before, after in zip(actor, ppo.policy.action_net.parameters()):
+            assert torch.equal(before, after)        # the actor is left as it was
+    finally:
+        env.close()
+
+
+def test_keep_cloning_pulls_the_policy_back_to_the_demonstrations_and_fades():
+    from stable_baselines3 import PPO
+    from mimo_social.train.demonstrations import Cloner, keep_cloning
+    env = make_env("reach", flat=True, max_steps=100)
+    try:
+        demos = record_demonstrations("reach", env, 4, 20_000)
+        ppo = PPO("MlpPolicy", env, seed=0, device="cpu")
+        settings = {"keep_updates": 40, "keep_until": 0.5, "lr": 1e-3, "loss": "mse",
+                    "batch_size": 64}
+        assert keep_cloning(ppo, demos, {**settings, "keep_updates": 0}, 1000, 0) is None
+        cb = keep_cloning(ppo, demos, settings, 1000, 0)
+        cb.init_callback(ppo)
+        loss = Cloner(ppo, demos).mean_loss
+        before = loss()
+        for t in (0, 100, 250, 500, 900):      # SB3 timesteps at each rollout's start
+            ppo.num_timesteps = t
+            cb.on_rollout_start()
+        # none before the first update; then 40 x (1 - t / 500): 32, 20, then none
+        assert cb.updates == 32 + 20 and loss() < before / 2
+    finally:
+        env.close()
+
+
+def test_a_run_goes_on_cloning_during_rl_when_asked(tmp_path):
+    out = tmp_path / "run"
+    train("reach", "ppo", 1024, 0, out, progress=False, n_envs=1, eval_episodes=1,
+          algo_kwargs={"n_steps": 256, "n_epochs": 1, "batch_size": 256},
+          env_kwargs={"max_steps": 100}, bc_episodes=3, bc_epochs=2,
+          bc_kwargs={"keep_updates": 10, "keep_until": 0.5, "critic_epochs": 2})
+    bc = json.loads((out / "config.json").read_text())["bc"]
+    # rollouts start at 0, 256, 512, 768 steps: 10 x (1 - 256 / 512) = 5 after the first
+    # update, none from 512 on
+    assert bc["keep_updates"] == 10 and bc["keep_updates_made"] == 5
+    assert bc["critic_epochs"] == 2 and bc["critic_explained_variance_after"] > bc[
+        "critic_explained_variance_before"]
