@@ -39,6 +39,11 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
   controller while RL's first, noisy updates would pull it away (the regularisation of
   demonstration-augmented policy gradient, Rajeswaran et al. 2018, as alternating updates).
 
+* ``dagger_rounds`` (default 0: none) and ``dagger_episodes`` (50): DAgger after the cloning
+  (:mod:`~mimo_social.train.dagger`): the cloned policy plays, the controller labels the states
+  it meets, the policy is cloned again on everything (the critic, if fitted, keeps the
+  controller's own episodes; ``keep_updates`` uses all the pairs).
+
 ``RecurrentPPO`` is refused (its policy needs the LSTM states over whole sequences).
 ``config.json["bc"]`` records the episodes, their seeds, the demonstrations' success rate and
 mean return, the samples, the settings, the loss before and after cloning and the time taken;
@@ -72,7 +77,8 @@ __all__ = ["BC_DEFAULTS", "BC_ALGOS", "DEMO_SEED", "Demonstrations", "Demonstrat
 
 #: the settings of ``bc_kwargs`` and their defaults (``epochs``: ``bc_epochs``)
 BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None,
-               "critic_epochs": 0, "keep_updates": 0, "keep_until": 0.5}
+               "critic_epochs": 0, "keep_updates": 0, "keep_until": 0.5, "dagger_rounds": 0,
+               "dagger_episodes": 50}
 BC_LOSSES = ("mse", "nll")
 BC_ALGOS = ("ppo", "sac")
 #: the demonstrations' first seed is this plus the run's seed (training: seed + i; the
@@ -133,6 +139,12 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
         raise TrainInputError(f"bc_kwargs: critic_epochs={ce!r}; allowed: an integer >= 0 "
                               "(> 0 with ppo only: epochs fitting its value function to the "
                               "demonstrations' returns)")
+    for key in ("dagger_rounds", "dagger_episodes"):
+        v = s[key]
+        if isinstance(v, bool) or not isinstance(v, int) or v < (key == "dagger_episodes"):
+            raise TrainInputError(f"bc_kwargs: {key}={v!r}; allowed: an integer >= "
+                                  f"{int(key == 'dagger_episodes')} (DAgger: rounds of the "
+                                  "cloned policy's episodes labelled by the controller)")
     ku, kt = s["keep_updates"], s["keep_until"]
     if isinstance(ku, bool) or not isinstance(ku, int) or ku < 0:
         raise TrainInputError(f"bc_kwargs: keep_updates={ku!r}; allowed: an integer >= 0 "
@@ -425,7 +437,9 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
             "epochs": int(settings["epochs"]), "batch_size": int(settings["batch_size"]),
             "lr": float(settings["lr"]), "log_std": settings["log_std"],
             "keep_updates": int(settings.get("keep_updates", 0)),
-            "keep_until": float(settings.get("keep_until", 0.5)), **res,
+            "keep_until": float(settings.get("keep_until", 0.5)),
+            "dagger_rounds": int(settings.get("dagger_rounds", 0)),
+            "dagger_episodes": int(settings.get("dagger_episodes", 50)), **res,
             "record_time_s": round(t1 - t0, 1),
             "clone_time_s": round(time.perf_counter() - t1, 1)}, demos
 

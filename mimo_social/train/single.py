@@ -167,13 +167,19 @@ def warm_start_run(model, task: str, env, bc: dict, seed: int, config: dict, out
     from .demonstrations import evaluate_after_bc, keep_cloning, warm_start
     config["bc"], demos = warm_start(model, task, env, bc, seed)
     b = config["bc"]
+    if bc["dagger_rounds"]:
+        from .dagger import dagger
+        demos, b["dagger"] = dagger(model, task, env, demos, bc, seed)
     rate = "n/a" if b["success_rate"] is None else f"{b['success_rate']:.0%}"
     warn(f"behaviour cloning: {b['episodes']} episodes of {b['controller']} (success {rate}, "
          f"{b['samples']} pairs), {b['epochs']} epochs: {b['loss']} loss {b['loss_before']:.4g}"
          f" -> {b['loss_after']:.4g}" + (
              f"; critic fitted to the returns, {b['critic_epochs']} epochs: explained variance "
              f"{b['critic_explained_variance_before']:.2f} -> "
-             f"{b['critic_explained_variance_after']:.2f}" if b.get("critic_epochs") else ""))
+             f"{b['critic_explained_variance_after']:.2f}" if b.get("critic_epochs") else "")
+         + "".join(f"; DAgger round {d['round']}: the cloned policy {d['success_rate']:.0%} "
+                   f"on its {bc['dagger_episodes']} episodes, {d['pairs']} pairs"
+                   for d in b.get("dagger", ()) if d["success_rate"] is not None))
     evaluate_after_bc(log, eval_episodes)
     write_config(out, config)
     return keep_cloning(model, demos, bc, total_steps, seed)

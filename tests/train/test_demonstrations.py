@@ -225,3 +225,29 @@ def test_a_run_goes_on_cloning_during_rl_when_asked(tmp_path):
     assert bc["keep_updates"] == 10 and bc["keep_updates_made"] == 5
     assert bc["critic_epochs"] == 2 and bc["critic_explained_variance_after"] > bc[
         "critic_explained_variance_before"]
+
+
+def test_dagger_labels_the_cloned_policy_s_states_with_the_controller_s_actions():
+    from stable_baselines3 import PPO
+    from mimo_social.train.dagger import DAGGER_SEED, dagger
+    env = make_env("reach", flat=True, max_steps=60)
+    try:
+        demos = record_demonstrations("reach", env, 3, 20_000)
+        ppo = PPO("MlpPolicy", env, seed=0, device="cpu")
+        clone(ppo, demos, 5, seed=0)
+        settings = {"dagger_rounds": 2, "dagger_episodes": 2, "epochs": 5, "batch_size": 64,
+                    "lr": 1e-3, "loss": "mse", "log_std": None}
+        joined, rounds = dagger(ppo, "reach", env, demos, settings, 7)
+        assert [r["round"] for r in rounds] == [1, 2]
+        assert rounds[0]["seeds"] == [DAGGER_SEED + 7, DAGGER_SEED + 8]
+        assert rounds[1]["seeds"] == [DAGGER_SEED + 1007, DAGGER_SEED + 1008]
+        added = sum(r["pairs_added"] for r in rounds)
+        assert len(joined) == len(demos) + added == rounds[-1]["pairs"]
+        assert joined.ends.sum() == 3 + 4 and len(joined.rewards) == len(joined)
+        # the labels are the controller's actions (in the action box), not the policy's own
+        new = slice(len(demos), len(joined))
+        assert np.all(np.abs(joined.actions) <= 1)
+        played = ppo.predict(joined.take(np.arange(len(joined))[new]), deterministic=True)[0]
+        assert not np.allclose(played, joined.actions[new], atol=1e-3)
+    finally:
+        env.close()
