@@ -97,7 +97,7 @@ def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = F
     evaluation episodes per policy (seeds ``eval_seed ..``; 0: no such table, each run's last
     evaluation during training instead)."""
     from .baselines import baselines, markdown_table, write_json
-    from .comparison import train_all
+    from .comparison import finished, train_all
     from .plots import plot_compare, plot_fig8
 
     tasks = list(tasks)
@@ -119,12 +119,13 @@ def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = F
              "run, " + (f"{jobs} runs at a time" if jobs > 1 else "one run at a time") + ".", "",
              f"![Fig. 8]({(out / 'fig8.png').name})", ""]
     for task in tasks:
-        done = [r["out"] for r in runs if r["task"] == task
-                and (Path(r["out"]) / "model.zip").exists()]
+        ours = [r for r in runs if r["task"] == task]
+        done = [r["out"] for r in ours if finished(r)]
+        missing = [Path(r["out"]).name for r in ours if not finished(r)]
         if not done:
             continue
         plot_compare(out / task, task)
-        table = _final_table(out / task, runs, task)
+        table = _final_table(out / task, [r for r in ours if finished(r)], task)
         if episodes > 0:
             res = baselines(task, episodes, eval_seed, done, progress=progress)
             write_json(res, out / task / "baselines.json")
@@ -134,6 +135,8 @@ def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = F
         lines += [f"## {task}", "", f"Budget: PPO {b['ppo']:,}, SAC {b['sac']:,} environment "
                   "steps" + (f"; recipe {recipe_steps or 'its own budget'}" if recipes else "")
                   + f". Curves: `{task}/compare.png`.", "", table]
+        if missing:   # interrupted, another budget, or not trained yet: not in the table
+            lines += [f"Not finished (left out of the table): {', '.join(missing)}.", ""]
     png = plot_fig8(out, tasks)
     (out / "fig8.md").write_text("\n".join(lines) + "\n")
     (out / "fig8.json").write_text(json.dumps({"seeds": seeds, "steps": budget,

@@ -44,6 +44,14 @@ def test_fig8_trains_plots_tabulates_and_reuses_finished_runs(tmp_path):
     text = (out / "fig8.md").read_text()
     for row in ("| ppo_seed0 | 2,048 |", "| sac_seed0 | 64 |", "| recipe_seed0 | 2,048 |"):
         assert row in text
+    # an interrupted run is left out of the table and named as not finished
+    cfg = task / "sac_seed0" / "config.json"
+    cfg.write_text(json.dumps({**json.loads(cfg.read_text()), "interrupted": True}))
+    fig8(out, 1, ["reach"], steps={"reach": {"ppo": 2048, "sac": 64}}, episodes=0,
+         eval_episodes=1, recipes=True, recipe_steps=2048, plot_only=True, progress=False)
+    text = (out / "fig8.md").read_text()
+    assert "| sac_seed0 |" not in text and "| ppo_seed0 | 2,048 |" in text
+    assert "Not finished (left out of the table): sac_seed0." in text
 
 
 def test_fig8_refuses_other_tasks_and_bad_counts(tmp_path, capsys):
