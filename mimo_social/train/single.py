@@ -177,8 +177,8 @@ def warm_start_run(model, task: str, env, bc: dict, seed: int, config: dict, out
              f"; critic fitted to the returns, {b['critic_epochs']} epochs: explained variance "
              f"{b['critic_explained_variance_before']:.2f} -> "
              f"{b['critic_explained_variance_after']:.2f}" if b.get("critic_epochs") else "")
-         + "".join(f"; DAgger round {d['round']}: the cloned policy {d['success_rate']:.0%} "
-                   f"on its {bc['dagger_episodes']} episodes, {d['pairs']} pairs"
+         + "".join(f"; DAgger play {d['round']}: the policy {d['success_rate']:.0%} on its "
+                   f"{bc['dagger_episodes']} episodes" + (" (kept)" if d["kept"] else "")
                    for d in b.get("dagger", ()) if d["success_rate"] is not None))
     evaluate_after_bc(log, eval_episodes)
     write_config(out, config)

@@ -227,6 +227,11 @@ def test_a_run_goes_on_cloning_during_rl_when_asked(tmp_path):
         "critic_explained_variance_before"]
 
 
+def entry_controller(task):
+    from mimo_social.envs.catalog import entry
+    return entry(task).controller
+
+
 def test_dagger_labels_the_cloned_policy_s_states_with_the_controller_s_actions():
     from stable_baselines3 import PPO
     from mimo_social.train.dagger import DAGGER_SEED, dagger
@@ -238,12 +243,23 @@ def test_dagger_labels_the_cloned_policy_s_states_with_the_controller_s_actions(
         settings = {"dagger_rounds": 2, "dagger_episodes": 2, "epochs": 5, "batch_size": 64,
                     "lr": 1e-3, "loss": "mse", "log_std": None}
         joined, rounds = dagger(ppo, "reach", env, demos, settings, 7)
-        assert [r["round"] for r in rounds] == [1, 2]
+        # two rounds, then the last policy's play (labelled, not cloned)
+        assert [r["round"] for r in rounds] == [1, 2, 3]
+        assert "loss_after" in rounds[1] and "loss_after" not in rounds[2]
         assert rounds[0]["seeds"] == [DAGGER_SEED + 7, DAGGER_SEED + 8]
         assert rounds[1]["seeds"] == [DAGGER_SEED + 1007, DAGGER_SEED + 1008]
         added = sum(r["pairs_added"] for r in rounds)
         assert len(joined) == len(demos) + added == rounds[-1]["pairs"]
-        assert joined.ends.sum() == 3 + 4 and len(joined.rewards) == len(joined)
+        assert joined.ends.sum() == 3 + 6 and len(joined.rewards) == len(joined)
+        # the policy kept is the best play's: playing it again on that play's seeds gives
+        # that play's numbers
+        kept = [r for r in rounds if r["kept"]]
+        assert len(kept) == 1 and kept[0]["success_rate"] == max(r["success_rate"]
+                                                                 for r in rounds)
+        from mimo_social.train.dagger import Labeller, play_labelled
+        again = play_labelled(Labeller(entry_controller("reach"), env, ppo), env,
+                      kept[0]["seeds"][0], 2)[-1]
+        assert again["return_mean"] == pytest.approx(kept[0]["return_mean"], rel=1e-5)
         # the labels are the controller's actions (in the action box), not the policy's own
         new = slice(len(demos), len(joined))
         assert np.all(np.abs(joined.actions) <= 1)
