@@ -136,7 +136,8 @@ def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = F
                   "steps" + (f"; recipe {recipe_steps or 'its own budget'}" if recipes else "")
                   + f". Curves: `{task}/compare.png`.", "", table]
         if missing:   # interrupted, another budget, or not trained yet: not in the table
-            lines += [f"Not finished (left out of the table): {', '.join(missing)}.", ""]
+            lines += ["Not in the table (not trained yet, interrupted or another budget): "
+                      f"{', '.join(missing)}.", ""]
     png = plot_fig8(out, tasks)
     (out / "fig8.md").write_text("\n".join(lines) + "\n")
     (out / "fig8.json").write_text(json.dumps({"seeds": seeds, "steps": budget,

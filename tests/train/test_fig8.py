@@ -51,7 +51,8 @@ def test_fig8_trains_plots_tabulates_and_reuses_finished_runs(tmp_path):
          eval_episodes=1, recipes=True, recipe_steps=2048, plot_only=True, progress=False)
     text = (out / "fig8.md").read_text()
     assert "| sac_seed0 |" not in text and "| ppo_seed0 | 2,048 |" in text
-    assert "Not finished (left out of the table): sac_seed0." in text
+    assert ("Not in the table (not trained yet, interrupted or another budget): sac_seed0."
+            in text)
 
 
 def test_fig8_refuses_other_tasks_and_bad_counts(tmp_path, capsys):
