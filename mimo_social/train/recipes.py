@@ -176,6 +176,13 @@ def _wall(run: Path) -> float:
     return float(config.get("wall_time_s", float("nan")))
 
 
+def warm_start_steps(run: Path) -> int:
+    """The environment steps a run's warm start took before RL (the controller's episodes and
+    DAgger's plays, ``config.json["bc"]``; 0 without one): part of a recipe's budget."""
+    bc = json.loads((Path(run) / "config.json").read_text()).get("bc") or {}
+    return int(bc.get("samples", 0)) + sum(int(d["pairs_added"]) for d in bc.get("dagger", ()))
+
+
 def check_recipe(spec: str | Path, seeds: Sequence[int] = (0, 1), out: str | Path = "runs/recipe",
                  *, jobs: int = 1, episodes: int = 30, eval_seed: int = 1000,
                  steps: int | None = None, share: float = PASS_SHARE,
@@ -212,7 +219,8 @@ def check_recipe(spec: str | Path, seeds: Sequence[int] = (0, 1), out: str | Pat
     for run, p in zip(runs, (p for p in res["policies"] if p["kind"] == "trained")):
         det, sampled = p["success_rate"], p["stochastic"]["success_rate"]
         rows.append({"seed": run["seed"], "steps": run["steps"], "wall_time_s": _wall(
-            Path(run["out"])), "success": det, "success_sampled": sampled,
+            Path(run["out"])), "warm_start_steps": warm_start_steps(Path(run["out"])),
+            "success": det, "success_sampled": sampled,
             "return": p["return_mean"], "return_sampled": p["stochastic"]["return_mean"],
             "passes": bool(det >= target), "passes_sampled": bool(sampled >= target)})
     result = {"recipe": recipe.name, "task": recipe.task, "algo": recipe.algo, "model": model,
@@ -244,10 +252,13 @@ def recipe_markdown(result: Mapping[str, Any]) -> str:
              f"Target: {_pct(result['target'])} success ({result['share']:.0%} of the scripted "
              f"controller's {_pct(result['scripted_success'])}), {result['episodes']} episodes "
              f"(seeds {result['eval_seeds'][0]}..{result['eval_seeds'][1]}).", "",
-             "| seed | steps | wall time | success, mean action | success, sampled | "
-             "return, mean action | return, sampled |", "|---|---|---|---|---|---|---|"]
+             "| seed | steps (RL + warm start) | wall time | success, mean action | "
+             "success, sampled | return, mean action | return, sampled |",
+             "|---|---|---|---|---|---|---|"]
     for r in result["seeds"]:
-        lines.append(f"| {r['seed']} | {r['steps']:,} | {r['wall_time_s'] / 60:.0f} min | "
+        ws = int(r.get("warm_start_steps", 0))
+        lines.append(f"| {r['seed']} | {r['steps']:,}" + (f" + {ws:,}" if ws else "")
+                     + f" | {r['wall_time_s'] / 60:.0f} min | "
                      f"{_pct(r['success'])} | {_pct(r['success_sampled'])} | "
                      f"{r['return']:.1f} | {r['return_sampled']:.1f} |")
     return "\n".join(lines) + "\n"

@@ -124,3 +124,17 @@ def test_an_interrupted_run_stops_the_runs_after_it(monkeypatch, capsys):
     comparison.train_all([{"out": o} for o in "abc"], jobs=1, desc="fig8")
     assert started == ["a", "b"]
     assert "fig8: interrupted in b" in capsys.readouterr().err
+
+
+def test_a_recipe_s_warm_start_steps_count_in_its_budget(tmp_path):
+    from mimo_social.train.recipes import warm_start_steps
+    spec = _write(tmp_path, TINY + 'bc_episodes = 2\nbc_kwargs = { dagger_rounds = 1, '
+                  'dagger_episodes = 1 }\n')
+    out = tmp_path / "out"
+    res = check_recipe(spec, [0], out, episodes=1, eval_seed=1000, progress=False)
+    bc = json.loads((out / "seed0" / "config.json").read_text())["bc"]
+    # the controller's 2 episodes and DAgger's 2 plays (a round, then the last policy's)
+    assert len(bc["dagger"]) == 2
+    ws = bc["samples"] + sum(d["pairs_added"] for d in bc["dagger"])
+    assert res["seeds"][0]["warm_start_steps"] == warm_start_steps(out / "seed0") == ws > 0
+    assert f"| 0 | 128 + {ws:,} |" in (out / "recipe.md").read_text()
