@@ -110,7 +110,12 @@ baselines:
     success (`mimo-social compare --task handover --mode scripted --algos ppo --seeds 2 --steps
     200000 --out runs/handover15 --eval-every 20000 --eval-episodes 10 --jobs 2`, then `mimo-social
     baselines handover --episodes 20 --seed 1000 --run runs/handover15/ppo_seed0
-    runs/handover15/ppo_seed1`)
+    runs/handover15/ppo_seed1`). The shipped recipe (issue 30; `mimo-social recipe handover
+    --seeds 0,1 --jobs 2 --out runs/recipes/handover`): with `assisted_gaze`, a warm start from
+    the scripted receiver with 6 DAgger rounds, then PPO 200k with the cloning kept up; each
+    run's best evaluated model, seeds 1000-1029, assisted gaze for every policy: 30 / 30 and
+    30 / 30 (mean action; sampled 1 / 30 and 4 / 30), return 14.4 and 14.5 (scripted 29 / 30,
+    13.9); the final models 7 / 30 and 26 / 30 (docs/baselines.md, "Recipes")
 sources:
     not in the MIMo paper: a social task of this package; rationale (give and take, 9-18 months),
     the release rule and figures: `docs/social/handover.md`

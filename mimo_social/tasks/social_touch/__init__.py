@@ -88,7 +88,12 @@ baselines:
     --seeds 2 --steps 400000 --out runs/social_touch15 --eval-every 25000 --eval-episodes 10 --jobs
     2`, then `mimo-social baselines social_touch --episodes 20 --seed 1000 --run
     runs/social_touch15/ppo_seed0 runs/social_touch15/ppo_seed1`; details
-    `docs/social/social_touch.md`)
+    `docs/social/social_touch.md`). With the random starts, the shipped recipe (issue 30: a
+    warm start from the scripted toucher with DAgger, the critic fitted and the cloning kept up,
+    then PPO, 600k steps; `mimo-social recipe social_touch --seeds 0,1 --jobs 2 --out
+    runs/recipes/social_touch`), seeds 1000-1029: 15 / 30 and 17 / 30 (mean action), 14 / 30 and
+    18 / 30 (sampled); the blind toucher's clone of the scripted one reaches 20-34 % on its own
+    episodes (docs/baselines.md, "Recipes")
 sources:
     not in the MIMo paper: a social task of this package, the social version of self-body touch
     (paper Sec. VI-A); rationale (touch, body-part games), distances and figures:
