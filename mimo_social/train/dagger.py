@@ -24,11 +24,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..core.episodes import run_episode
 from ..envs.catalog import entry
-from .demonstrations import Demonstrations, Demonstrator, clone
+from .demonstrations import Demonstrations, Demonstrator, clone, play
 
-__all__ = ["DAGGER_SEED", "Labeller", "play_labelled", "dagger"]
+__all__ = ["DAGGER_SEED", "Labeller", "dagger"]
 
 DAGGER_SEED = 30_000
 
@@ -46,35 +45,16 @@ class Labeller(Demonstrator):
         return action
 
 
-def _joined(a: Demonstrations, obs, actions, rewards, ends) -> Demonstrations:
+def _joined(a: Demonstrations, b: Demonstrations) -> Demonstrations:
+    """``a``'s pairs followed by ``b``'s (the episode numbers: ``a``'s, the demonstrations')."""
     if isinstance(a.obs, dict):
-        new_obs = {k: np.concatenate([a.obs[k], obs[k]]) for k in a.obs}
+        obs = {k: np.concatenate([a.obs[k], b.obs[k]]) for k in a.obs}
     else:
-        new_obs = np.concatenate([a.obs, obs])
-    return Demonstrations(new_obs, np.concatenate([a.actions, actions]),
-                          np.concatenate([a.rewards, rewards]), np.concatenate([a.ends, ends]),
+        obs = np.concatenate([a.obs, b.obs])
+    return Demonstrations(obs, np.concatenate([a.actions, b.actions]),
+                          np.concatenate([a.rewards, b.rewards]),
+                          np.concatenate([a.ends, b.ends]),
                           a.seeds, a.returns, a.lengths, a.successes)
-
-
-def play_labelled(labeller: Labeller, env, first: int, episodes: int):
-    """``episodes`` episodes (seeds ``first ..``) of ``labeller`` on ``env``: the pairs
-    (observations, the controller's labels, rewards, episode ends) and the play's success rate
-    and mean return."""
-    returns, successes, lengths = [], [], []
-    for k in range(int(episodes)):
-        ep = run_episode(env, labeller, first + k, on_step=labeller.on_step)
-        agent = next(iter(ep.returns))
-        returns.append(float(ep.returns[agent]))
-        successes.append(ep.success(agent))
-        lengths.append(int(ep.length))
-    obs = ({k: np.stack([o[k] for o in labeller.obs]) for k in labeller.obs[0]}
-           if isinstance(labeller.obs[0], dict) else np.stack(labeller.obs))
-    ends = np.zeros(len(labeller.actions), bool)
-    ends[np.cumsum(lengths) - 1] = True
-    reported = [s for s in successes if s is not None]
-    return (obs, np.stack(labeller.actions), np.asarray(labeller.rewards, np.float32), ends,
-            {"success_rate": float(np.mean(reported)) if reported else None,
-             "return_mean": float(np.mean(returns))})
 
 
 def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, Any],
@@ -90,14 +70,17 @@ def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, 
     rounds, best = [], None
     for r in range(int(settings["dagger_rounds"]) + 1):
         first = DAGGER_SEED + int(seed) + 1000 * r
-        *pairs, measured = play_labelled(Labeller(controller, env, model), env, first,
-                                 int(settings["dagger_episodes"]))
-        demos = _joined(demos, *pairs)
+        played = play(Labeller(controller, env, model), env, first,
+                      int(settings["dagger_episodes"]))
+        demos = _joined(demos, played)
+        measured = played.summary()
         score = (measured["success_rate"] or 0.0, measured["return_mean"])
         if best is None or score > best[0]:
             best = (score, copy.deepcopy(model.policy.state_dict()), r)
-        record = {"round": r + 1, "seeds": [first, first + int(settings["dagger_episodes"]) - 1],
-                  **measured, "pairs_added": len(pairs[3]), "pairs": len(demos)}
+        record = {"round": r + 1, "seeds": measured["seeds"],
+                  "success_rate": measured["success_rate"],
+                  "return_mean": measured["return_mean"], "pairs_added": len(played),
+                  "pairs": len(demos)}
         if r < int(settings["dagger_rounds"]):
             res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
                         float(settings["lr"]), str(settings["loss"]), int(seed) + r + 1,

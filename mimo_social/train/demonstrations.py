@@ -72,7 +72,7 @@ from ..envs.catalog import entry
 from .tasks import TrainInputError
 
 __all__ = ["BC_DEFAULTS", "BC_ALGOS", "DEMO_SEED", "Demonstrations", "Demonstrator",
-           "check_bc", "record_demonstrations", "Cloner", "clone", "keep_cloning",
+           "check_bc", "play", "record_demonstrations", "Cloner", "clone", "keep_cloning",
            "returns_to_go", "fit_critic", "warm_start", "evaluate_after_bc"]
 
 #: the settings of ``bc_kwargs`` and their defaults (``epochs``: ``bc_epochs``)
@@ -222,27 +222,34 @@ class Demonstrator:
         return flat
 
 
+def play(recorder: Demonstrator, env, first: int, episodes: int) -> Demonstrations:
+    """``episodes`` episodes (seeds ``first, first+1, ...``) of ``recorder`` (a
+    :class:`Demonstrator`, or anything that records as one) on ``env``: every pair it recorded,
+    with each step's reward, the episodes' ends and each episode's numbers."""
+    seeds, returns, lengths, successes = [], [], [], []
+    for k in range(int(episodes)):
+        ep = run_episode(env, recorder, first + k, on_step=recorder.on_step)
+        agent = next(iter(ep.returns))
+        seeds.append(first + k)
+        returns.append(float(ep.returns[agent]))
+        lengths.append(int(ep.length))
+        successes.append(ep.success(agent))
+    obs = ({k: np.stack([o[k] for o in recorder.obs]) for k in recorder.obs[0]}
+           if isinstance(recorder.obs[0], dict) else np.stack(recorder.obs))
+    ends = np.zeros(len(recorder.actions), bool)
+    ends[np.cumsum(lengths) - 1] = True
+    return Demonstrations(obs, np.stack(recorder.actions),
+                          np.asarray(recorder.rewards, np.float32), ends, seeds, returns,
+                          lengths, successes)
+
+
 def record_demonstrations(task: str, env, episodes: int, seed: int) -> Demonstrations:
     """``episodes`` episodes of the task's controller on the learner's env ``env`` (seeds
     ``seed, seed+1, ...``; the controller reset with each episode's seed)."""
     controller = entry(task).controller
     if controller is None:
         raise TrainInputError(f"{task} has no scripted controller")
-    demo = Demonstrator(controller, env)
-    seeds, returns, lengths, successes = [], [], [], []
-    for k in range(int(episodes)):
-        ep = run_episode(env, demo, seed + k, on_step=demo.on_step)
-        agent = next(iter(ep.returns))
-        seeds.append(seed + k)
-        returns.append(float(ep.returns[agent]))
-        lengths.append(int(ep.length))
-        successes.append(ep.success(agent))
-    obs = ({k: np.stack([o[k] for o in demo.obs]) for k in demo.obs[0]}
-           if isinstance(demo.obs[0], dict) else np.stack(demo.obs))
-    ends = np.zeros(len(demo.actions), bool)
-    ends[np.cumsum(lengths) - 1] = True
-    return Demonstrations(obs, np.stack(demo.actions), np.asarray(demo.rewards, np.float32),
-                          ends, seeds, returns, lengths, successes)
+    return play(Demonstrator(controller, env), env, seed, episodes)
 
 
 def returns_to_go(rewards: np.ndarray, ends: np.ndarray, gamma: float) -> np.ndarray:
@@ -430,16 +437,16 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
     t1 = time.perf_counter()
     res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
                 float(settings["lr"]), str(settings["loss"]), int(seed), settings["log_std"])
-    if int(settings.get("critic_epochs", 0)):
+    if int(settings["critic_epochs"]):
         res.update(fit_critic(model, demos, int(settings["critic_epochs"]),
                               int(settings["batch_size"]), float(settings["lr"]), int(seed)))
     return {**demos.summary(), "controller": entry(task).controller.__name__,
             "epochs": int(settings["epochs"]), "batch_size": int(settings["batch_size"]),
             "lr": float(settings["lr"]), "log_std": settings["log_std"],
-            "keep_updates": int(settings.get("keep_updates", 0)),
-            "keep_until": float(settings.get("keep_until", 0.5)),
-            "dagger_rounds": int(settings.get("dagger_rounds", 0)),
-            "dagger_episodes": int(settings.get("dagger_episodes", 50)), **res,
+            "keep_updates": int(settings["keep_updates"]),
+            "keep_until": float(settings["keep_until"]),
+            "dagger_rounds": int(settings["dagger_rounds"]),
+            "dagger_episodes": int(settings["dagger_episodes"]), **res,
             "record_time_s": round(t1 - t0, 1),
             "clone_time_s": round(time.perf_counter() - t1, 1)}, demos
 

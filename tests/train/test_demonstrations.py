@@ -256,10 +256,10 @@ def test_dagger_labels_the_cloned_policy_s_states_with_the_controller_s_actions(
         kept = [r for r in rounds if r["kept"]]
         assert len(kept) == 1 and kept[0]["success_rate"] == max(r["success_rate"]
                                                                  for r in rounds)
-        from mimo_social.train.dagger import Labeller, play_labelled
-        again = play_labelled(Labeller(entry_controller("reach"), env, ppo), env,
-                      kept[0]["seeds"][0], 2)[-1]
-        assert again["return_mean"] == pytest.approx(kept[0]["return_mean"], rel=1e-5)
+        from mimo_social.train.dagger import Labeller
+        from mimo_social.train.demonstrations import play
+        again = play(Labeller(entry_controller("reach"), env, ppo), env, kept[0]["seeds"][0], 2)
+        assert again.summary()["return_mean"] == pytest.approx(kept[0]["return_mean"], rel=1e-5)
         # the labels are the controller's actions (in the action box), not the policy's own
         new = slice(len(demos), len(joined))
         assert np.all(np.abs(joined.actions) <= 1)
