@@ -67,14 +67,14 @@ def _machine() -> str:
     return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
-def _final_table(folder: Path, runs: list[dict], task: str) -> str:
-    """Each finished run's last evaluation (its progress.csv), a markdown table."""
+def _final_table(runs: list[dict]) -> str:
+    """Each run's last evaluation (its progress.csv), a markdown table."""
     import csv
     lines = ["| run | steps | wall time | evaluation episodes | success, mean action | "
              "success, sampled | return, mean action |", "|---|---|---|---|---|---|---|"]
     for r in runs:
         run = Path(r["out"])
-        if r["task"] != task or not (run / "progress.csv").exists():
+        if not (run / "progress.csv").exists():
             continue
         with open(run / "progress.csv") as f:
             last = list(csv.DictReader(f))[-1]
@@ -120,14 +120,15 @@ def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = F
              f"![Fig. 8]({(out / 'fig8.png').name})", ""]
     for task in tasks:
         ours = [r for r in runs if r["task"] == task]
-        done = [r["out"] for r in ours if finished(r)]
-        missing = [Path(r["out"]).name for r in ours if not finished(r)]
+        done = [r for r in ours if finished(r)]
+        missing = [Path(r["out"]).name for r in ours if r not in done]
         if not done:
             continue
         plot_compare(out / task, task)
-        table = _final_table(out / task, [r for r in ours if finished(r)], task)
+        table = _final_table(done)
         if episodes > 0:
-            res = baselines(task, episodes, eval_seed, done, progress=progress)
+            res = baselines(task, episodes, eval_seed, [r["out"] for r in done],
+                            progress=progress)
             write_json(res, out / task / "baselines.json")
             table = markdown_table(res)
             (out / task / "baselines.md").write_text(table)
