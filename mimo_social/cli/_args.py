@@ -15,11 +15,9 @@ from __future__ import annotations
 
 import argparse
 import errno
-import inspect
 import json
 import math
 import os
-from dataclasses import fields
 from pathlib import Path
 
 __all__ = ["positive_int", "non_negative_int", "int_range", "seed", "positive_float",
@@ -169,16 +167,11 @@ def json_object(text: str) -> dict:
 
 
 def env_setting_names() -> list[str]:
-    """What ``parallel_env(**kwargs)`` of a task takes: the env's own settings, the agents'
-    settings (given to all), ``n_agents``, ``task_options`` and ``max_cycles``."""
-    from ..core.config import AgentConfig
-    from ..core.env import MimoParallelEnv
-    from ..core.factory import make_parallel
+    """What ``parallel_env(**kwargs)`` of a task takes: the env's own keywords (``n_agents``,
+    ``task_options``, ``max_cycles``, ...) and the agents' settings (given to all)."""
+    from ..core.factory import ENV_KEYWORDS, agent_settings
 
-    own = [p.name for fn in (MimoParallelEnv.__init__, make_parallel)
-           for p in inspect.signature(fn).parameters.values()
-           if p.kind is p.POSITIONAL_OR_KEYWORD and p.name not in ("self", "task", "task_cls")]
-    return sorted({*own, "max_cycles", *(f.name for f in fields(AgentConfig))})
+    return sorted({*ENV_KEYWORDS, *agent_settings()})
 
 
 def env_kwargs(text: str) -> dict:

@@ -74,7 +74,7 @@ def test_action_without_expression_when_expressions_are_on(env):
     ({"hands": "claws"}, r"hands='claws'.*mitten"),
     ({"actuation": "hydraulic"}, r"actuation.*spring_damper"),
     ({"posture": "flying"}, r"posture.*standing"),
-    ({"colour": 3}, r"unknown agent setting.*colour.*allowed"),
+    ({"colour": 3}, r"unknown keyword colour=3.*allowed"),
     ({"proprioception": {"components": ["qpos", "smell"]}}, r"proprioception.*smell"),
     ({"proprioception": {"rate": 3}}, r"unknown setting.*rate"),
     ({"vestibular": 3}, r"vestibular=3.*allowed"),
