@@ -57,17 +57,23 @@ def _from_mapping(cls, what: str, value: Mapping[str, Any]):
 class AgentConfig:
     """Everything that can differ between agents."""
 
+    # "mitten" (44 actuated DoF) or "five_fingers" (88: 22 finger joints per hand, two-toe
+    # feet); agents in one world may differ
     hands: str = "mitten"
+    # "spring_damper" (a motor per axis, controls in [-1, 1]), "muscle" (two opposing muscles
+    # per axis, controls in [0, 1]) or "positional" (controls are target angles across each
+    # joint's range, tracked by a servo within its torque limits)
     actuation: str = "spring_damper"
+    # joint angles, velocities, torques, limit sensors, the actuation's state
     proprioception: ProprioceptionConfig | None = ProprioceptionConfig()
-    vestibular: VestibularConfig | None = VestibularConfig()
-    touch: TouchConfig | None = None
-    vision: VisionConfig | None = None
-    expressions: bool = True
-    posture: str = "standing"
+    vestibular: VestibularConfig | None = VestibularConfig()   # the head's gyro and accel
+    touch: TouchConfig | None = None     # the full-body skin: a force vector per point
+    vision: VisionConfig | None = None   # two eye cameras: RGB, optionally depth
+    expressions: bool = True   # the face is part of the action: 7 expressions
+    posture: str = "standing"   # the start posture
     position: tuple[float, float] | None = None   # (x, y) on the floor; None: the task decides
     facing: tuple[float, float] | None = None     # a point (x, y) to face; None: the task decides
-    clothes_rgba: tuple[float, float, float, float] | None = None
+    clothes_rgba: tuple[float, float, float, float] | None = None  # None: distinct colours
     # Body size factor: every length of the body times `scale` (1: the 18-month-old, 77.8 cm;
     # 1.3: about a 3-year-old's height; 2.2: a caregiver's, 1.7 m); masses, torques and the rest
     # follow the scaling laws of docs/bodies.md.
@@ -211,11 +217,11 @@ class PhysicsConfig:
     # and the fastest physics: 0.88x dense's time for one infant, 0.59x for eight; MuJoCo Warp
     # takes no dense Jacobian above 60 degrees of freedom
     jacobian: str = "sparse"
-    solver: str = "newton"
-    cone: str = "pyramidal"
-    iterations: int = 50
-    tolerance: float = 1e-8
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    solver: str = "newton"         # MuJoCo's constraint solver
+    cone: str = "pyramidal"        # the friction cone
+    iterations: int = 50           # solver iterations per physics step, at most
+    tolerance: float = 1e-8        # the solver stops early below this improvement
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)   # m/s^2
 
     def __post_init__(self):
         put = partial(object.__setattr__, self)

@@ -37,7 +37,7 @@ COMPONENTS = ("qpos", "qvel", "torque", "limits", "actuation")
 class ProprioceptionConfig:
     """Joint positions, velocities, actuator torques, limit proximity, actuation state."""
 
-    components: tuple[str, ...] = COMPONENTS
+    components: tuple[str, ...] = COMPONENTS   # the parts observed, in this order
     limit_margin_deg: float = 5.0  # a limit sensor rises from 0 to 1 over this last stretch
 
     def __post_init__(self):

@@ -87,12 +87,12 @@ class TouchConfig:
     points; ``frame`` is the frame of the force vectors; ``normal_only`` keeps 1 value a point.
     """
 
-    density: float = 1.0
-    response: str = "spread_linear"
-    frame: str = "body"
-    normal_only: bool = False
-    exclude: tuple[str, ...] = ()
-    cache: bool = True
+    density: float = 1.0   # times the published points per area (spacing / sqrt(density))
+    response: str = "spread_linear"   # how a contact spreads over the points near it
+    frame: str = "body"    # the frame of the force vectors: the body part's or the world
+    normal_only: bool = False   # one value a point, the pressing force, not 3
+    exclude: tuple[str, ...] = ()   # body parts without skin
+    cache: bool = True     # read and write the built skin in the disk cache
 
     def __post_init__(self):
         put = partial(object.__setattr__, self)

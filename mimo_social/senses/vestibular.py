@@ -19,7 +19,7 @@ COMPONENTS = ("gyro", "accel")
 class VestibularConfig:
     """Angular velocity (gyro, rad/s) and linear acceleration (accel, m/s^2) at the head centre."""
 
-    components: tuple[str, ...] = COMPONENTS
+    components: tuple[str, ...] = COMPONENTS   # gyro (rad/s) and accel (m/s^2), in order
 
     def __post_init__(self):
         object.__setattr__(self, "components", components(

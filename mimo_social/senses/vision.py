@@ -60,9 +60,9 @@ EYES = ("left", "right")
 class VisionConfig:
     """Two eye cameras (60 degree field of view) rendering RGB images, optionally depth."""
 
-    width: int = 256
-    height: int = 256
-    depth: bool = False
+    width: int = 256        # pixels, each eye
+    height: int = 256       # pixels, each eye
+    depth: bool = False     # depth images too (metres), `depth_left` / `depth_right`
     every: int = 1          # render every k-th control step, holding the last images between
     acuity: float | str | None = None   # None | "age" | cut-off in cycles per degree
 
