@@ -167,19 +167,32 @@ def _wall_unit(seconds: float) -> tuple[str, float]:
 def _curves(ax, runs, xkey: str, xscale: float, key: str, scale: float, color, label: str,
             ls: str = "-"):
     """One algorithm on one axis: a thin line per seed, the mean over seeds (on the union of the
-    runs' x values up to the shortest run's end) and the min-max band."""
-    runs = [(c, p) for c, p in runs if key in p]
-    if not runs:
-        return
+    runs' x values up to the shortest run's end) and the min-max band. Rows without a value are
+    left out; a run or a mean with a single evaluation is a marker (its band a vertical bar),
+    so that no run in the legend goes undrawn."""
+    points = []
     for _, p in runs:
-        ax.plot(p[xkey] / xscale, p[key] * scale, color=color, alpha=0.3, lw=0.8, ls=ls)
-    end = min(p[xkey][-1] for _, p in runs)
-    grid = np.unique(np.concatenate([p[xkey][p[xkey] <= end] for _, p in runs]))
-    ys = np.array([np.interp(grid, p[xkey], p[key]) for _, p in runs]) * scale
+        if key not in p or xkey not in p:
+            continue
+        ok = np.isfinite(p[xkey]) & np.isfinite(p[key])
+        if ok.any():
+            points.append((p[xkey][ok], p[key][ok]))
+    if not points:
+        return
+    for x, y in points:
+        ax.plot(x / xscale, y * scale, color=color, alpha=0.3, lw=0.8, ls=ls,
+                marker="o" if len(x) == 1 else None, ms=4)
+    end = min(x[-1] for x, _ in points)
+    grid = np.unique(np.concatenate([x[x <= end] for x, _ in points]))
+    ys = np.array([np.interp(grid, x, y) for x, y in points]) * scale
     ax.plot(grid / xscale, np.nanmean(ys, axis=0), color=color, lw=2, label=label, ls=ls,
-            marker="o", ms=3)   # (a marker: a run evaluated once is a point, not a line)
-    ax.fill_between(grid / xscale, np.nanmin(ys, axis=0), np.nanmax(ys, axis=0), color=color,
-                    alpha=0.15, lw=0)
+            marker="o", ms=3 if len(grid) > 1 else 6)
+    if len(grid) == 1:            # a band of zero width is not drawn: a bar instead
+        ax.vlines(grid / xscale, np.nanmin(ys, axis=0), np.nanmax(ys, axis=0), color=color,
+                  alpha=0.5, lw=3)
+    else:
+        ax.fill_between(grid / xscale, np.nanmin(ys, axis=0), np.nanmax(ys, axis=0),
+                        color=color, alpha=0.15, lw=0)
 
 
 def group_name(config: dict) -> str:
@@ -210,7 +223,8 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
     The figure has the evaluation return (and, where the task reports one, the success rate)
     against environment steps (left) and against each run's wall time (right; left out when a
     run's ``progress.csv`` has no wall times): per algorithm a thin line per seed, the mean over
-    seeds and the min-max band."""
+    seeds and the min-max band (a run evaluated once: a point; a mean of one point: a point
+    with the min-max as a vertical bar)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -4,6 +4,7 @@ keyword arguments, and ``--jobs`` (runs in parallel processes, the same files as
 import csv
 import json
 
+import matplotlib.collections
 import matplotlib.figure
 import numpy as np
 import pytest
@@ -72,6 +73,51 @@ def test_the_figure_has_steps_and_wall_time_side_by_side(tmp_path, figures):
     assert {(r["algo"], r["seed"]) for r in rows} == {(a, s) for a in ("ppo", "sac")
                                                       for s in ("0", "1")}
     assert "wall_time_s" in rows[0]
+
+
+def _drawn_points(ax, color):
+    """The (x, y) points of ``color`` a reader sees: those of lines of two points or more, and
+    single points that carry a marker."""
+    seen = set()
+    for line in ax.get_lines():
+        if matplotlib.colors.to_hex(line.get_color()) != matplotlib.colors.to_hex(color):
+            continue
+        xy = [(float(x), float(y)) for x, y in zip(line.get_xdata(), line.get_ydata())
+              if np.isfinite(x) and np.isfinite(y)]
+        if len(xy) >= 2 or line.get_marker() not in ("None", "", " ", None):
+            seen.update((round(x, 6), round(y, 6)) for x, y in xy)
+    return seen
+
+
+def test_runs_evaluated_once_are_drawn_in_compare_png(tmp_path, figures):
+    """SAC's short runs have one evaluation each (at different wall times): each is a point on
+    both panels, the mean a point with its min-max bar, not only a name in the legend."""
+    _fake_run(tmp_path, "ppo", 0, 400, 0.01)
+    for seed, wall in ((0, 456.9), (1, 578.3)):
+        run = tmp_path / f"sac_seed{seed}"
+        run.mkdir()
+        (run / "config.json").write_text(json.dumps({"task": "reach", "algo": "sac",
+                                                     "seed": seed}))
+        write_progress(run / "progress.csv", [
+            {"timesteps": 5000, "wall_time_s": wall, "eval_return_mean": -50.0 - 30 * seed,
+             "eval_return_std": 0.0, "eval_length_mean": 88.0, "eval_success_rate": 0.0,
+             "eval_return_mean_stochastic": -70.0, "train_return_mean": -65.0,
+             "train_episodes": 70}])
+    plot_compare(tmp_path)
+    (fig,) = figures
+    steps, wall = fig.axes[0], fig.axes[1]               # the return over steps and wall time
+    assert "SAC (2 seeds), mean action" in [t.get_text() for t in steps.get_legend().texts]
+    assert {(5000.0, -50.0), (5000.0, -80.0), (5000.0, -65.0)} <= _drawn_points(steps,
+                                                                                 "tab:blue")
+    minutes = {(round(w / 60, 6), r) for w, r in ((456.9, -50.0), (578.3, -80.0))}
+    assert minutes <= _drawn_points(wall, "tab:blue")
+    bars = [c for c in steps.collections if isinstance(c, matplotlib.collections.LineCollection)
+            and matplotlib.colors.to_hex(c.get_edgecolor()[0]) == matplotlib.colors.to_hex(
+                "tab:blue")]
+    assert [[tuple(map(float, p)) for p in seg] for seg in bars[0].get_segments()] == [
+        [(5000.0, -80.0), (5000.0, -50.0)]]
+    with open(tmp_path / "compare.csv", newline="") as f:
+        assert sum(r["algo"] == "sac" for r in csv.DictReader(f)) == 2
 
 
 def test_without_success_or_wall_times_the_figure_has_fewer_panels(tmp_path, figures):
