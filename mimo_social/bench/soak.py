@@ -18,8 +18,19 @@ resident memory (``VmRSS`` of ``/proc/self/status``, MB), its OS threads (``/pro
 and open file descriptors (``/proc/self/fd``). :func:`soak` returns per phase the steps per
 second and the growth of each per 100k steps: the slope of a least-squares line through the
 samples after the warm-up (the first ``warmup`` share of the phase's steps, when caches and
-pools fill), times 1e5. :func:`write_outputs` writes the samples as ``soak.csv``, the figures as
-``soak.json`` and the three curves against steps as ``soak.png``.
+pools fill; at least :data:`WARMUP_EPISODES` episodes, the first recordings' rotation), times
+1e5. :func:`write_outputs` writes the samples as ``soak.csv``, the figures as ``soak.json`` and
+the three curves against steps as ``soak.png``.
+
+What a growth figure can resolve: resident memory jitters by about :data:`RSS_JITTER_MB` in a
+process that does not grow (allocator pages taken and given back; measured here after the
+warm-up: up to 0.7 MB), so a line fitted over ``W`` steps after the warm-up resolves about
+``RSS_JITTER_MB * 1e5 / W`` MB per 100k steps (``resolution_mb_per_100k``). A phase needs at
+least :data:`MIN_FIT_STEPS` steps after its warm-up (5 MB per 100k: a leak of 50 bytes a step)
+for its growth to mean anything (:func:`min_phase_steps`: 22,223 steps with the defaults); a
+shorter phase still runs (its steps per second are measured) but its growth figures are
+``None`` and the summary says "too short" with the minimum. (Extrapolated from 400 steps, the
+first episode's allocations read as "+1670 MB per 100k steps".)
 """
 
 from __future__ import annotations
@@ -41,13 +52,22 @@ from ..core.random_actions import random_action_block
 from ..envs import free_play_v0
 from ..util.checks import check_int, check_number
 
-__all__ = ["PHASES", "METRICS", "process_sample", "soak", "write_outputs", "format_summary"]
+__all__ = ["PHASES", "METRICS", "process_sample", "soak", "write_outputs", "format_summary",
+           "min_phase_steps", "warmup_steps", "short_phases", "MIN_FIT_STEPS", "RSS_JITTER_MB",
+           "WARMUP_EPISODES"]
 
 #: the phases of a soak, in the order they run
 PHASES = ("touch", "vision+recording")
 #: what is sampled: (key, label with unit)
 METRICS = (("rss_mb", "resident memory (MB)"), ("threads", "OS threads"),
            ("fds", "open file descriptors"))
+#: MB: how much the resident memory of a process that does not grow moves between samples
+RSS_JITTER_MB = 1.0
+#: steps after the warm-up a growth figure needs: it then resolves RSS_JITTER_MB * 1e5 /
+#: MIN_FIT_STEPS = 5 MB per 100k steps
+MIN_FIT_STEPS = 20_000
+#: the warm-up covers at least this many episodes (the first reset and recording rotation)
+WARMUP_EPISODES = 2
 CSV_FIELDS = ("phase", "step", "total_step", "wall_s", "rss_mb", "threads", "fds",
               "steps_per_s", "recordings")
 
@@ -70,6 +90,27 @@ def process_sample() -> dict[str, float]:
         except OSError:
             pass
     return out
+
+
+def warmup_steps(n_steps: int, episode_steps: int, warmup: float) -> float:
+    """The steps of a phase of ``n_steps`` left out of the growth fit: the ``warmup`` share of
+    them, at least :data:`WARMUP_EPISODES` episodes of ``episode_steps``."""
+    return max(warmup * n_steps, WARMUP_EPISODES * episode_steps)
+
+
+def min_phase_steps(episode_steps: int = 1000, warmup: float = 0.1) -> int:
+    """The fewest steps of a phase whose growth figures mean something: its warm-up
+    (:func:`warmup_steps`) and then :data:`MIN_FIT_STEPS`."""
+    by_share = math.ceil(MIN_FIT_STEPS / (1.0 - warmup))
+    return max(by_share, WARMUP_EPISODES * episode_steps + MIN_FIT_STEPS)
+
+
+def short_phases(steps: int, vision_steps: int, episode_steps: int = 1000,
+                 warmup: float = 0.1) -> dict[str, int]:
+    """``{phase: its steps}`` of the phases that run (steps > 0) but too few steps for a growth
+    figure (fewer than :func:`min_phase_steps`)."""
+    least = min_phase_steps(episode_steps, warmup)
+    return {p: n for p, n in zip(PHASES, (steps, vision_steps)) if 0 < n < least}
 
 
 def growth_per_100k(steps, values, warmup_step: float = 0.0) -> float:
@@ -154,9 +195,12 @@ def soak(steps: int = 1_000_000, vision_steps: int = 100_000, *, seed: int = 0,
 
     Each phase is sampled every ``min(sample_every, steps // 20)`` steps (at least 20 samples
     a phase); its figures are ``steps``, ``wall_s``, ``steps_per_s``, ``episodes``,
-    ``recordings``, the first and last sample and ``growth_per_100k[metric]`` (see the module
-    docstring; the warm-up is the first ``warmup`` share of the phase's steps). Recordings go
-    to ``folder`` (default: a temporary folder, removed at the end).
+    ``recordings``, the first and last sample, ``warmup_steps``, ``min_steps``,
+    ``resolution_mb_per_100k`` and ``growth_per_100k[metric]`` (see the module docstring; the
+    warm-up is the first ``warmup`` share of the phase's steps, at least
+    :data:`WARMUP_EPISODES` episodes; ``None`` each when the phase has fewer than
+    ``min_steps``). Recordings go to ``folder`` (default: a temporary folder, removed at the
+    end).
     """
     steps = check_int("soak", "steps", steps, lo=0)
     vision_steps = check_int("soak", "vision_steps", vision_steps, lo=0)
@@ -189,13 +233,19 @@ def soak(steps: int = 1_000_000, vision_steps: int = 100_000, *, seed: int = 0,
                              keep_recordings, bar.update if bar is not None else (lambda k: None),
                              offset, rows)
             mine = rows[first:]
+            warm = warmup_steps(n, episode_steps, warmup)
+            least = min_phase_steps(episode_steps, warmup)
             res["sample_every"] = every
             res["first"] = {k: mine[0][k] for k, _ in METRICS}
             res["last"] = {k: mine[-1][k] for k, _ in METRICS}
+            res["warmup_steps"] = int(math.ceil(warm))
+            res["min_steps"] = least
+            res["resolution_mb_per_100k"] = (round(RSS_JITTER_MB * 1e5 / (n - warm), 3)
+                                             if n >= least else None)
             res["growth_per_100k"] = {
                 k: round(growth_per_100k([r["step"] for r in mine], [r[k] for r in mine],
-                                         warmup * n), 3) + 0.0     # + 0.0: no "-0.0"
-                for k, _ in METRICS}
+                                         warm), 3) + 0.0 if n >= least else None
+                for k, _ in METRICS}                                 # + 0.0: no "-0.0"
             phases[phase] = res
             offset += n
     finally:
@@ -218,9 +268,14 @@ def format_summary(result: dict) -> str:
     for phase, r in result["phases"].items():
         g = r["growth_per_100k"]
         rss = f"{r['first']['rss_mb']:.0f} -> {r['last']['rss_mb']:.0f}"
-        lines.append(f"{phase:<18} {r['steps']:>9} {r['steps_per_s']:>8.0f} "
-                     f"{r['recordings']:>5}  {rss:>21} {g['rss_mb']:>8.2f} "
-                     f"{g['threads']:>12.2f} {g['fds']:>9.2f}")
+        head = (f"{phase:<18} {r['steps']:>9} {r['steps_per_s']:>8.0f} "
+                f"{r['recordings']:>5}  {rss:>21} ")
+        if g["rss_mb"] is None:
+            lines.append(head + f"too short for a growth figure: give it at least "
+                                f"{r['min_steps']} steps")
+        else:
+            lines.append(head + f"{g['rss_mb']:>8.2f} {g['threads']:>12.2f} {g['fds']:>9.2f}"
+                         f"  (+-{r['resolution_mb_per_100k']:.2f} MB/100k)")
         lines.append(f"{'':<18} threads {r['first']['threads']:.0f} -> "
                      f"{r['last']['threads']:.0f}, fds {r['first']['fds']:.0f} -> "
                      f"{r['last']['fds']:.0f}")
@@ -276,11 +331,13 @@ def plot(result: dict, path: str | Path) -> None:
             y = np.array([s[key] for s in rows], float)
             ax.plot(x, y, "o-", ms=3, lw=1, color="#4C72B0")
             g = r["growth_per_100k"][key]
-            keep = x >= warm * r["steps"]
-            if np.isfinite(g) and keep.sum() >= 2:
+            keep = x >= r["warmup_steps"]
+            if g is not None and np.isfinite(g) and keep.sum() >= 2:
                 k, c = np.polyfit(x[keep], y[keep], 1)
                 ax.plot(x[keep], k * x[keep] + c, "--", color="#C44E52", lw=1)
-            ax.set_title(f"{phase}: {label}\ngrowth {g:+.2f} per 100k steps", fontsize=9)
+            growth = (f"growth {g:+.2f} per 100k steps" if g is not None else
+                      f"too short for a growth figure (min {r['min_steps']} steps)")
+            ax.set_title(f"{phase}: {label}\n{growth}", fontsize=9)
             ax.set_ylabel(label, fontsize=8)
             ax.tick_params(labelsize=7)
             ax.xaxis.set_major_formatter(FuncFormatter(short))
@@ -291,5 +348,6 @@ def plot(result: dict, path: str | Path) -> None:
                               f"{r['recordings']} recordings)" if phase != "touch"
                               else f"steps ({r['steps_per_s']:.0f} steps/s)", fontsize=8)
     fig.suptitle("mimo-social bench soak: growth after a warm-up of "
-                 f"{warm:.0%} of each phase's steps", fontsize=10)
+                 f"{warm:.0%} of each phase's steps (at least {WARMUP_EPISODES} episodes)",
+                 fontsize=10)
     fig.savefig(str(path), dpi=110)

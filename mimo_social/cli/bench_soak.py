@@ -3,7 +3,12 @@ resident memory, OS threads and open file descriptors, and report their growth p
 (the library: :mod:`mimo_social.bench.soak`).
 
     mimo-social bench soak --out soak              # 1e6 touch steps, 1e5 vision + recording
-    mimo-social bench soak --steps 20000 --vision-steps 5000 --out /tmp/soak
+    mimo-social bench soak --steps 50000 --vision-steps 25000 --out /tmp/soak
+
+A phase shorter than :func:`mimo_social.bench.soak.min_phase_steps` (22,223 steps with the
+default warm-up and episodes) runs, but a warning before the run says so and the summary gives
+no growth for it ("too short", with the minimum). ``--vision-steps`` defaults to a tenth of
+``--steps`` (so ``--steps 10`` is a short run, not 1e5 steps of vision); with ``--steps 0``, 1e5.
 """
 
 from __future__ import annotations
@@ -13,7 +18,7 @@ import sys
 from pathlib import Path
 
 from ..bench import soak as soak_lib
-from ._args import non_negative_int
+from ._args import non_negative_int, output_dir
 
 __all__ = ["NAME", "HELP", "add_parser", "run"]
 
@@ -72,10 +77,10 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
                     "least-squares line after the warm-up) and the steps per second.")
     parser.add_argument("--steps", type=_count, default=1_000_000, metavar="N",
                         help="steps of free play with touch (default: 1e6; 0 skips it)")
-    parser.add_argument("--vision-steps", type=_count, default=100_000, metavar="N",
-                        help="steps of free play with vision + recording (default: 1e5; "
-                             "0 skips it)")
-    parser.add_argument("--out", default="soak", metavar="DIR",
+    parser.add_argument("--vision-steps", type=_count, default=None, metavar="N",
+                        help="steps of free play with vision + recording (default: a tenth of "
+                             "--steps, 1e5 with --steps 0; 0 skips it)")
+    parser.add_argument("--out", default="soak", metavar="DIR", type=output_dir,
                         help="folder for soak.csv, soak.json, soak.png (default: ./soak)")
     parser.add_argument("--seed", type=non_negative_int, default=0, help="seed of actions and resets")
     parser.add_argument("--sample-every", type=_positive, default=10_000, metavar="N",
@@ -87,7 +92,7 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
                         help="eye image edge in pixels, 8 to 2048 (default: 64)")
     parser.add_argument("--warmup", type=_fraction, default=0.1, metavar="F",
                         help="share of each phase's steps left out of the fit (default: 0.1)")
-    parser.add_argument("--keep-recordings", default=None, metavar="DIR",
+    parser.add_argument("--keep-recordings", default=None, metavar="DIR", type=output_dir,
                         help="keep every recording in DIR (default: a temporary folder, "
                              "each file deleted once closed)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -109,15 +114,32 @@ def _command(args) -> str:
     return " ".join(parts)
 
 
+def _warn_short(args) -> None:
+    """One line on stderr per phase too short for a growth figure, before it runs."""
+    least = soak_lib.min_phase_steps(args.episode_steps, args.warmup)
+    flags = {"touch": "--steps", "vision+recording": "--vision-steps"}
+    for phase, n in soak_lib.short_phases(args.steps, args.vision_steps, args.episode_steps,
+                                          args.warmup).items():
+        print(f"mimo-social bench {NAME}: warning: {flags[phase]} {n}: too short for a growth "
+              f"figure of {phase} (its growth is left out); give at least {least} steps (a "
+              f"warm-up of {args.warmup:g} of the steps, at least "
+              f"{soak_lib.WARMUP_EPISODES} episodes, then {soak_lib.MIN_FIT_STEPS} steps to "
+              "fit)", file=sys.stderr)
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.vision_steps is None:        # a tenth of --steps, as the defaults 1e6 and 1e5
+        args.vision_steps = args.steps // 10 if args.steps else 100_000
     if args.steps + args.vision_steps == 0:
         print(f"mimo-social bench {NAME}: error: --steps 0 and --vision-steps 0: nothing to run",
               file=sys.stderr)
         return 2
+    _warn_short(args)
     try:                                   # a folder that cannot be made: say so before the run
         Path(args.out).mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        print(f"mimo-social bench {NAME}: error: --out {args.out}: {e}", file=sys.stderr)
+    except OSError as e:                   # (--out was checked; this is a race or a full disk)
+        print(f"mimo-social bench {NAME}: error: --out {args.out}: cannot make the folder: "
+              f"{e.strerror or e}", file=sys.stderr)
         return 1
     try:
         result = soak_lib.soak(args.steps, args.vision_steps, seed=args.seed,
@@ -128,7 +150,9 @@ def run(args: argparse.Namespace) -> int:
                                progress=not args.no_progress)
         paths = soak_lib.write_outputs(result, args.out, _command(args))
     except OSError as e:
-        print(f"mimo-social bench {NAME}: error: cannot write the outputs: {e}", file=sys.stderr)
+        where = f" {e.filename}" if e.filename else ""
+        print(f"mimo-social bench {NAME}: error: cannot write the outputs{where}: "
+              f"{e.strerror or e}", file=sys.stderr)
         return 1
     print(soak_lib.format_summary(result))
     print("wrote " + ", ".join(str(p) for p in paths.values()))

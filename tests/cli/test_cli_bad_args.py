@@ -86,6 +86,8 @@ BAD = [
     (["bench", "engines", "--out", "{file}"], "--out"),
     (["bench", "soak", "--steps", "-1"], "--steps"),
     (["bench", "soak", "--vision-size", "4"], "--vision-size"),
+    (["bench", "soak", "--out", "{file}"], "--out"),
+    (["soak", "--keep-recordings", "{file}/r"], "--keep-recordings"),
     (["calibrate", "fmax", "--iterations", "-1"], "--iterations"),
     (["calibrate", "fmax", "--steps", "3"], "--steps"),
     (["calibrate", "vmax", "--episodes", "0"], "--episodes"),
