@@ -6,9 +6,11 @@ read-back waits for the rasterizer threads). So:
 
 * one GL context per process, created lazily in the process that renders and never pickled;
   current only inside :func:`gl_current` (a process-wide lock; released after each render, ~10
-  us), so any thread may render; a process forked after OpenGL was used refuses to render
-  with a RuntimeError (Mesa would hang there): use the ``spawn`` / ``forkserver`` start methods
-  for worker processes;
+  us), so any thread may render; a process forked after its parent used OpenGL makes its own
+  context on a new EGL display (:func:`mimo_social.render.gl.fresh_display_after_fork`; the
+  inherited one would hang) and renderers made in the parent remake their GL objects there;
+  where no new display can be had (OSMesa) it refuses to render with a RuntimeError that says
+  to use the ``spawn`` / ``forkserver`` start methods for worker processes;
 * one :class:`TileRenderer` (one ``MjrContext``, one offscreen buffer) for all the cameras of
   a world: every image is a tile (a viewport) of that buffer, rendered one after the other and
   read back with ONE ``glReadPixels`` per step; an agent's two eyes sit side by side and are
@@ -47,11 +49,11 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-from .gl import INSTALL_HINT, gl_backend, gl_context_class
+from .gl import INSTALL_HINT, fresh_display_after_fork, gl_backend, gl_context_class
 
 __all__ = ["shared_gl_context", "gl_current", "free_shared_gl_context", "has_gl_context",
-           "TileRenderer", "Tile", "tessellation_for", "coarse_planes", "free_render_context",
-           "MAX_BUFFER_SIDE"]
+           "inherited", "TileRenderer", "Tile", "tessellation_for", "coarse_planes",
+           "free_render_context", "MAX_BUFFER_SIDE"]
 
 MAX_BUFFER_SIDE = 4096      # tiles are packed in batches no larger than this (pixels per side)
 _GL = None                  # the process's GL context
@@ -63,6 +65,7 @@ _FORKED_FROM = None         # (parent pid, what it had made) in a child forked a
 _TLS = threading.local()    # .depth: gl_current blocks open on this thread
 _PENDING = []               # MjrContexts to free when the current render ends
 _LEFT_ON = None             # the thread shared_gl_context() left the context current on
+_INHERITED = []             # GL objects a forked child got from its parent: kept, never freed
 
 
 def has_gl_context() -> bool:
@@ -93,25 +96,47 @@ if hasattr(os, "register_at_fork"):
     os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
-def _refuse_after_fork() -> None:
+def _own_display_after_fork() -> None:
+    """In a process forked after its parent used OpenGL: a new display for this process's own
+    context (the parent's context and display are kept, untouched: using or freeing them here
+    hangs), else a RuntimeError naming the cause and the fix. Call under _LOCK."""
+    global _GL, _GL_PID, _FORKED_FROM
     if _FORKED_FROM is None:
+        return
+    if fresh_display_after_fork():
+        if _GL is not None:
+            _INHERITED.append(_GL)
+        _GL, _GL_PID, _FORKED_FROM = None, None, None
         return
     parent, used = _FORKED_FROM
     raise RuntimeError(
         f"cannot render in process {os.getpid()}: it was forked from process {parent}, which "
-        f"had already made {used}; OpenGL (Mesa's EGL and OSMesa alike) does not survive "
-        "fork: a new context here hangs and the inherited one fails. Start worker processes "
-        "with the 'spawn' or 'forkserver' method (multiprocessing.set_start_method('spawn'), "
-        "or the start_method argument of the vector env), or make and step the vision envs "
-        "only inside the workers, forking before the parent renders anything")
+        f"had already made {used}; with MUJOCO_GL={gl_backend()!r} no new display could be "
+        "made here (that needs EGL with Mesa's surfaceless platform), and the inherited one "
+        "hangs. Start worker processes with the 'spawn' or 'forkserver' method "
+        "(multiprocessing.set_start_method('spawn'), or the start method or context argument "
+        "of the vector env), use MUJOCO_GL=egl, or fork before the parent renders anything")
+
+
+def inherited(con, made_in: int | None) -> bool:
+    """Whether ``con`` (GL objects made in process ``made_in``) came from a parent process
+    through fork; it is then kept alive and never freed here (its ids mean nothing, or other
+    objects, in this process's context). Renderers call this before drawing and remake their
+    objects when it says True."""
+    if con is None or made_in is None or made_in == os.getpid():
+        return False
+    _INHERITED.append(con)
+    return True
 
 
 def _context():
     """The process's GL context, made on first use (not left current); call under _LOCK."""
     global _GL, _GL_PID, _GL_MADE, _ATEXIT
-    _refuse_after_fork()
+    _own_display_after_fork()
     if _GL is not None and _GL_PID == os.getpid():
         return _GL
+    if _GL is not None:   # made in a parent process: kept, never freed here
+        _INHERITED.append(_GL)
     _GL = None
     cls = gl_context_class()
     try:
@@ -135,10 +160,10 @@ def gl_current():
     The renderers draw only inside this block: one thread at a time (a process-wide lock), and
     at the end the context is released again (or the context that was current before is made
     current again), so any thread may render next: an env made and reset on one thread can be
-    stepped on another. Costs ~10 us a block (EGL, llvmpipe). Raises a RuntimeError naming the
-    cause in a process forked from one that had used OpenGL (where rendering would hang)."""
+    stepped on another. Costs ~10 us a block (EGL, llvmpipe). In a process forked from one
+    that had used OpenGL the context is made on a new display; where none can be made (OSMesa)
+    it raises a RuntimeError naming the cause and the fix (rendering there would hang)."""
     global _LEFT_ON
-    _refuse_after_fork()
     with _LOCK:
         ctx = _context()
         me = threading.get_ident()
@@ -259,8 +284,11 @@ def coarse_planes(model):
     return planes, grid
 
 
-def free_render_context(con) -> None:
-    """Free an MjrContext made on this process's shared GL context (no-op after a fork)."""
+def free_render_context(con, made_in: int | None = None) -> None:
+    """Free an MjrContext made on this process's shared GL context (in process ``made_in``,
+    when given); one made in a parent process before a fork is kept, not freed."""
+    if inherited(con, made_in):
+        return
     if con is None or _GL is None or _GL_PID != os.getpid() or _FORKED_FROM is not None:
         return
     if getattr(_TLS, "depth", 0):   # called (e.g. by the garbage collector) amid a render
@@ -343,6 +371,7 @@ class TileRenderer:
         self.floor_quads = floor_quads
         self.cull = cull
         self._con = None
+        self._con_pid = None   # the process the GL objects were made in
         self._scn = None
 
     # -- lazily made GL objects ----------------------------------------------------------------
@@ -378,6 +407,7 @@ class TileRenderer:
         opt.flags[mujoco.mjtVisFlag.mjVIS_FLEXSKIN] = 1
         opt.sitegroup[:] = 0                   # sites are markers, not things to see
         self._con, self._scn, self._opt = con, scn, opt
+        self._con_pid = os.getpid()
         self._cam = mujoco.MjvCamera()
         self._cam.type = mujoco.mjtCamera.mjCAMERA_FIXED
         opt.geomgroup[_CULL_GROUP] = 0
@@ -409,7 +439,7 @@ class TileRenderer:
         return self._read
 
     def close(self):
-        free_render_context(getattr(self, "_con", None))
+        free_render_context(getattr(self, "_con", None), getattr(self, "_con_pid", None))
         self._con = self._scn = None
 
     def __del__(self):   # the GL objects live in a context current only while rendering:
@@ -428,6 +458,8 @@ class TileRenderer:
         """Render ``jobs`` = [(tile index, camera id), ...] now; return {tile index: (rgb,
         depth or None)} as new arrays (rgb uint8 (h, w, 3); depth float32 (h, w) in metres
         along the camera's view axis)."""
+        if inherited(self._con, self._con_pid):   # made before a fork: remade in this process
+            self._con = None
         with gl_current():     # any thread; the context is released again at the end
             if self._con is None:
                 self._make(model)

@@ -12,15 +12,19 @@ was as fast as any other thread count, and ``softpipe`` is ~50x slower.
 Every renderer of the package shares ONE GL context per process (made on first use, in the
 process that renders): the eyes (:mod:`mimo_social.render.eye_renderer`) and ``env.render()``
 (:mod:`mimo_social.render.scene`). It is current only while a renderer draws, so any thread
-may render. OpenGL does not survive ``fork`` (Mesa hangs in the child): a process forked after
-its parent used OpenGL raises a RuntimeError when it tries to render, so subprocess vector envs
-must use the ``spawn`` or ``forkserver`` start method (or fork before anything renders). When
+may render. An OpenGL context does not survive ``fork`` (Mesa hangs in the child on the
+display its parent used): a process forked after its parent used EGL makes its own context on a
+new display of Mesa's surfaceless platform (:func:`fresh_display_after_fork`), so subprocess
+vector envs work with the default ``fork`` start method too; where that is not possible (OSMesa,
+a driver without the surfaceless platform) it raises a RuntimeError that says to use ``spawn``
+or ``forkserver``. When
 ``mujoco`` was imported before ``mimo_social`` (so it chose GLFW, useless without a display),
 :func:`gl_context_class` loads EGL's or OSMesa's context class when the first context is made.
 """
 
 from __future__ import annotations
 
+import ctypes
 import ctypes.util
 import os
 import sys
@@ -100,3 +104,36 @@ def gl_context_class():
                        "was chosen, and none could be loaded now (" + "; ".join(errors) + "); "
                        "set MUJOCO_GL=egl (or osmesa) before starting Python, or import "
                        f"mimo_social first; if that fails too, {INSTALL_HINT}")
+
+
+EGL_PLATFORM_SURFACELESS_MESA = 0x31DD
+
+
+def fresh_display_after_fork() -> bool:
+    """In a process forked after its parent used EGL: point MuJoCo's EGL module at a new,
+    initialised display of Mesa's surfaceless platform, so that the next context is made there
+    (the inherited display's rasterizer threads were not forked: a context on it hangs). The
+    inherited display is left alone. Returns whether it did; False where the backend is not EGL,
+    the driver has no surfaceless platform, or the inherited display already was that one."""
+    egl_module = sys.modules.get("mujoco.egl")
+    if egl_module is None or os.environ.get("MUJOCO_GL") != "egl":
+        return False
+    egl = egl_module.EGL
+    try:
+        extensions = egl.eglQueryString(egl.EGL_NO_DISPLAY, egl.EGL_EXTENSIONS) or b""
+        if b"EGL_MESA_platform_surfaceless" not in extensions:
+            return False
+        display = egl.eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA,
+                                               egl.EGL_DEFAULT_DISPLAY, None)
+        if not display or _address(display) == _address(egl_module.EGL_DISPLAY):
+            return False
+        if egl.eglInitialize(display, None, None) != egl.EGL_TRUE:
+            return False
+    except Exception:  # noqa: BLE001 - no fresh display: the caller says what to do instead
+        return False
+    egl_module.EGL_DISPLAY = display
+    return True
+
+
+def _address(pointer) -> int | None:
+    return None if pointer is None else ctypes.cast(pointer, ctypes.c_void_p).value

@@ -6,10 +6,12 @@ gives a :class:`SceneRenderer` with the model's own visual quality.
 
 from __future__ import annotations
 
+import os
+
 import mujoco
 import numpy as np
 
-from .eye_renderer import coarse_planes, free_render_context, gl_current
+from .eye_renderer import coarse_planes, free_render_context, gl_current, inherited
 from .gl import ensure_gl_backend
 
 __all__ = ["SceneRenderer", "make_scene_renderer", "make_renderer"]
@@ -26,6 +28,7 @@ class SceneRenderer:
         self._height, self._width = int(height), int(width)
         self._max_geom = max_geom
         self._con = None
+        self._con_pid = None   # the process the GL objects were made in
         self._scene = mujoco.MjvScene(model, max_geom)
         self._scene_option = mujoco.MjvOption()
         self._rect = mujoco.MjrRect(0, 0, self._width, self._height)
@@ -50,6 +53,7 @@ class SceneRenderer:
         try:
             vis.offwidth, vis.offheight = max(saved[0], self._width), max(saved[1], self._height)
             self._con = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_150)
+            self._con_pid = os.getpid()
         finally:
             vis.offwidth, vis.offheight = saved
             if grid is not None:
@@ -77,6 +81,8 @@ class SceneRenderer:
 
     def render(self, *, out: np.ndarray | None = None) -> np.ndarray:
         buf = np.empty((self._height, self._width, 3), np.uint8)
+        if inherited(self._con, self._con_pid):   # made before a fork: remade in this process
+            self._con = None
         with gl_current():     # any thread; the context is released again at the end
             if self._con is None:
                 self._make()
@@ -90,7 +96,7 @@ class SceneRenderer:
         return np.ascontiguousarray(img)
 
     def close(self):
-        free_render_context(getattr(self, "_con", None))
+        free_render_context(getattr(self, "_con", None), getattr(self, "_con_pid", None))
         self._con = None
 
     def __del__(self):   # free the GL objects on the shared context (not current after a render)
