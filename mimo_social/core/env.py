@@ -11,6 +11,8 @@ allowed. A simulation that goes unstable ends the episode for every agent with t
 The senses come from the registry :data:`mimo_social.senses.SENSES`: for each registered sense
 that an agent has on, a sense of its own, or one shared system for the world (the skin reads the
 contacts once for everyone, the eyes of everyone share one renderer) with a sense per agent.
+A sense with nothing to read (proprioception when every joint of the agent is held) is left out:
+its key is absent from the observation, never an array of size 0.
 
 Sensorimotor delays (``AgentConfig.delays``, :mod:`mimo_social.core.delays`): a sense delayed by
 ``k`` control steps observes at step ``t`` what it read at ``t - k`` (the reading at reset before
@@ -73,6 +75,12 @@ def _expression_id(agent: str, given) -> int:
 
 
 _INT_SCALARS = frozenset((np.int64, np.int32, np.int16, np.int8, np.uint64, np.uint32,
+def _empty(space) -> bool:
+    """Whether an observation space holds no value (a Box with a 0 in its shape)."""
+    shape = getattr(space, "shape", None)
+    return shape is not None and 0 in shape
+
+
                           np.uint16, np.uint8))
 
 
@@ -160,14 +168,18 @@ class MimoParallelEnv(ParallelEnv):
             if system is not None:
                 self.systems[key] = system
             for i, sense in enumerate(per_agent):
-                if sense is not None:
+                # a sense with nothing to read (proprioception of an agent whose joints are all
+                # held) is left out: its key is absent, never an array of size 0
+                if sense is not None and not all(_empty(s) for s in sense.spaces.values()):
                     self.senses[i].append(sense)
         for i, name in enumerate(self.possible_agents):
             obs = {}
             for sense in self.senses[i]:
                 obs.update(sense.spaces)
             obs.update(self.task.task_spaces(self, i))
-            if not obs:
+            # an agent whose senses on have nothing to read (a scripted partner without eyes,
+            # every joint held) observes an empty dict; every sense off is a mistake
+            if not obs and not any(getattr(self.agent_configs[i], key) for key in SENSES):
                 raise ConfigError(f"{name}: every sense is off; turn on at least one of "
                                   f"{', '.join(SENSES)}")
             self._obs_spaces[name] = spaces.Dict(obs)

@@ -87,7 +87,9 @@ class ObsFlattener:
             hi = np.asarray(flat.high, dtype=np.float32).ravel()
             lows.append(lo * scale if image else lo)
             highs.append(hi * scale if image else hi)
-        self.space = spaces.Box(np.concatenate(lows), np.concatenate(highs), dtype=np.float32)
+        empty = np.zeros(0, np.float32)   # an agent that observes nothing (an empty Dict)
+        self.space = spaces.Box(np.concatenate(lows or [empty]),
+                                np.concatenate(highs or [empty]), dtype=np.float32)
         self._box = [isinstance(sub, spaces.Box) for _, sub in self.parts]
 
     def __call__(self, obs) -> np.ndarray:
@@ -99,7 +101,7 @@ class ObsFlattener:
                 chunks.append(v * scale if scale is not None else v)
             else:
                 chunks.append(np.asarray(spaces.flatten(sub, value), dtype=np.float32).ravel())
-        return np.concatenate(chunks)
+        return np.concatenate(chunks) if chunks else np.zeros(0, np.float32)
 
 
 class FlatObservationWrapper(gym.ObservationWrapper):

@@ -165,6 +165,30 @@ def test_pickle_mid_episode(entry, form):
     clone.close()
 
 
+# -- observations ------------------------------------------------------------------------------
+@pytest.mark.parametrize("entry, form", _cases("observations", forms=FORMS))
+def test_no_observation_is_an_empty_array(entry, form):
+    """After a reset no agent observes an array of size 0 (a client reducing over every key,
+    ``np.max`` say, fails on one: an agent whose joints are all held has no proprioception key
+    at all), every observation lies in its agent's space with the same keys, and no agent of
+    the world (scripted partners too) has a space of size 0."""
+    env = _make(entry, form)
+    obs, _ = env.reset(seed=0)
+    inner = env.unwrapped
+    for agent in inner.possible_agents:
+        for key, space in inner.observation_space(agent).spaces.items():
+            assert 0 not in space.shape, f"{agent}: space {key!r} is {space}"
+    assert set(obs) == set(env.possible_agents)
+    for agent, o in obs.items():
+        space = env.observation_space(agent)
+        assert set(o) == set(space.spaces), agent
+        assert space.contains(o), agent
+        for key, value in o.items():
+            assert np.asarray(value).size > 0, f"{agent}: {key!r} has size 0"
+            assert np.isfinite(np.max(value)), (agent, key)
+    env.close()
+
+
 # -- rendering ---------------------------------------------------------------------------------
 @pytest.mark.parametrize("entry, form", _cases("render"))
 def test_render_rgb_array(entry, form):

@@ -100,9 +100,9 @@ def test_options_conditions_and_bodies():
     motors = env.action_space("infant_0")["motors"]
     assert motors.shape == (9,) and (motors.low == -1).all() and (motors.high == 1).all()
     assert env.action_space("infant_0")["expression"].n == len(EXPRESSIONS)
-    # held (gaze_free=False): no motor, no proprioception
+    # held (gaze_free=False): no motor, no proprioception key (never an empty array)
     held = contingency_v0.parallel_env(task_options=HELD)
-    assert held.observation_space("infant_0")["proprioception"].shape == (0,)
+    assert set(held.observation_space("infant_0").spaces) == {"eye_left", "eye_right"}
     assert held.action_space("infant_0")["motors"].shape == (0,)
     # an infant caregiver stands; the scripted caregiver has no eyes
     s = contingency_v0.scripted_env(per_agent=[{}, {"body": "infant"}]).unwrapped

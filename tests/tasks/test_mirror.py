@@ -53,9 +53,9 @@ def test_spaces_eyes_and_expression_action():
     env = mirror_v0.parallel_env()
     for a in env.possible_agents:
         obs_space = env.observation_space(a)
-        assert set(obs_space.spaces) == {"proprioception", "eye_left", "eye_right"}
+        # head and eyes held: no free joint, so no proprioception key (never an empty array)
+        assert set(obs_space.spaces) == {"eye_left", "eye_right"}
         assert obs_space["eye_left"].shape == (64, 64, 3)
-        assert obs_space["proprioception"].shape == (0,)   # head and eyes held: no free joint
         assert env.action_space(a)["expression"].n == len(EXPRESSIONS)
         assert env.action_space(a)["motors"].shape == (0,)
     assert env.max_steps == 500
@@ -122,9 +122,11 @@ def test_partner_expression_only_in_the_eye_images(assisted_gaze):
         obs, _ = env.reset(seed=5)
         obs, *_ = env.step({"infant_0": act(0), "infant_1": act(e)})
         o = obs["infant_0"]
-        assert set(o) == {"proprioception", "eye_left", "eye_right"}
+        # proprioception only with assisted gaze (head and eyes are joints then)
+        assert set(o) == {"eye_left", "eye_right"} | ({"proprioception"} if assisted_gaze
+                                                      else set())
         images.append(np.concatenate([o["eye_left"], o["eye_right"]]).astype(int))
-        others.append(o["proprioception"])
+        others.append(o.get("proprioception", np.zeros(1)))
     for e in range(1, len(EXPRESSIONS)):
         np.testing.assert_array_equal(others[e], others[0])
     # every pair of faces differs clearly (thousands of pixel levels summed; the renderer is

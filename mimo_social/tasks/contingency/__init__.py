@@ -55,8 +55,9 @@ action:
     face; held (`gaze_free=False`) `motors=Box(0,)`, the face alone
 observation:
     `eye_left`, `eye_right` (64x64x3 RGB: the caregiver's face reaches the learner only through its
-    eyes), `proprioception` (54 floats: its head and eye joints; held 0, no free joint); never the
-    caregiver's expression, mode or stream
+    eyes), `proprioception` (54 floats: its head and eye joints; held: no free joint, so no such
+    key; nor for a learning caregiver, whose joints are all held); never the caregiver's
+    expression, mode or stream
 reward:
     +1 on a step of shared smiling: the learner and the caregiver both show "happy" while the
     learner's gaze is on the caregiver's face (`partners/cues.py`, `learner_cues`), else 0; with

@@ -22,9 +22,9 @@ action:
     (below)
 observation:
     `eye_left`, `eye_right` (64x64x3 RGB; the only way the partner's face reaches the learner),
-    `proprioception` (its own joints: none are free by default, so 0 floats; 36 with
-    `assisted_gaze`: the head and eye angles, constant since neither face moves); never the
-    partner's expression
+    `proprioception` only with `assisted_gaze` (36: the head and eye angles, constant since neither
+    face moves; by default every joint is held, so there is no such key); never the partner's
+    expression
 two learners:
     `roles="leader"` (default): per episode one agent is the leader, whose face the task's script
     sets (each face held for a time drawn from `leader_hold_s` (1-2 s), the next one drawn among the
