@@ -74,13 +74,13 @@ def _expression_id(agent: str, given) -> int:
                      + ", ".join(f"{k}={n}" for k, n in enumerate(EXPRESSIONS)))
 
 
-_INT_SCALARS = frozenset((np.int64, np.int32, np.int16, np.int8, np.uint64, np.uint32,
 def _empty(space) -> bool:
     """Whether an observation space holds no value (a Box with a 0 in its shape)."""
     shape = getattr(space, "shape", None)
     return shape is not None and 0 in shape
 
 
+_INT_SCALARS = frozenset((np.int64, np.int32, np.int16, np.int8, np.uint64, np.uint32,
                           np.uint16, np.uint8))
 
 
