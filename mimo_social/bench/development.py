@@ -3,14 +3,26 @@ of sensorimotor delays and of the acuity filter, each measured against the same 
 
 ``mimo-social bench development`` runs it (:mod:`mimo_social.cli.bench_development`); the numbers
 go to BENCHMARKS.md. Variants that are compared run in turns of 100 steps under the same smooth
-random actions (:func:`mimo_social.bench.vision_cost.bench_env`), so a change of the machine's
-speed touches them alike; each figure is the mean over every step.
+random actions (:func:`mimo_social.bench.vision_cost.bench_env`; 100 untimed steps each first),
+so a change of the machine's speed touches them alike; each figure is the mean over every step.
+
+A comparison (``+x % vs base``) is a ratio of two timings, and one turn's timing moves by tens of
+percent on a shared machine (a scheduler's slice, another process's burst), far more than the
+timer's resolution. So each comparison also gives the noise of that ratio turn by turn (two
+standard errors of the mean of the per-turn ratios, ``+-``), and it needs at least
+:data:`MIN_TURNS` turns of each configuration: with a per-turn spread of 15 % that bounds the
+noise near 10 %; fewer turns give no comparison (the ms per step are still shown). The delay
+configurations get ``sim_seconds`` each and the acuity ones two thirds of it, so
+:func:`min_sim_seconds` (15 s at 10 ms a step, the default) is what gives every comparison its
+turns. (From 0.06 simulated s, one turn of 6 steps, delays once read as making steps 48-53 %
+faster.)
 """
 
 from __future__ import annotations
 
+import math
 import time
-from typing import Callable, Sequence
+from typing import Sequence
 
 import numpy as np
 
@@ -18,10 +30,16 @@ from ..body.tables import load_body
 from ..core.config import PhysicsConfig
 from ..envs import free_play_v0
 from ..senses import SENSES
-from .vision_cost import bench_env
+from .vision_cost import TURN_STEPS, bench_env
 
-__all__ = ["BUILD_BODIES", "ALL_DELAYS_MS", "build_times", "delay_cost",
-           "acuity_cost", "measure", "format_results"]
+__all__ = ["BUILD_BODIES", "ALL_DELAYS_MS", "MIN_TURNS", "build_times", "delay_cost",
+           "acuity_cost", "measure", "format_results", "min_sim_seconds", "turns_of",
+           "compare_turns"]
+
+#: turns of :data:`~mimo_social.bench.vision_cost.TURN_STEPS` steps a comparison needs
+MIN_TURNS = 10
+#: the acuity configurations run this share of ``sim_seconds``
+ACUITY_SHARE = 2 / 3
 
 #: The bodies whose build time is measured: (label, agent settings).
 BUILD_BODIES = (
@@ -62,17 +80,43 @@ def build_times(hands: Sequence[str] = ("mitten", "five_fingers"), repeats: int 
     return out
 
 
-def _ms_per_step(configs: dict[str, dict], sim_seconds: float) -> dict[str, float]:
+def _control_dt() -> float:
+    return PhysicsConfig().timestep * PhysicsConfig().frame_skip
+
+
+def turns_of(sim_seconds: float) -> int:
+    """Turns of :data:`TURN_STEPS` steps that ``sim_seconds`` simulated seconds make (the last
+    one may be shorter)."""
+    return math.ceil(int(round(sim_seconds / _control_dt())) / TURN_STEPS)
+
+
+def min_sim_seconds() -> float:
+    """The fewest ``sim_seconds`` of :func:`measure` that give every comparison (the acuity
+    ones run :data:`ACUITY_SHARE` of it) :data:`MIN_TURNS` turns."""
+    return round(MIN_TURNS * TURN_STEPS * _control_dt() / ACUITY_SHARE, 6)
+
+
+def compare_turns(turn_s: Sequence[float], base_turn_s: Sequence[float]) -> dict:
+    """``turns`` and ``noise_pct``: two standard errors of the mean of the per-turn ratios of
+    ``turn_s`` over ``base_turn_s`` (the same turns of the same steps), in percent; NaN with
+    fewer than two turns."""
+    r = np.asarray(turn_s, float) / np.asarray(base_turn_s, float)
+    noise = 200 * float(np.std(r, ddof=1)) / math.sqrt(len(r)) if len(r) > 1 else math.nan
+    return {"turns": len(r), "noise_pct": noise}
+
+
+def _ms_per_step(configs: dict[str, dict], sim_seconds: float) -> tuple[dict, dict]:
     """Milliseconds per env step of each free-play configuration, measured by
     :func:`~mimo_social.bench.vision_cost.bench_env` (the configurations take turns of 100
-    steps under the same smooth random actions)."""
-    dt = PhysicsConfig().timestep * PhysicsConfig().frame_skip
-    return {r["config"]: 1e3 * r["total"] * dt for r in bench_env(configs, sim_seconds)}
+    steps under the same smooth random actions), and each one's seconds per turn."""
+    rows = bench_env(configs, sim_seconds)
+    return ({r["config"]: 1e3 * r["total"] * _control_dt() for r in rows},
+            {r["config"]: r["turn_s"] for r in rows})
 
 
-def delay_cost(sim_seconds: float = 15.0) -> dict[str, float]:
+def delay_cost(sim_seconds: float = 15.0) -> tuple[dict, dict]:
     """ms per step of two infants with touch, no delays vs every sense delayed 100 ms
-    (:data:`ALL_DELAYS_MS`), and with vision (64x64 eyes) too."""
+    (:data:`ALL_DELAYS_MS`), and with vision (64x64 eyes) too; and the seconds of each turn."""
     eyes = {"width": 64, "height": 64}
     return _ms_per_step({
         "touch": dict(n_agents=2, touch=True),
@@ -82,9 +126,10 @@ def delay_cost(sim_seconds: float = 15.0) -> dict[str, float]:
                                         delays=ALL_DELAYS_MS)}, sim_seconds)
 
 
-def acuity_cost(sizes: Sequence[int] = (128, 256), sim_seconds: float = 10.0) -> dict[str, float]:
+def acuity_cost(sizes: Sequence[int] = (128, 256), sim_seconds: float = 10.0
+                ) -> tuple[dict, dict]:
     """ms per step of two newborns with vision, acuity off vs on (the newborn's blur), per eye
-    image size."""
+    image size; and the seconds of each turn."""
     return _ms_per_step({
         f"{size}x{size} eyes, acuity {'on' if acuity else 'off'}": dict(
             n_agents=2, age_months=0.0,
@@ -92,18 +137,44 @@ def acuity_cost(sizes: Sequence[int] = (128, 256), sim_seconds: float = 10.0) ->
         for size in sizes for acuity in (None, "age")}, sim_seconds)
 
 
+def _delay_base(name: str) -> str:
+    return name.replace(" + delays", "")
+
+
+def _acuity_base(name: str) -> str:
+    return name.replace("acuity on", "acuity off")
+
+
 def measure(sim_seconds: float = 15.0, repeats: int = 3) -> dict:
     """Every figure of this module, as a dict for JSON (``sim_seconds`` per delay
-    configuration, two thirds of it per acuity one)."""
-    return {"build": build_times(repeats=repeats), "delays": delay_cost(sim_seconds),
-            "acuity": acuity_cost(sim_seconds=sim_seconds * 2 / 3)}
+    configuration, two thirds of it per acuity one): ``build``, ``delays`` and ``acuity`` (ms
+    per step) and ``comparisons`` (per compared configuration: its base, ``turns`` and
+    ``noise_pct``, :func:`compare_turns`)."""
+    delays, delay_turns = delay_cost(sim_seconds)
+    acuity, acuity_turns = acuity_cost(sim_seconds=sim_seconds * ACUITY_SHARE)
+    comparisons = {}
+    for turns, base_of in ((delay_turns, _delay_base), (acuity_turns, _acuity_base)):
+        for name, t in turns.items():
+            base = base_of(name)
+            if base != name:
+                comparisons[name] = {"base": base, **compare_turns(t, turns[base])}
+    return {"build": build_times(repeats=repeats), "delays": delays, "acuity": acuity,
+            "comparisons": comparisons, "min_turns": MIN_TURNS}
 
 
-def _relative(costs: dict[str, float], base_of: Callable[[str], str]) -> list[str]:
+def _relative(costs: dict[str, float], comparisons: dict) -> list[str]:
     lines = []
     for name, ms in costs.items():
-        base = base_of(name)
-        extra = "" if base == name else f" ({100 * (ms / costs[base] - 1):+.1f} % vs {base})"
+        c = comparisons.get(name)
+        if c is None:
+            extra = ""
+        elif c["turns"] < MIN_TURNS:
+            extra = (f" (no comparison with {c['base']}: {c['turns']} turn(s) of up to "
+                     f"{TURN_STEPS} steps, fewer than {MIN_TURNS}; give --sim-seconds >= "
+                     f"{min_sim_seconds():g})")
+        else:
+            extra = (f" ({100 * (ms / costs[c['base']] - 1):+.1f} % +- {c['noise_pct']:.1f} % "
+                     f"vs {c['base']})")
         lines.append(f"| {name} | {ms:.2f}{extra} |")
     return lines
 
@@ -115,10 +186,10 @@ def format_results(results: dict) -> str:
              "| --- | --- | --- | --- |"]
     for r in results["build"]:
         lines.append(f"| {r['hands']} | {r['body']} | {r['tables_ms']:.1f} | {r['env_ms']:.1f} |")
-    lines += ["", "Delays (every sense 100 ms), two infants, ms per step:", "",
-              "| env | ms/step |", "| --- | --- |"]
-    lines += _relative(results["delays"], lambda n: n.replace(" + delays", ""))
+    lines += ["", "Delays (every sense 100 ms), two infants, ms per step (+-: two standard "
+              "errors of the per-turn ratio):", "", "| env | ms/step |", "| --- | --- |"]
+    lines += _relative(results["delays"], results["comparisons"])
     lines += ["", "Acuity filter (newborns, age 0), two infants, ms per step:", "",
               "| env | ms/step |", "| --- | --- |"]
-    lines += _relative(results["acuity"], lambda n: n.replace("acuity on", "acuity off"))
+    lines += _relative(results["acuity"], results["comparisons"])
     return "\n".join(lines)

@@ -154,9 +154,19 @@ def bench_images(sizes=(64, 256), agents=(1, 2), rounds: int = 5, n_states: int 
     return out
 
 
-def bench_env(configs=None, sim_seconds: float = 5.0, seed: int = 0) -> list[dict]:
+#: steps each configuration of :func:`bench_env` makes, untimed, before its timed ones (the
+#: first steps pay one-off costs: the first render compiles llvmpipe's shaders, caches fill)
+WARMUP_STEPS = 100
+#: steps of one turn of :func:`bench_env`
+TURN_STEPS = 100
+
+
+def bench_env(configs=None, sim_seconds: float = 5.0, seed: int = 0,
+              warmup_steps: int = WARMUP_STEPS) -> list[dict]:
     """Real seconds per simulated second of whole env steps (vision and total, from
-    ``env.timing`` and the wall clock), the configurations taking turns of 100 steps."""
+    ``env.timing`` and the wall clock), the configurations taking turns of
+    :data:`TURN_STEPS` steps after ``warmup_steps`` untimed steps each; ``turn_s``: the wall
+    seconds of each turn (for the noise of a comparison, turn by turn)."""
     configs = configs or {
         "1 infant, 2 x 64x64": dict(n_agents=1, vision={"width": 64, "height": 64}),
         "1 infant, 2 x 256x256": dict(n_agents=1, vision={"width": 256, "height": 256}),
@@ -168,27 +178,37 @@ def bench_env(configs=None, sim_seconds: float = 5.0, seed: int = 0) -> list[dic
         env = free_play_v0.parallel_env(max_steps=10 ** 9, **kw)
         env.reset(seed=seed)
         n_steps = int(round(sim_seconds / env.dt))
-        acts = [smooth_random_actions(n_steps, env.action_space(a)["motors"].shape[0], seed + i)
+        acts = [smooth_random_actions(warmup_steps + n_steps,
+                                      env.action_space(a)["motors"].shape[0], seed + i)
                 for i, a in enumerate(env.possible_agents)]
-        for k in env.timing:
-            env.timing[k] = 0.0
-        runs[name] = {"env": env, "acts": acts, "k": 0, "n": n_steps, "wall": 0.0}
+        runs[name] = {"env": env, "acts": acts, "k": 0, "n": n_steps, "wall": 0.0,
+                      "turns": []}
+
+    def step(r, k):
+        r["env"].step({a: {"motors": r["acts"][i][0][k], "expression": int(r["acts"][i][1][k])}
+                       for i, a in enumerate(r["env"].possible_agents)})
+
+    for r in runs.values():                  # untimed: the one-off costs of the first steps
+        for k in range(warmup_steps):
+            step(r, k)
+        for key in r["env"].timing:
+            r["env"].timing[key] = 0.0
     while any(r["k"] < r["n"] for r in runs.values()):
         for r in runs.values():
-            env, acts = r["env"], r["acts"]
-            stop = min(r["n"], r["k"] + 100)
+            stop = min(r["n"], r["k"] + TURN_STEPS)
             t0 = time.perf_counter()
             for k in range(r["k"], stop):
-                env.step({a: {"motors": acts[i][0][k], "expression": int(acts[i][1][k])}
-                          for i, a in enumerate(env.possible_agents)})
-            r["wall"] += time.perf_counter() - t0
+                step(r, warmup_steps + k)
+            r["turns"].append(time.perf_counter() - t0)
+            r["wall"] += r["turns"][-1]
             r["k"] = stop
     out = []
     for name, r in runs.items():
         env, sim = r["env"], r["n"] * r["env"].dt
         out.append({"config": name, "sim_s": sim, "vision": env.timing["vision"] / sim,
-                    "total": r["wall"] / sim,
+                    "total": r["wall"] / sim, "turn_s": r["turns"],
                     **{k: v / sim for k, v in env.timing.items() if k != "vision"}})
+        env.close()
     return out
 
 

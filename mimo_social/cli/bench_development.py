@@ -3,12 +3,17 @@ of sensorimotor delays and of the acuity filter (:mod:`mimo_social.bench.develop
 
     mimo-social bench development                      # the figures of BENCHMARKS.md
     mimo-social bench development --sim-seconds 1 --repeats 1 --json out.json
+
+Below ``--sim-seconds`` 15 (:func:`mimo_social.bench.development.min_sim_seconds`) a comparison
+has fewer than 10 turns of 100 steps to go on: a warning says so before the run and those
+comparisons are left out of the table (the ms per step are still shown).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 from ..bench import development
 from ._args import output_file, positive_float, positive_int, write_file
@@ -29,7 +34,8 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
                     "sensorimotor delays and the acuity filter, measured in turns of 100 steps.")
     parser.add_argument("--sim-seconds", type=positive_float, default=15.0,
                         help="simulated seconds per delay configuration, two thirds of it per "
-                             "acuity one, in turns of 100 steps (default 15)")
+                             "acuity one, in turns of 100 steps (default 15, the least that "
+                             "gives every comparison 10 turns)")
     parser.add_argument("--repeats", type=positive_int, default=3,
                         help="builds per body; the median is shown (default 3)")
     parser.add_argument("--json", default=None, type=output_file, help="write all results here")
@@ -38,6 +44,14 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    least = development.min_sim_seconds()
+    if args.sim_seconds < least:
+        turns = development.turns_of(args.sim_seconds * development.ACUITY_SHARE)
+        print(f"mimo-social bench {NAME}: warning: --sim-seconds {args.sim_seconds:g}: too short "
+              f"to compare timings ({turns} turn(s) of 100 steps for the acuity ones; a "
+              f"comparison needs {development.MIN_TURNS}, the noise of one turn being tens of "
+              f"percent); the comparisons are left out; give --sim-seconds >= {least:g}",
+              file=sys.stderr)
     results = development.measure(args.sim_seconds, args.repeats)
     print(development.format_results(results))
     if args.json:
