@@ -26,14 +26,24 @@ import mujoco
 import numpy as np
 
 from ..senses.delays import CHANNELS, developmental_delays
-from .config import DELAY_CHANNELS
+from ..util.checks import ConfigError
+from .config import DELAY_CHANNELS, DELAY_LIMIT_MS
 
-__all__ = ["delays_ms", "delay_steps", "SenseDelay", "MotorDelay", "delay_sensors",
-           "fill_sensor_history", "VESTIBULAR_SENSORS"]
+__all__ = ["delays_ms", "delay_steps", "check_delay_steps", "MAX_DELAY_STEPS", "SenseDelay",
+           "MotorDelay", "delay_sensors", "fill_sensor_history", "VESTIBULAR_SENSORS"]
 
 
 #: the agent's MuJoCo sensors of the vestibular sense (unprefixed names)
 VESTIBULAR_SENSORS = ("vestibular_gyro", "vestibular_accel")
+
+#: the most control steps one delay may span. A delayed sense keeps ``k + 1`` readings per agent
+#: (a pair of 256x256 eyes: 0.39 MB a reading), MuJoCo ``k * frame_skip + 2`` vestibular samples,
+#: so the buffers grow with delay / control step: this bounds them whatever the control step.
+#: 1000 steps hold the longest delay allowed (``DELAY_LIMIT_MS``, 1 s: about four times the
+#: longest published latency, a newborn's visual 260 ms, ``senses/data/delays.csv``) down to a
+#: 1 ms control step, and that latency down to 0.26 ms; at the default 10 ms step 1 s is 100
+#: steps. A longer delay is no sensory delay (a reaction, the policy's business).
+MAX_DELAY_STEPS = 1000
 
 
 def delays_ms(config) -> dict[str, float]:
@@ -52,6 +62,28 @@ def delay_steps(config, dt: float) -> dict[str, int]:
     """Every channel's delay in whole control steps of ``dt`` seconds (see the module)."""
     return {c: int(math.floor(ms / (1000.0 * dt) + 0.5 + 1e-9))
             for c, ms in delays_ms(config).items()}
+
+
+def check_delay_steps(agent: str, config, dt: float) -> dict[str, int]:
+    """:func:`delay_steps` of ``agent``'s config, else a ConfigError naming the agent, the
+    channel, the delay and the most allowed when a channel that is on (its sense on, or the
+    motor command) spans more than :data:`MAX_DELAY_STEPS` control steps of ``dt`` seconds."""
+    steps = delay_steps(config, dt)
+    # a channel whose sense is off has no buffer (nothing to delay)
+    over = [c for c, k in steps.items() if k > MAX_DELAY_STEPS
+            and (c == "motor" or getattr(config, c, None))]
+    if over:
+        c, ms = over[0], delays_ms(config)[over[0]]
+        age = "an adult" if config.age is None else f"{config.age:g} months"
+        given = (f"delays='developmental' ({age}) gives {c} {ms:g} ms"
+                 if config.delays == "developmental" else f"delays[{c!r}]={ms:g} ms")
+        longest = MAX_DELAY_STEPS * dt * 1000.0
+        raise ConfigError(
+            f"agent {agent}: {given}: {steps[c]} control steps of {dt * 1000.0:g} ms; allowed: "
+            f"at most {MAX_DELAY_STEPS} steps, {longest:g} ms at this control step (physics "
+            f"timestep x frame_skip; a step of {DELAY_LIMIT_MS / MAX_DELAY_STEPS:g} ms or "
+            f"more allows the full {DELAY_LIMIT_MS:g} ms)")
+    return steps
 
 
 class SenseDelay:

@@ -26,7 +26,7 @@ from ..expressions.switch import FaceTextures
 from ..scenery import SCENES, add_playroom, clear_toys
 from ..util.checks import check_choice
 from .config import AgentConfig, PhysicsConfig
-from .delays import delay_sensors, delay_steps, fill_sensor_history
+from .delays import check_delay_steps, delay_sensors, fill_sensor_history
 
 __all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE"]
 
@@ -211,7 +211,9 @@ class World:
                 pos=[setup.position[0], setup.position[1], height], quat=root_quat)
             prefix = f"{self.names[i]}/"
             spec.attach(build.spec, prefix=prefix, frame=frame)
-            k = delay_steps(cfg, physics.timestep * physics.frame_skip)["vestibular"]
+            # every channel within MAX_DELAY_STEPS (the env's rings too), else a ConfigError
+            k = check_delay_steps(self.names[i], cfg,
+                                  physics.timestep * physics.frame_skip)["vestibular"]
             if k and cfg.vestibular:    # MuJoCo's own sensor delay (core/delays.py)
                 delay_sensors(spec, prefix, k, physics.timestep, physics.frame_skip)
             mat = spec.add_material(name=f"{prefix}face")

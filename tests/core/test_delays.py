@@ -193,6 +193,32 @@ def test_bad_delays_are_named(delays, words):
         assert word in message, f"{word!r} not in {message!r}"
 
 
+def test_a_delay_of_more_steps_than_the_cap_is_refused_when_the_env_is_made():
+    """The buffers grow with delay / control step: at the finest control step (0.1 ms) the
+    largest delay in milliseconds (1 s) would be 10 000 steps of touch readings. A channel that
+    is on may span at most MAX_DELAY_STEPS steps: beyond, a ConfigError names the agent, the
+    channel, the delay, its steps and the most allowed; at the cap the env is made."""
+    fine = {"timestep": 0.0001, "frame_skip": 1}          # a 0.1 ms control step
+    cases = [({"touch": 1000.0}, ["touch", "1000 ms", "10000 control steps"]),
+             ({"motor": 100.1}, ["motor", "100.1 ms", "1001 control steps"]),
+             ("developmental", ["delays='developmental'", "(0 months)", "vision 260 ms",
+                                "2600 control steps"])]
+    for delays, words in cases:
+        with pytest.raises(ConfigError) as err:
+            _env(delays, physics=fine, age_months=0, vision={"width": 8, "height": 8})
+        for word in ["agent infant_0", *words, "at most 1000 steps",
+                     "100 ms at this control step", "1 ms or more allows the full 1000 ms"]:
+            assert word in str(err.value), f"{word!r} not in {str(err.value)!r}"
+    from mimo_social.core.delays import MAX_DELAY_STEPS
+    assert MAX_DELAY_STEPS == 1000
+    # at the cap the rings are built; a sense that is off has nothing to delay (no error)
+    env = _env({"motor": 100.0, "vision": 1000.0}, physics=fine)
+    assert env.delay_steps("infant_0")["motor"] == MAX_DELAY_STEPS
+    # the same delay at a 1 ms control step is 1000 steps: allowed
+    env = _env({"touch": 1000.0}, physics={"timestep": 0.001, "frame_skip": 1})
+    assert env.delay_steps("infant_0")["touch"] == MAX_DELAY_STEPS
+
+
 @pytest.mark.slow
 def test_mujocos_vestibular_delay_is_exact_over_ten_thousand_steps():
     """MuJoCo's own delay, set as k * dt - timestep / 2 with zero-order hold, reads the wanted
