@@ -269,6 +269,9 @@ def _eval_main(args) -> int:
     for key in ("record", "video", "frames"):
         if key in res:
             print(f"wrote {res[key]}")
+    if res.get("video_error"):
+        print(f"mimo-social eval: error: --video: {res['video_error']}", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -430,7 +433,8 @@ def add_parser(subparsers) -> None:
     p.add_argument("--record", default=None, type=output_file,
                    help="write a Rerun recording (.rrd)")
     p.add_argument("--video", default=None, type=output_file, help="write an MP4 video (needs "
-                   "imageio+ffmpeg or an ffmpeg program)")
+                   "imageio with its ffmpeg plugin, in the train extra, or an ffmpeg program; "
+                   "tried before the episodes start)")
     p.add_argument("--frames", default=None, type=output_dir, help="write every frame as a PNG "
                    "file into this directory")
     p.add_argument("--frame-every", type=positive_int, default=1, help="keep every k-th frame")

@@ -7,8 +7,14 @@ the same episodes with the stochastic policy (sampled actions, torch seeded with
 numbers under ``res["stochastic"]`` (recordings, videos and frames are of the first policy
 only). ``progress`` shows a progress bar over the episodes. ``record`` writes a Rerun
 recording of all episodes; ``video`` an MP4 of ``env.render()`` frames, which needs ``imageio``
-with its ffmpeg plugin or an ``ffmpeg`` program (:class:`VideoUnavailable` says so if neither is
-there: ``frames`` writes the frames as PNG files instead).
+with its ffmpeg plugin (``pip install 'imageio[ffmpeg]'``, in the ``train`` extra) or an
+``ffmpeg`` program: ``frames`` writes the frames as PNG files instead.
+
+Every output is checked before anything is loaded (:func:`check_outputs`): each path can be
+written, and the MP4 encoder is made to write a two-frame video in a temporary folder
+(:class:`VideoUnavailable` if it cannot). Should the video still fail while the episodes run
+(a full disk, the encoder dying), the episodes go on, the recording and frames are written, and
+``res["video_error"]`` says what happened (no ``res["video"]``).
 
 A recurrent policy (``--algo recurrent_ppo``) carries its LSTM state across the steps of an
 episode and starts each episode afresh (:class:`~mimo_social.train.rollouts.PolicyState`). A run
@@ -23,8 +29,10 @@ from __future__ import annotations
 import functools
 
 import json
+import os
 import shutil
 import subprocess
+import tempfile
 import time
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -33,9 +41,9 @@ import numpy as np
 
 from .envs import make_env, make_parallel_env, make_scripted_env, run_observation
 from .rollouts import evaluate_agents, evaluate_policy, load_vecnormalize, vecnormalize_path
-from .tasks import algo_class
+from .tasks import TrainInputError, algo_class
 
-__all__ = ["evaluate", "EvalOutputs", "VideoUnavailable"]
+__all__ = ["evaluate", "EvalOutputs", "VideoUnavailable", "check_outputs"]
 
 
 class VideoUnavailable(RuntimeError):
@@ -71,8 +79,65 @@ def _mp4_writer(path: Path, fps: int):
     def close():
         if "proc" in state:
             state["proc"].stdin.close()
-            state["proc"].wait()
+            if state["proc"].wait():
+                raise OSError(f"ffmpeg exited with code {state['proc'].returncode} writing "
+                              f"{path}")
     return write, close
+
+
+def _writable(name: str, path: Path, folder: bool) -> None:
+    """A TrainInputError naming ``name`` and ``path`` unless ``path`` can be written: a file
+    (``folder=False``) or a folder, existing and writable, or made in the nearest existing
+    folder above it, which must be writable."""
+    if not str(path):
+        raise TrainInputError(f"{name}: an empty path; allowed: a "
+                              f"{'folder' if folder else 'file'} to write")
+    if path.exists():
+        if folder != path.is_dir():
+            raise TrainInputError(
+                f"{name} {path}: is a {'file' if folder else 'folder'}; allowed: a "
+                f"{'folder to write into' if folder else 'file to write'}")
+        if not os.access(path, os.W_OK | (os.X_OK if folder else 0)):
+            raise TrainInputError(f"{name} {path}: not writable")
+        return
+    above = path.absolute().parent
+    while not above.exists():
+        above = above.parent
+    if not above.is_dir():
+        raise TrainInputError(f"{name} {path}: {above} is a file, not a folder")
+    if not os.access(above, os.W_OK | os.X_OK):
+        raise TrainInputError(f"{name} {path}: the folder {above} is not writable")
+
+
+def check_outputs(record=None, video=None, frames=None) -> None:
+    """Before an evaluation loads anything: every output path given can be written (a
+    TrainInputError naming it otherwise) and, for ``video``, the MP4 encoder works: it writes
+    a two-frame 16x16 video in a temporary folder (:class:`VideoUnavailable` with the reason
+    otherwise, e.g. no ``imageio`` with its ffmpeg plugin and no ``ffmpeg`` program)."""
+    for name, path, folder in (("record", record, False), ("video", video, False),
+                               ("frames", frames, True)):
+        if path is not None:
+            _writable(name, Path(path), folder)
+    if video is None:
+        return
+    with tempfile.TemporaryDirectory(prefix="mimo-social-video-") as tmp:
+        probe = Path(tmp) / "probe.mp4"
+        try:
+            write, close = _mp4_writer(probe, 25)
+        except VideoUnavailable as e:
+            raise VideoUnavailable(str(e).replace(str(probe), str(video))) from None
+        try:
+            for _ in range(2):
+                write(np.zeros((16, 16, 3), np.uint8))
+            close()
+        except Exception as e:  # noqa: BLE001 (any encoder failure says the same)
+            raise VideoUnavailable(f"cannot write {video}: the MP4 encoder failed on a test "
+                                   f"video ({type(e).__name__}: {e}); use --frames DIR to "
+                                   "write the frames as PNG files") from None
+        if not probe.is_file() or probe.stat().st_size == 0:
+            raise VideoUnavailable(f"cannot write {video}: the MP4 encoder wrote nothing for "
+                                   "a test video; use --frames DIR to write the frames as PNG "
+                                   "files")
 
 
 class EvalOutputs:
@@ -84,15 +149,21 @@ class EvalOutputs:
         self.env, self.frames, self.frame_every = env, frames, int(frame_every)
         self.want_frames = video is not None or frames is not None
         self.write = self._close_video = None
-        if video is not None:
-            self.write, self._close_video = _mp4_writer(
-                Path(video), int(penv.metadata.get("render_fps", 100)))
-        if frames is not None:
-            Path(frames).mkdir(parents=True, exist_ok=True)
+        #: why the video failed while the episodes ran (None: it did not)
+        self.video_error: str | None = None
         self.recorder = None
-        if record is not None:
+        if record is not None:            # first: a video that fails does not stop it
             from ..recording.recorder import Recorder
             self.recorder = Recorder(penv, record)
+        if frames is not None:
+            Path(frames).mkdir(parents=True, exist_ok=True)
+        if video is not None:
+            self.video = Path(video)
+            try:
+                self.write, self._close_video = _mp4_writer(
+                    self.video, int(penv.metadata.get("render_fps", 100)))
+            except VideoUnavailable as e:
+                self.video_error = str(e)
         self.episode, self.step = -1, 0
 
     def on_reset(self) -> None:
@@ -113,16 +184,47 @@ class EvalOutputs:
             return
         frame = self.env.render()
         if self.write is not None:
-            self.write(frame)
+            try:
+                self.write(frame)
+            except Exception as e:  # noqa: BLE001 (the episodes and the recording go on)
+                self._video_failed(e)
         if self.frames is not None:
             import matplotlib.image as mpimg
             mpimg.imsave(Path(self.frames) / f"ep{self.episode:03d}_{self.step:05d}.png", frame)
 
+    def _video_failed(self, error: Exception, when: str = "") -> None:
+        self.video_error = (f"cannot write {self.video}: {type(error).__name__}: {error} "
+                            f"({when}episode {self.episode}, step {self.step}); the other "
+                            "outputs were written")
+        close, self.write, self._close_video = self._close_video, None, None
+        try:
+            if close is not None:
+                close()
+        except Exception:  # noqa: BLE001 (the first error is the one to report)
+            pass
+
     def close(self) -> None:
-        if self.recorder is not None:
-            self.recorder.close()
-        if self._close_video is not None:
-            self._close_video()
+        try:
+            if self.recorder is not None:
+                self.recorder.close()
+        finally:
+            if self._close_video is not None:
+                close, self._close_video, self.write = self._close_video, None, None
+                try:
+                    close()
+                except Exception as e:  # noqa: BLE001
+                    self._video_failed(e, "closing it after ")
+
+    def report(self, res: dict, record, video, frames) -> dict:
+        """``res`` with the paths written (``record``, ``video``, ``frames``) and, if the video
+        failed, ``video_error`` instead of ``video``."""
+        for key, value in (("record", record), ("video", video), ("frames", frames)):
+            if value is not None:
+                res[key] = str(value)
+        if self.video_error is not None:
+            res.pop("video", None)
+            res["video_error"] = self.video_error
+        return res
 
 
 class _Bar:
@@ -166,6 +268,7 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
              both: bool = False, progress: bool = False) -> dict:
     """Reload a trained policy from a ``train`` directory and run ``episodes`` episodes
     (``both``: with the deterministic and with the stochastic policy; module docstring)."""
+    check_outputs(record, video, frames)        # before anything slow is loaded
     import torch
     torch.set_num_threads(1)
     run = Path(run)
@@ -217,12 +320,7 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
                 "vecnormalize": str(stats) if stats.is_file() else None,
                 "episodes": episodes, "deterministic": deterministic, "seed": seed,
                 "wall_time_s": round(time.perf_counter() - t0, 2)})
-    if record is not None:
-        res["record"] = str(record)
-    if video is not None:
-        res["video"] = str(video)
-    if frames is not None:
-        res["frames"] = str(frames)
+    outputs.report(res, record, video, frames)
     (run / "eval_results.json").write_text(json.dumps(res, indent=2, default=float))
     return res
 
@@ -284,10 +382,7 @@ def evaluate_with_outputs(policies: Mapping[str, Any], env, inner, episodes: int
         outputs.close()
         env.close()
     res["wall_time_s"] = round(time.perf_counter() - t0, 2)
-    for key, value in (("record", record), ("video", video), ("frames", frames)):
-        if value is not None:
-            res[key] = str(value)
-    return res
+    return outputs.report(res, record, video, frames)
 
 
 def _evaluate_multi(run: Path, config: dict, episodes: int, *, model: str, seed: int,

@@ -21,7 +21,7 @@ from typing import Any, Mapping
 import numpy as np
 from gymnasium import spaces
 
-from ..evaluation import evaluate_with_outputs
+from ..evaluation import check_outputs, evaluate_with_outputs
 from ..tasks import TrainInputError
 from .env import learner_env
 
@@ -139,6 +139,7 @@ def evaluate_rllib(run: str | Path, episodes: int = 10, *, model: str = "final",
                    video: str | Path | None = None, frames: str | Path | None = None,
                    frame_every: int = 1, env_kwargs: Mapping[str, Any] | None = None) -> dict:
     """Reload an RLlib run's RLModules and run ``episodes`` episodes (module docstring)."""
+    check_outputs(record, video, frames)        # before anything slow is loaded
     import torch
 
     from .config import quiet_rllib
