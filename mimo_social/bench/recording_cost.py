@@ -3,6 +3,15 @@
 
 ``mimo-social bench recording`` runs it (:mod:`mimo_social.cli.bench_recording`); the numbers go
 to BENCHMARKS.md and the recorder's docstring.
+
+Both figures are extrapolations, so a run needs a length for them. A recording starts with a
+fixed part (the scene's meshes, the viewer's layout: 0.77 MB for two infants without images,
+measured as the intercept of file size against run length) that a size per simulated minute
+spreads over the run: under :data:`MIN_SIM_SECONDS` it is over a tenth of the smallest
+configuration's 14.7 MB per minute (at 0.5 s it read as 107 MB per minute), and the costs then
+rest on fewer than 30 alternating blocks of 100 steps. Shorter runs still run, but their cost
+and size per minute are left out (``too_short``). The ``--eyes`` comparison takes medians of
+per-round costs and needs :data:`MIN_EYE_ROUNDS` rounds of one flush interval each.
 """
 
 from __future__ import annotations
@@ -19,7 +28,15 @@ from ..envs import free_play_v0
 from ..recording import Recorder
 
 __all__ = ["BENCH_CONFIGS", "EYE_COST_CONFIG", "EYE_COST_VARIANTS", "bench_eye_cost",
-           "bench_recording", "format_eye_table", "format_table"]
+           "bench_recording", "format_eye_table", "format_table", "MIN_SIM_SECONDS",
+           "MIN_EYE_ROUNDS", "MIN_EYE_SIM_SECONDS"]
+
+#: simulated seconds a run of :func:`bench_recording` needs for a cost and a size per minute
+MIN_SIM_SECONDS = 30.0
+#: rounds (flush intervals) :func:`bench_eye_cost` needs for its medians of per-round costs
+MIN_EYE_ROUNDS = 5
+#: its simulated seconds with the default flush interval of 4 s
+MIN_EYE_SIM_SECONDS = 4.0 * MIN_EYE_ROUNDS
 
 #: the configurations of :func:`bench_recording`: env keyword arguments of ``free_play_v0``
 BENCH_CONFIGS = {
@@ -118,7 +135,8 @@ def bench_recording(configs: Mapping[str, dict] | None = None, sim_seconds: floa
                     "in_recorder_pct": 100.0 * rec.overhead_s / wall[0],
                     "mb_per_sim_minute": size / 1e6 / minutes, "file_mb": size / 1e6,
                     "rerun_threads_cpu_s": other_threads, "eye_frames": rec.eye_frames,
-                    "path": str(path)})
+                    "path": str(path),
+                    "too_short": n_steps * envs[0].dt < MIN_SIM_SECONDS - 1e-9})
     return out
 
 
@@ -127,9 +145,17 @@ def format_table(results: list[dict]) -> str:
     header = ("| configuration | ms/step plain | ms/step recorded | cost: CPU (all threads) | "
               "CPU (main thread) | wall clock | MB per sim. minute |")
     lines = [header, "|---|---|---|---|---|---|---|"]
-    lines += [f"| {r['config']} | {r['ms_per_step']:.3f} | {r['ms_per_step_recorded']:.3f} | "
-              f"{r['cpu_pct']:.1f} % | {r['main_cpu_pct']:.1f} % | {r['wall_pct']:.1f} % | "
-              f"{r['mb_per_sim_minute']:.1f} |" for r in results]
+    for r in results:
+        head = f"| {r['config']} | {r['ms_per_step']:.3f} | {r['ms_per_step_recorded']:.3f} | "
+        if r.get("too_short"):
+            lines.append(head + "too short | too short | too short | too short |")
+        else:
+            lines.append(head + f"{r['cpu_pct']:.1f} % | {r['main_cpu_pct']:.1f} % | "
+                                f"{r['wall_pct']:.1f} % | {r['mb_per_sim_minute']:.1f} |")
+    if any(r.get("too_short") for r in results):
+        lines.append(f"\ntoo short: under {MIN_SIM_SECONDS:g} simulated s a run gives no cost "
+                     "or size per minute (the file's fixed part and a few blocks' noise would "
+                     f"be the figure); give --sim-seconds >= {MIN_SIM_SECONDS:g}")
     return "\n".join(lines)
 
 
@@ -226,7 +252,8 @@ def bench_eye_cost(sim_seconds: float = 40.0, rounds: int | None = None, seed: i
             "encoder_ms_per_step": enc_ms,
             "encoder_pct": 100.0 * enc_ms / med(cpu[base]),
             "eye_frames": rec.eye_frames if rec is not None else 0,
-            "path": str(rec.path) if rec is not None else None})
+            "path": str(rec.path) if rec is not None else None,
+            "too_short": rounds < MIN_EYE_ROUNDS})
     return out
 
 
@@ -239,8 +266,14 @@ def format_eye_table(results: list[dict]) -> str:
         plain = r["eye_frames"] == 0 and r["main_cpu_pct"] == 0.0
         cost = "-" if plain else f"{r['main_cpu_pct']:.1f} %"
         wall = "-" if plain else f"{r['wall_pct']:.1f} %"
+        if r.get("too_short") and not plain:
+            cost = wall = "too short"
         enc = (f"{r['encoder_ms_per_step']:.3f} ms ({r['encoder_pct']:.1f} %)"
                if r["encoder_ms_per_step"] else "-")
         lines.append(f"| {r['variant']} | {r['ms_per_step']:.3f} | {r['cpu_ms_per_step']:.3f} | "
                      f"{cost} | {wall} | {enc} | {r['eye_frames']} |")
+    if any(r.get("too_short") for r in results):
+        lines.append(f"\ntoo short: {results[0]['rounds']} round(s); the costs are medians of "
+                     f"per-round costs and need {MIN_EYE_ROUNDS} rounds of one flush interval "
+                     f"(4 simulated s by default): give --sim-seconds >= {MIN_EYE_SIM_SECONDS:g}")
     return "\n".join(lines)

@@ -32,7 +32,8 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
                     "video rate) and encoded on a worker thread; Recorder(eye_every_k_steps=1) "
                     "logs every frame (the last row).")
     parser.add_argument("--sim-seconds", type=positive_float, default=None,
-                        help="simulated seconds per configuration (default: 60; --eyes: 40)")
+                        help="simulated seconds per configuration (default: 60; --eyes: 40; "
+                             "under 30, --eyes 20, the costs and sizes are left out)")
     indices = [str(i) for i in range(len(recording_cost.BENCH_CONFIGS))]
     parser.add_argument("--only", default=None, type=comma_choices(indices, "index"),
                         help="comma-separated indices of the configurations to run "
@@ -51,6 +52,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"mimo-social bench {NAME}: error: --only picks configurations of the size and "
               "cost table; --eyes runs its own comparison; allowed: one of them", file=sys.stderr)
         return 2
+    least = recording_cost.MIN_EYE_SIM_SECONDS if args.eyes else recording_cost.MIN_SIM_SECONDS
+    if args.sim_seconds is not None and args.sim_seconds < least:
+        print(f"mimo-social bench {NAME}: warning: --sim-seconds {args.sim_seconds:g}: too short "
+              f"for a {'median cost over rounds' if args.eyes else 'cost or a size per minute'}"
+              f" (they are left out); give --sim-seconds >= {least:g}", file=sys.stderr)
     if args.eyes:
         results = recording_cost.bench_eye_cost(args.sim_seconds or 40.0, folder=args.folder)
         print(recording_cost.format_eye_table(results))

@@ -65,7 +65,12 @@ def test_bench_recording_eyes_command_prints_the_table(tmp_path, capsys, monkeyp
     assert cli.main(["bench", "recording", "--eyes", "--folder", str(tmp_path)]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("| run | ms/step (wall) |")
-    assert [x.split(" | ")[0] for x in lines[2:]] == [f"| {k}" for k in EYE_COST_VARIANTS]
+    rows = lines[2:2 + len(EYE_COST_VARIANTS)]
+    assert [x.split(" | ")[0] for x in rows] == [f"| {k}" for k in EYE_COST_VARIANTS]
+    # one round: no median cost to speak of
+    assert all(" | too short | too short | " in x for x in rows[1:])
+    assert lines[-1].startswith("too short: 1 round(s); the costs are medians of per-round "
+                                "costs and need 5 rounds")
 
 
 def test_bench_recording_eyes_with_only_is_refused(capsys):

@@ -203,9 +203,21 @@ def test_bench_recording_subcommand_measures_chosen_configurations(tmp_path, cap
     assert bench_recording in cli.bench.MEASUREMENTS.values()
     assert cli.main(["bench", "recording", "--sim-seconds", "0.2", "--only", "0",
                      "--folder", str(tmp_path)]) == 0
-    lines = capsys.readouterr().out.splitlines()
-    assert len(lines) == 3 and lines[0].startswith("| configuration |")
+    out, err = capsys.readouterr()
+    lines = out.splitlines()
+    assert len(lines) == 5 and lines[0].startswith("| configuration |")
     assert lines[2].startswith("| 2 infants, no images |")
     assert (tmp_path / "bench_0.rrd").stat().st_size > 0
+    # 0.2 simulated s: the file's fixed part would be the size per minute; no cost, no size
+    assert lines[2].endswith("| too short | too short | too short | too short |")
+    assert lines[4].startswith("too short: under 30 simulated s a run gives no cost or size")
+    assert err == ("mimo-social bench recording: warning: --sim-seconds 0.2: too short for a "
+                   "cost or a size per minute (they are left out); give --sim-seconds >= 30\n")
     with pytest.raises(SystemExit, match="--only"):
         cli.main(["bench", "recording", "--only", "first"])
+    # long enough: the figures, no note
+    from mimo_social.bench.recording_cost import format_table
+    row = {"config": "c", "ms_per_step": 1.0, "ms_per_step_recorded": 1.1, "cpu_pct": 12.0,
+           "main_cpu_pct": 8.0, "wall_pct": 10.0, "mb_per_sim_minute": 14.7, "too_short": False}
+    assert format_table([row]).splitlines()[2:] == [
+        "| c | 1.000 | 1.100 | 12.0 % | 8.0 % | 10.0 % | 14.7 |"]
