@@ -7,8 +7,9 @@ the 3D view shows the bodies (a developer's check; docs/viewer_check.md).
 See :mod:`viewer_check.check` (beside this script) for what is served, started and looked for.
 Needs Chromium (``chromium`` on the ``PATH`` or ``$MIMO_SOCIAL_CHROMIUM``), the Python package
 ``playwright`` (no browser download: the system Chromium is driven) and ``rerun`` (rerun-sdk).
-Exit code 0 when the bodies show, 1 when they do not (the message says which colours were
-missing and where the screenshot is) or a tool is missing, 2 for a bad argument.
+Exit code 0 when the bodies and every panel's data show, 1 when they do not (the message says
+which colours were missing or which panels were empty, and where the screenshot is) or a tool is
+missing, 2 for a bad argument.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import math
 import sys
 
 from mimo_social.cli._args import input_file, output_file
-from viewer_check import ViewerCheckError, check_viewer
+from viewer_check import TIMEOUT, ViewerCheckError, check_viewer
 
 PROG = "scripts/check_viewer.py"
 
@@ -57,16 +58,18 @@ def build_parser() -> argparse.ArgumentParser:
                     "Chromium (software WebGL), wait for the recording to load, save a "
                     "screenshot and check that the 3D view shows every agent's clothes colour, "
                     "beyond what the same view of the recording without the agents shows (the "
-                    "play room's furniture has such hues). 1 to 3 minutes with software "
-                    "rendering.")
+                    "play room's furniture has such hues), and that no other panel is empty "
+                    "('No data available'). 1 to 3 minutes with software rendering, more on a "
+                    "loaded machine.")
     parser.add_argument("file", metavar="FILE.rrd", type=input_file,
                         help="the recording to open")
     parser.add_argument("--screenshot", metavar="PATH", type=output_file, default=None,
                         help="where the PNG goes (default: next to the recording, "
                              "<name>_viewer.png)")
     parser.add_argument("--timeout", metavar="S", type=_number(1.0, None, "seconds >= 1"),
-                        default=180.0, help="seconds to wait for each page to load and show "
-                                            "(default 180)")
+                        default=TIMEOUT, help="the most seconds for each page to load and show "
+                        f"(an overall limit: the check goes on as soon as the page is ready; "
+                        f"default {TIMEOUT:.0f})")
     parser.add_argument("--size", metavar="WxH", type=_size, default=(1920, 1080),
                         help="the browser page's size in pixels (default 1920x1080)")
     parser.add_argument("--at", metavar="FRACTION", default=None,

@@ -17,7 +17,15 @@ lines of one grey; the largest region they enclose is the 3D view in the layout 
 :mod:`mimo_social.recording.blueprint` (``view=`` gives another region). A pixel counts for a
 colour when its hue is within :data:`HUE_TOLERANCE` degrees of the colour's and it is saturated
 and bright enough (lighting scales the colour but keeps its hue), so background, floor, skin and
-the grey grid do not count.
+the grey grid do not count. Every other panel must show data (:mod:`.panels`): a face, an eye
+or a plot that shows only "No data available" (its data not yet decoded, or not in the file)
+fails the check.
+
+Nothing waits a fixed time: the page is polled until the conditions hold (the viewer's page and
+canvas loaded, the viewer's console saying the data has finished loading, the bodies and every
+panel shown in two agreeing frames), within generous limits (:data:`TIMEOUT` per page,
+:data:`SETTLE` after the load); a page that does not load is opened again, a screenshot that
+fails is taken again (:mod:`.web_viewer`).
 """
 
 from __future__ import annotations
@@ -38,19 +46,25 @@ import numpy as np
 
 from mimo_social.util.checks import ConfigError, check_int, check_number
 
+from .panels import SEPARATOR_RGB, long_runs, empty_panels, panel_boxes
 from .web_viewer import (Browser, FileServer, ViewerCheckError, WebViewer, browser_missing,
                          chromium_path, without_agents)
+from .web_viewer import screenshot as take_screenshot
 
-__all__ = ["HUE_TOLERANCE", "MIN_PIXELS", "ViewerCheck", "ViewerCheckError", "browser_missing",
-           "check_viewer", "chromium_path", "colour_pixels", "find_3d_view", "time_bar",
-           "recording_colours", "without_agents"]
+__all__ = ["HUE_TOLERANCE", "MIN_PIXELS", "SETTLE", "TIMEOUT", "ViewerCheck", "ViewerCheckError",
+           "browser_missing", "check_viewer", "chromium_path", "colour_pixels", "find_3d_view",
+           "time_bar", "recording_colours", "without_agents"]
 
 #: degrees of hue a lit pixel may be off its clothes colour
 HUE_TOLERANCE = 14.0
 #: the fewest pixels of each agent's colour the 3D view must show (at 1920x1080)
 MIN_PIXELS = 150
-#: the colour of the viewer's one-pixel panel separators (light theme)
-SEPARATOR_RGB = (223, 223, 223)
+#: the most seconds one page may take, from opening it to the verdict (each wait on it, a
+#: screenshot included, is bounded by it); on a quiet machine the demo takes 20-60 s
+TIMEOUT = 600.0
+#: the most seconds to wait, once the viewer has said the data is loaded, for the bodies and
+#: every panel's data to show (images are decoded after the load)
+SETTLE = 60.0
 
 
 @dataclass(frozen=True)
@@ -162,34 +176,11 @@ def colour_pixels(img: np.ndarray, rgb, box=None, hue_tolerance: float = HUE_TOL
 
 # ------------------------------------------------------------------------------ the 3D view
 
-def _long_runs(mask: np.ndarray, length: int) -> np.ndarray:
-    """The pixels of ``mask`` in horizontal runs of at least ``length`` pixels."""
-    padded = np.zeros((mask.shape[0], mask.shape[1] + 2), dtype=np.int8)
-    padded[:, 1:-1] = mask
-    d = np.diff(padded, axis=1)
-    out = np.zeros(mask.shape, dtype=bool)
-    for y, x in zip(*np.nonzero(d == 1)):
-        end = x + np.argmax(d[y, x:] == -1)
-        if end - x >= length:
-            out[y, x:end] = True
-    return out
-
-
 def find_3d_view(img: np.ndarray) -> tuple[int, int, int, int]:
     """The box (x0, y0, x1, y1) of the largest panel of the viewer page in ``img``: the regions
     enclosed by the viewer's long one-pixel separator lines (gaps at their junctions closed)."""
-    from scipy import ndimage
-
-    sep = np.abs(img[..., :3].astype(np.int16) - np.array(SEPARATOR_RGB)).max(axis=-1) <= 1
-    lines = _long_runs(sep, 60) | _long_runs(sep.T, 60).T
-    lines = ndimage.binary_dilation(lines, iterations=3)
-    labels, n = ndimage.label(~lines)
-    if n == 0:
-        return (0, 0, img.shape[1], img.shape[0])
-    sizes = np.bincount(labels.ravel())[1:]
-    k = int(np.argmax(sizes))
-    ys, xs = ndimage.find_objects(labels)[k]
-    return (int(xs.start), int(ys.start), int(xs.stop), int(ys.stop))
+    boxes = panel_boxes(img, min_size=1)
+    return boxes[0] if boxes else (0, 0, img.shape[1], img.shape[0])
 
 
 # ---------------------------------------------------------------------------------- the check
@@ -207,14 +198,17 @@ def _parse_size(size) -> tuple[int, int]:
             check_int("viewer check", "height", h, 480, 4320))
 
 
-def check_viewer(path: str | Path, screenshot: str | Path | None = None, timeout: float = 180.0,
-                 size="1920x1080", colours: dict | None = None, min_pixels: int = MIN_PIXELS,
-                 settle: float = 20.0, view=None, at: float | None = None, wait: float = 0.0,
-                 baseline: bool = True, poll: float = 2.0,
+def check_viewer(path: str | Path, screenshot: str | Path | None = None,
+                 timeout: float = TIMEOUT, size="1920x1080", colours: dict | None = None,
+                 min_pixels: int = MIN_PIXELS, settle: float = SETTLE, view=None,
+                 at: float | None = None, wait: float = 0.0, baseline: bool = True,
+                 poll: float = 2.0,
                  progress: Callable[[str], None] | None = print) -> ViewerCheck:
     """Open ``path`` in Rerun's web viewer in headless Chromium and check that its 3D view shows
-    the bodies (module docstring). ``screenshot``: where the PNG goes (default: next to the
-    recording, ``<name>_viewer.png``); ``timeout``: seconds to wait for each page; ``size``:
+    the bodies and that every other panel shows data (module docstring). ``screenshot``: where
+    the PNG goes (default: next to the recording, ``<name>_viewer.png``); ``timeout``: the most
+    seconds for each page, from opening it (again, when it does not load) to the verdict; each
+    wait on it (a screenshot, a click) is bounded by it, not by a fixed limit; ``size``:
     the page, ``"WxH"`` or (w, h); ``colours``: agent -> RGB (0-255) to look for (default:
     :func:`recording_colours`); ``min_pixels``: of each colour, scaled with the page's area
     from 1920x1080; ``settle``: seconds to wait once the viewer has said the data is loaded
@@ -224,8 +218,8 @@ def check_viewer(path: str | Path, screenshot: str | Path | None = None, timeout
     more before the last screenshot; ``baseline``: also open the recording without the agents
     (:func:`without_agents`) and count only the pixels the bodies add (a play room has
     furniture and toys of the clothes' hues); ``progress``: called with a line per poll (None:
-    quiet). Raises :class:`ViewerCheckError` when the bodies do not show (the screenshots are
-    saved first) or a tool is missing."""
+    quiet). Raises :class:`ViewerCheckError` when the bodies do not show or a panel shows no
+    data (the screenshots are saved first), or a tool is missing."""
     path = Path(path)
     if not path.is_file():
         raise ConfigError(f"viewer check: recording {str(path)!r} is not a file")
@@ -262,7 +256,7 @@ def check_viewer(path: str | Path, screenshot: str | Path | None = None, timeout
         if baseline:
             without_agents(path, list(colours), folder / "without_agents.rrd")
         with FileServer(folder) as files, \
-                WebViewer(folder / "rerun.log") as viewer, \
+                WebViewer(folder / "rerun.log", start_timeout=timeout) as viewer, \
                 Browser() as browser:
             def urls(name):
                 file_url = f"http://127.0.0.1:{files.port}/{name}"
@@ -289,7 +283,7 @@ def time_bar(img: np.ndarray) -> tuple[int, int, int] | None:
     best = None
     for y in range(max(0, h - 60), h):
         dark = img[y, :, :3].max(axis=-1) < 90
-        runs = _long_runs(dark[None, :], w // 3)[0]
+        runs = long_runs(dark[None, :], w // 3)[0]
         if runs.any():
             xs = np.flatnonzero(runs)
             if best is None or xs[-1] - xs[0] > best[1] - best[0]:
@@ -299,12 +293,13 @@ def time_bar(img: np.ndarray) -> tuple[int, int, int] | None:
 
 @dataclass
 class _Seen:
-    """One page's last look: the image, the 3D view's box, each agent's pixel count, when the
-    data loaded and when the colours first showed, the console errors."""
+    """One page's last look: the image, the 3D view's box, each agent's pixel count, the panels
+    without data, when the data loaded and when the colours first showed, the console errors."""
 
     img: np.ndarray
     box: tuple
     counts: dict
+    empty: list
     loaded: float | None
     shown: float | None
     elapsed: float
@@ -313,15 +308,15 @@ class _Seen:
 
 def _watch(browser: Browser, page_url: str, file_url: str, shot: Path, *, size, colours,
            view, say, timeout, settle, at, wait, poll, need, must_show: bool) -> _Seen:
-    """Open the viewer on ``file_url``, poll screenshots until the data is loaded and (when
-    ``must_show``) every colour shows, or it gives up; then ``at`` and ``wait``; save the last
-    screenshot to ``shot``."""
+    """Open the viewer on ``file_url`` (opened again when it does not load) and poll
+    screenshots until the data is loaded, the frames agree and (when ``must_show``) every
+    colour shows in the 3D view and every other panel shows data, or it gives up: ``timeout``
+    seconds after opening, ``settle`` seconds after the load (or after the first console error
+    while loading); then ``at`` and ``wait``; save the last screenshot to ``shot``."""
     from PIL import Image
 
     loaded: list[float] = []
-    errors: list[str] = []
-    page = browser.browser.new_page(viewport={"width": size[0], "height": size[1]},
-                                    color_scheme="light")
+    errors: list[tuple[float, str]] = []
     t0 = time.monotonic()
 
     def on_console(msg):
@@ -330,37 +325,43 @@ def _watch(browser: Browser, page_url: str, file_url: str, shot: Path, *, size, 
             loaded.append(time.monotonic() - t0)
         elif msg.type == "error" and "ERR_NAME_NOT_RESOLVED" not in text \
                 and "Failed to fetch" not in text:    # the page's web fonts: no network
-            errors.append(text.strip().splitlines()[0][:200])
+            errors.append((time.monotonic() - t0, text.strip().splitlines()[0][:200]))
+
+    page = browser.open(page_url, size, timeout, on_console, say)
 
     def look():
-        img = np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB"))
+        png = take_screenshot(page, timeout)
+        img = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
         box = tuple(view) if view is not None else find_3d_view(img)
         counts = {a: colour_pixels(img, c, box) for a, c in colours.items()}
+        others = [b for b in panel_boxes(img) if b != box]
+        empty = empty_panels(img, others) if must_show else []
         state = f"data loaded after {loaded[0]:.1f} s" if loaded else "loading the data"
         say(f"  {time.monotonic() - t0:5.1f} s: {state}; 3D view {box[2] - box[0]}x"
-            f"{box[3] - box[1]} px; " + ", ".join(f"{a} {n} px" for a, n in counts.items()))
-        return img, box, counts
+            f"{box[3] - box[1]} px; " + ", ".join(f"{a} {n} px" for a, n in counts.items())
+            + (f"; {len(empty)} of {len(others)} other panels without data" if must_show
+               else ""))
+        return img, box, counts, empty
 
     try:
-        page.on("console", on_console)
-        page.goto(page_url, wait_until="load", timeout=timeout * 1000)
         streak, shown_at, prev, after = 0, None, None, 0
         while True:     # until two polls after the load agree (and show), or it gives up
             page.wait_for_timeout(poll * 1000)   # console events come in meanwhile
             after += bool(loaded)                 # this poll's screenshot is after the load
-            img, box, counts = look()
+            img, box, counts, empty = look()
             elapsed = time.monotonic() - t0
-            ok = all(n >= need for n in counts.values()) or not must_show
-            if ok and must_show and shown_at is None:
+            shows = all(n >= need for n in counts.values())
+            if shows and must_show and shown_at is None:
                 shown_at = elapsed
+            ok = not must_show or (shows and not empty)
             steady = prev is not None and all(
                 abs(n - prev[a]) <= max(need, 0.15 * max(n, prev[a])) for a, n in counts.items())
             prev = counts
             streak = streak + 1 if ok and steady else 0
             if streak and (after >= 2 or streak >= 4):
                 break
-            if (errors and not loaded) or elapsed >= timeout \
-                    or (loaded and elapsed - loaded[0] >= settle):
+            if elapsed >= timeout or (loaded and elapsed - loaded[0] >= settle) \
+                    or (errors and not loaded and elapsed - errors[0][0] >= settle):
                 break
         if loaded and (at is not None or wait > 0):
             bar = time_bar(img)
@@ -371,26 +372,29 @@ def _watch(browser: Browser, page_url: str, file_url: str, shot: Path, *, size, 
             elif at is not None:
                 say("  no time bar found: the time cursor stays")
             end = time.monotonic() + wait
-            while True:
+            while True:     # the frames after the move: at least one, until ``wait`` is over
                 page.wait_for_timeout(poll * 1000)
-                img, box, counts = look()
+                img, box, counts, empty = look()
                 if time.monotonic() >= end:
                     break
     finally:
         page.close()
     Image.fromarray(img).save(shot)
-    return _Seen(img, box, counts, loaded[0] if loaded else None, shown_at,
-                 time.monotonic() - t0, errors)
+    return _Seen(img, box, counts, empty, loaded[0] if loaded else None, shown_at,
+                 time.monotonic() - t0, [text for _, text in errors])
 
 
 def _verdict(first: _Seen, scene: _Seen | None, shot: Path, colours: dict, need: int,
              size) -> ViewerCheck:
-    """The check's result, or :class:`ViewerCheckError` saying what was missing."""
+    """The check's result, or :class:`ViewerCheckError` saying what was missing (and what the
+    viewer's console reported, when it did)."""
     x0, y0, x1, y1 = first.box
     where = f"the 3D view (x {x0}-{x1}, y {y0}-{y1} of the page)"
-    if first.errors and first.loaded is None:
-        raise ViewerCheckError("the viewer reported errors before the data loaded: "
-                               + " | ".join(first.errors[:3]) + f"; screenshot: {shot}")
+    when = (f"after {first.elapsed:.0f} s ("
+            + (f"data loaded after {first.loaded:.1f} s" if first.loaded is not None
+               else "the viewer never said the data had loaded") + ")")
+    console = ("" if not first.errors else
+               "; the viewer's console reported: " + " | ".join(first.errors[:3]))
     own = dict(first.counts)
     if scene is not None and scene.loaded is None:
         raise ViewerCheckError(f"the recording without the agents (the baseline) did not load "
@@ -399,9 +403,6 @@ def _verdict(first: _Seen, scene: _Seen | None, shot: Path, colours: dict, need:
         own = {a: max(0, n - scene.counts[a]) for a, n in first.counts.items()}
     lacking = [a for a in colours if own[a] < need]
     if lacking:
-        when = (f"after {first.elapsed:.0f} s ("
-                + (f"data loaded after {first.loaded:.1f} s" if first.loaded is not None
-                   else "the viewer never said the data had loaded") + ")")
         what = ", ".join(
             f"{a} ({_hex(colours[a])}: {first.counts[a]} px"
             + ("" if scene is None else f", {scene.counts[a]} px without the agents") + ")"
@@ -410,7 +411,12 @@ def _verdict(first: _Seen, scene: _Seen | None, shot: Path, colours: dict, need:
             f"; without the agents: {shot.with_name(shot.stem + '_without_agents.png')}")
         raise ViewerCheckError(
             f"{where} does not show the bodies: too few pixels (need {need} the bodies add) of "
-            f"{what}; {when}; screenshot: {shot}{base}")
+            f"{what}; {when}{console}; screenshot: {shot}{base}")
+    if first.empty:
+        boxes = ", ".join(f"x {a}-{c}, y {b}-{d}" for a, b, c, d in first.empty)
+        raise ViewerCheckError(
+            f"{len(first.empty)} panels show no data (nothing but a line such as 'No data "
+            f"available', or nothing): {boxes}; {when}{console}; screenshot: {shot}")
     return ViewerCheck(shot, {a: _hex(c) for a, c in colours.items()}, own, dict(first.counts),
                        None if scene is None else dict(scene.counts), first.box, first.loaded,
                        first.shown if first.shown is not None else first.elapsed,

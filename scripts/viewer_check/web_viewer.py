@@ -19,7 +19,7 @@ import urllib.request
 from pathlib import Path
 
 __all__ = ["Browser", "FileServer", "ViewerCheckError", "WebViewer", "browser_missing",
-           "chromium_path", "launch_args", "rerun_command", "without_agents"]
+           "chromium_path", "launch_args", "rerun_command", "screenshot", "without_agents"]
 
 _CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 
@@ -158,8 +158,19 @@ def launch_args() -> list[str]:
     return args
 
 
+def _first_line(error: BaseException) -> str:
+    text = str(error).strip()
+    return (text.splitlines()[0] if text else type(error).__name__)[:200]
+
+
 class Browser:
-    """Headless Chromium driven by Playwright (software WebGL)."""
+    """Headless Chromium driven by Playwright (software WebGL).
+
+    Every wait on the page is bounded by the check's own limit (:meth:`open` sets it as the
+    page's default), never by Playwright's 30 s: with software WebGL on a loaded machine one
+    frame of a 1920x1080 page can take longer than that. A page that fails to load is opened
+    again (:meth:`open`), a screenshot that fails is taken again (:func:`screenshot`).
+    """
 
     def __enter__(self):
         from playwright.sync_api import sync_playwright
@@ -184,6 +195,61 @@ class Browser:
             self.browser.close()
         finally:
             self._pw.stop()
+
+    def open(self, url: str, size: tuple[int, int], limit: float, on_console=None,
+             say=lambda _line: None, attempts: int = 3):
+        """A new page at ``size`` showing ``url``, once its document has loaded and the viewer's
+        canvas is on it; each wait of the page (this one, its screenshots, clicks) may take up
+        to ``limit`` seconds. A page that does not load (a timeout, a crashed or closed page, a
+        refused connection) is closed and opened again, ``attempts`` times in all.
+        ``on_console`` gets the page's console messages from the start."""
+        from playwright.sync_api import Error
+
+        why = "not tried"
+        for attempt in range(1, attempts + 1):
+            page = self.browser.new_page(viewport={"width": size[0], "height": size[1]},
+                                         color_scheme="light")
+            page.set_default_timeout(limit * 1000)
+            page.set_default_navigation_timeout(limit * 1000)
+            if on_console is not None:
+                page.on("console", on_console)
+            try:
+                page.goto(url, wait_until="load")
+                page.wait_for_selector("canvas", state="attached")
+                return page
+            except Error as e:
+                why = _first_line(e)
+                _close(page)
+                if attempt < attempts:
+                    say(f"  the viewer's page did not load ({why}); opening it again "
+                        f"({attempt + 1} of {attempts})")
+        raise ViewerCheckError(f"the viewer's page did not load in {attempts} attempts of up to "
+                               f"{limit:.0f} s each: {why}")
+
+
+def _close(page) -> None:
+    try:
+        page.close()
+    except Exception:                 # already closed, or the browser went with it
+        pass
+
+
+def screenshot(page, limit: float, attempts: int = 3) -> bytes:
+    """A PNG of ``page``, waiting up to ``limit`` seconds for the frame (the page's compositor
+    draws one first; software WebGL under load can take long); a failed one is taken again,
+    ``attempts`` times in all, unless the page is gone."""
+    from playwright.sync_api import Error
+
+    why = "not tried"
+    for _ in range(attempts):
+        try:
+            return page.screenshot(timeout=limit * 1000)
+        except Error as e:
+            why = _first_line(e)
+            if page.is_closed():
+                break
+    raise ViewerCheckError(f"no screenshot of the viewer's page in {attempts} attempts of up "
+                           f"to {limit:.0f} s each: {why}")
 
 
 def without_agents(path: str | Path, agents, out: str | Path) -> Path:

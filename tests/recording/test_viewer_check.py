@@ -28,9 +28,11 @@ SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
 sys.path.insert(0, str(SCRIPTS))       # the check is a script's module, not the package's
 
 import check_viewer as script  # noqa: E402
-from viewer_check import (SEPARATOR_RGB, ViewerCheckError, browser_missing,  # noqa: E402
-                          check_viewer, colour_pixels, find_3d_view, recording_colours,
-                          time_bar, without_agents)
+from viewer_check import (SEPARATOR_RGB, TIMEOUT, ViewerCheckError,  # noqa: E402
+                          browser_missing, check_viewer, colour_pixels, empty_panels,
+                          find_3d_view, is_empty_panel, panel_boxes, recording_colours,
+                          screenshot, time_bar, without_agents)
+from viewer_check.web_viewer import Browser, rerun_command  # noqa: E402
 
 main = script.main
 
@@ -129,6 +131,112 @@ def test_time_bar_is_the_long_dark_run_at_the_bottom():
     assert time_bar(np.full((300, 800, 3), 255, np.uint8)) is None
 
 
+def _panels_page(empty: bool):
+    """A fake viewer page of four panels, each with a title bar (its name in dark grey): a large
+    one, an image, a plot, and one whose body holds only a short line of grey text in its middle
+    (``empty``: the viewer's "No data available") or an image; and a blank grid cell (no title)."""
+    img = np.full((540, 960, 3), 255, np.uint8)
+    img[:, 500] = img[:, 730] = img[270, 500:] = SEPARATOR_RGB
+    for x0, y0 in ((0, 0), (501, 0), (731, 0), (501, 271)):
+        img[y0 + 8:y0 + 18, x0 + 10:x0 + 90] = (60, 60, 60)            # the panel's name
+    img[40:500, 20:480] = (120, 160, 90)                                # the 3D view's scene
+    img[40:260, 510:720] = (240, 200, 170)                              # a face image
+    img[60:250, 740] = img[250, 740:950] = 80                           # a plot's axes
+    img[100:200:7, 745:945] = 200
+    img[200:240, 745:945:3] = (200, 60, 50)
+    if empty:
+        img[395:405, 570:660] = (90, 90, 90)                            # "No data available"
+    else:
+        img[300:520, 510:720] = (90, 140, 200)
+    return img
+
+
+def test_the_panels_are_found_and_one_without_data_is_told():
+    full, empty = _panels_page(False), _panels_page(True)
+    boxes = panel_boxes(full)
+    assert len(boxes) == 5 and boxes[0][2] <= 500             # the largest first
+    assert empty_panels(full) == []                            # the blank cell is no panel
+    lacking = empty_panels(empty)
+    assert len(lacking) == 1
+    x0, y0, x1, y1 = lacking[0]
+    assert 495 <= x0 <= 505 and 265 <= y0 <= 275 and x1 >= 725 and y1 == 540
+    assert is_empty_panel(empty, lacking[0]) and not is_empty_panel(full, lacking[0])
+    blank = full.copy()
+    blank[300:520, 510:720] = 255                               # nothing at all: empty too
+    assert empty_panels(blank) == lacking
+
+
+def _error(text):
+    from playwright.sync_api import Error
+    return Error(text)
+
+
+class _Page:
+    """A fake Playwright page: its first screenshots fail (``failures``: the errors' texts), its
+    first loads fail (``loads``: True for each that fails); it notes what each was allowed."""
+
+    def __init__(self, failures=(), loads=()):
+        self.failures, self.loads = list(failures), list(loads)
+        self.timeouts, self.closed, self.visited = [], False, []
+
+    def screenshot(self, timeout=30_000):
+        self.timeouts.append(timeout)
+        if self.failures:
+            raise _error(self.failures.pop(0))
+        return b"png"
+
+    def is_closed(self):
+        return self.closed
+
+    def set_default_timeout(self, ms):
+        self.default = ms
+
+    def set_default_navigation_timeout(self, ms):
+        self.navigation = ms
+
+    def on(self, event, handler):
+        self.handler = handler
+
+    def goto(self, url, wait_until=None, timeout=None):
+        self.visited.append(url)
+        if self.loads and self.loads.pop(0):
+            raise _error("page.goto: Timeout 900000ms exceeded.")
+
+    def wait_for_selector(self, selector, state=None, timeout=None):
+        return None
+
+    def close(self):
+        self.closed = True
+
+
+@needs_browser
+def test_a_screenshot_waits_as_long_as_the_check_allows_and_is_taken_again():
+    """Not Playwright's fixed 30 s: the check's own limit; a failed one is taken again."""
+    page = _Page(failures=["Timeout 30000ms exceeded.", "Protocol error "
+                           "(Page.captureScreenshot): Internal error"])
+    assert screenshot(page, 600.0) == b"png"
+    assert page.timeouts == [600_000] * 3
+    page = _Page(failures=["Internal error"] * 3)
+    with pytest.raises(ViewerCheckError, match="no screenshot .* 3 attempts .* Internal error"):
+        screenshot(page, TIMEOUT)
+
+
+@needs_browser
+def test_a_page_that_does_not_load_is_opened_again():
+    pages = [_Page(loads=[True]), _Page(loads=[True, True]), _Page()]
+    browser = Browser()
+    browser.browser = type("Fake", (), {"new_page": lambda self, **kw: pages.pop(0)})()
+    said = []
+    opened = pages[2]
+    assert browser.open("http://viewer", (1280, 720), 900.0, say=said.append) is opened
+    assert opened.default == opened.navigation == 900_000 and opened.visited == ["http://viewer"]
+    assert len(said) == 2 and "opening it again (3 of 3)" in said[-1]
+    pages = [_Page(loads=[True]) for _ in range(3)]
+    browser.browser = type("Fake", (), {"new_page": lambda self, **kw: pages.pop(0)})()
+    with pytest.raises(ViewerCheckError, match="did not load in 3 attempts"):
+        browser.open("http://viewer", (1280, 720), 900.0)
+
+
 def test_the_colours_looked_for_are_the_agents_clothes(recording):
     colours = recording_colours(recording)
     assert list(colours) == ["infant_0", "infant_1"]
@@ -189,10 +297,12 @@ def test_the_check_left_the_package(capsys):
 @needs_browser
 def test_the_web_viewer_shows_both_bodies_in_its_3d_view(recording, tmp_path, capsys):
     shot = tmp_path / "shot.png"
-    code = main([str(recording), "--screenshot", str(shot), "--timeout", "150",
+    code = main([str(recording), "--screenshot", str(shot),
                  "--size", "1280x720"])              # half the pixels of 1920x1080: faster
     out = capsys.readouterr().out
     assert code == 0, out
+    # every poll looks at the other panels too: the faces, eyes and plots showed their data
+    assert re.search(r"; 0 of \d+ other panels without data$", out, re.M), out
     # progress shown at every poll (a poll before the load says "loading the data"; on a quiet
     # machine the first poll may already find it loaded)
     assert "viewer check passed" in out
@@ -208,9 +318,9 @@ def test_the_web_viewer_shows_both_bodies_in_its_3d_view(recording, tmp_path, ca
 def test_a_recording_without_bodies_fails_the_check(tmp_path):
     path = _no_bodies(tmp_path / "floor.rrd")
     shot = tmp_path / "floor.png"
-    with pytest.raises(ViewerCheckError) as e:
+    with pytest.raises(ViewerCheckError) as e:      # fails: it may give up soon after the load
         check_viewer(path, screenshot=shot, colours={"infant_0": BLUE, "infant_1": RED},
-                     timeout=120, settle=8, progress=None)
+                     settle=8, progress=None)
     text = str(e.value)
     assert "does not show the bodies" in text and "infant_0 (#" in text and ": 0 px" in text
     assert str(shot) in text and shot.is_file()
@@ -223,8 +333,26 @@ def test_the_play_room_without_its_agents_fails_the_check(recording, tmp_path):
     empty = without_agents(recording, ["infant_0", "infant_1"], tmp_path / "empty.rrd")
     with pytest.raises(ViewerCheckError, match="without the agents") as e:
         check_viewer(empty, screenshot=tmp_path / "empty.png", colours=recording_colours(recording),
-                     timeout=150, settle=10, progress=None)
+                     settle=10, progress=None)
     assert "does not show the bodies" in str(e.value)
+
+
+@pytest.mark.slow
+@needs_browser
+def test_panels_without_data_fail_the_check(recording, tmp_path):
+    """The bodies show, but the faces and eyes are not in the file: their six panels show only
+    "No data available" (what a screenshot taken before the images had loaded showed)."""
+    agents = list(recording_colours(recording))
+    drop = [f"/agents/{a}/{p}" for a in agents for p in ("face", "eyes/left", "eyes/right")]
+    faceless = tmp_path / "faceless.rrd"
+    subprocess.run(rerun_command() + ["rrd", "filter", str(recording), "-o", str(faceless)]
+                   + [arg for e in drop for arg in ("--drop-entity", e)], check=True,
+                   capture_output=True, stdin=subprocess.DEVNULL)
+    shot = tmp_path / "faceless.png"
+    with pytest.raises(ViewerCheckError, match="6 panels show no data") as e:
+        check_viewer(faceless, screenshot=shot, size="1280x720", baseline=False, settle=20,
+                     progress=None)
+    assert str(shot) in str(e.value) and shot.is_file()
 
 
 @pytest.mark.slow
@@ -233,7 +361,7 @@ def test_the_demo_in_the_viewer(tmp_path):
     from mimo_social.experiments.demo import record_demo
 
     run = record_demo(tmp_path / "demo.rrd", progress=False)
-    result = check_viewer(run.path, screenshot=tmp_path / "demo.png", timeout=300, at=0.3,
-                          wait=4, progress=None)
+    result = check_viewer(run.path, screenshot=tmp_path / "demo.png", at=0.8, wait=4,
+                          progress=None)     # as docs/demo_viewer.png is made
     assert len(result.pixels) == 2 and min(result.pixels.values()) >= 150
     assert result.scene is not None
