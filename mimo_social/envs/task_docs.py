@@ -102,10 +102,12 @@ docs/training.md), keeps `best_model.zip`, saves checkpoints and writes `progres
 `episodes.csv` and `learning_curve.png`; Ctrl-C or SIGTERM saves the run as it stands. `eval`
 reloads `model.zip` (or `--model best`), prints return, success rate and length (of both
 policies), and can record a Rerun file
-(`--record`), an MP4 (`--video`, needs `imageio` + `imageio-ffmpeg` or an `ffmpeg` program: the
-command says so when neither is installed) or PNG frames (`--frames`). `compare` trains every
-algorithm with seeds 0..n-1 into `OUT/<algo>_seed<k>` and draws them together in
-`OUT/compare.png` (mean over seeds with the min-max band; PPO red, SAC blue) with the numbers
+(`--record`), an MP4 (`--video`, needs `imageio[ffmpeg]`, in the `train` extra, or an `ffmpeg`
+program: the command tries the encoder and every output path before the episodes start, and a
+video that fails midway leaves the recording written) or PNG frames (`--frames`). `compare`
+trains every algorithm with seeds 0..n-1 into `OUT/<algo>_seed<k>` and draws them together in
+`OUT/compare.png` (mean over seeds with the min-max band, a run evaluated once a point; PPO
+red, SAC blue) with the numbers
 in `OUT/compare.csv`; runs of different lengths (e.g. `--algos sac --steps 15000` into the same
 `--out`) are drawn together too.
 
