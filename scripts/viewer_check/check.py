@@ -49,6 +49,7 @@ from mimo_social.util.checks import ConfigError, check_int, check_number
 from .panels import SEPARATOR_RGB, long_runs, empty_panels, panel_boxes
 from .web_viewer import (Browser, FileServer, ViewerCheckError, WebViewer, browser_missing,
                          chromium_path, without_agents)
+from .web_viewer import browser_errors, click
 from .web_viewer import screenshot as take_screenshot
 
 __all__ = ["HUE_TOLERANCE", "MIN_PIXELS", "SETTLE", "TIMEOUT", "ViewerCheck", "ViewerCheckError",
@@ -263,15 +264,17 @@ def check_viewer(path: str | Path, screenshot: str | Path | None = None,
                 return (f"http://127.0.0.1:{viewer.port}/?url="
                         f"{urllib.parse.quote(file_url, safe='')}", file_url)
 
-            first = _watch(browser, *urls("recording.rrd"), shot, must_show=True, **opts)
+            with browser_errors("showing the recording"):
+                first = _watch(browser, *urls("recording.rrd"), shot, must_show=True, **opts)
             scene = None
             if baseline and all(n >= need for n in first.counts.values()):
                 say("the same view of the recording without the agents (the scene's own "
                     "pixels of these colours):")
-                scene = _watch(browser, *urls("without_agents.rrd"),
-                               shot.with_name(shot.stem + "_without_agents.png"),
-                               must_show=False, view=first.box, **{k: v for k, v in opts.items()
-                                                                   if k != "view"})
+                with browser_errors("showing the recording without the agents"):
+                    scene = _watch(browser, *urls("without_agents.rrd"),
+                                   shot.with_name(shot.stem + "_without_agents.png"),
+                                   must_show=False, view=first.box,
+                                   **{k: v for k, v in opts.items() if k != "view"})
     return _verdict(first, scene, shot, colours, need, (width, height))
 
 
@@ -367,7 +370,7 @@ def _watch(browser: Browser, page_url: str, file_url: str, shot: Path, *, size, 
             bar = time_bar(img)
             if at is not None and bar is not None:
                 x0, x1, y = bar
-                page.mouse.click(x0 + at * (x1 - x0), y)
+                click(page, x0 + at * (x1 - x0), y)
                 say(f"  time cursor moved to {at:.0%} of the recording")
             elif at is not None:
                 say("  no time bar found: the time cursor stays")

@@ -4,6 +4,7 @@ Chromium driven by Playwright, and ``rerun rrd filter`` for a copy without the a
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import http.server
 import importlib.util
@@ -19,7 +20,8 @@ import urllib.request
 from pathlib import Path
 
 __all__ = ["Browser", "FileServer", "ViewerCheckError", "WebViewer", "browser_missing",
-           "chromium_path", "launch_args", "rerun_command", "screenshot", "without_agents"]
+           "browser_errors", "chromium_path", "click", "launch_args", "rerun_command", "screenshot",
+           "without_agents"]
 
 _CHROMIUM_NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 
@@ -232,6 +234,31 @@ def _close(page) -> None:
         page.close()
     except Exception:                 # already closed, or the browser went with it
         pass
+
+
+@contextlib.contextmanager
+def browser_errors(what: str):
+    """Turns an error of the browser that was not taken again (Playwright's ``Error``) into a
+    :class:`ViewerCheckError` naming ``what`` was being done: one line, not a traceback."""
+    from playwright.sync_api import Error
+
+    try:
+        yield
+    except Error as e:
+        raise ViewerCheckError(f"the browser failed while {what}: {_first_line(e)}") from None
+
+
+def click(page, x: float, y: float, attempts: int = 3) -> None:
+    """A mouse click on ``page`` at (x, y), taken again when the browser fails it."""
+    from playwright.sync_api import Error
+
+    for attempt in range(attempts):
+        try:
+            page.mouse.click(x, y)
+            return
+        except Error:
+            if attempt == attempts - 1 or page.is_closed():
+                raise
 
 
 def screenshot(page, limit: float, attempts: int = 3) -> bytes:

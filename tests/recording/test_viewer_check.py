@@ -222,6 +222,17 @@ def test_a_screenshot_waits_as_long_as_the_check_allows_and_is_taken_again():
 
 
 @needs_browser
+def test_a_browser_failure_is_one_line_of_the_check_not_a_traceback():
+    from viewer_check.web_viewer import browser_errors
+
+    with pytest.raises(ViewerCheckError) as e:
+        with browser_errors("showing the recording"):
+            raise _error("Protocol error (Input.dispatchMouseEvent): Internal error\nCall log:")
+    assert str(e.value) == ("the browser failed while showing the recording: Protocol error "
+                            "(Input.dispatchMouseEvent): Internal error")
+
+
+@needs_browser
 def test_a_page_that_does_not_load_is_opened_again():
     pages = [_Page(loads=[True]), _Page(loads=[True, True]), _Page()]
     browser = Browser()
