@@ -320,22 +320,10 @@ class MimoParallelEnv(ParallelEnv):
         # every live agent's action is read and checked before any is applied: a bad action
         # leaves the env as it was (no agent's controls or face changed)
         checked = []
+        index, actuation, check = self._index, self.actuation, self._checked_action
         for a in self.agents:
-            i = self._index[a]
-            act = self.actuation[i]
-            action = actions[a]
-            expression = None
-            if self.agent_configs[i].expressions:
-                if not (type(action) is dict and action.keys() == _ACTION_KEYS) and (
-                        not isinstance(action, Mapping) or set(action) != _ACTION_KEYS):
-                    raise ValueError(f"{a}: action must be a dict with keys 'motors' and "
-                                     f"'expression' (expressions are on), got "
-                                     f"{show(action, 120)}")
-                motors, given = action["motors"], action["expression"]
-                expression = _expression_id(a, given)
-            else:
-                motors = action
-            checked.append((i, act, expression, self._motor_values(a, act, motors)))
+            i = index[a]
+            checked.append((i, actuation[i], *check(i, a, actions[a])))
         w = self.world
         for i, act, expression, u in checked:
             if expression is not None:
@@ -352,6 +340,28 @@ class MimoParallelEnv(ParallelEnv):
                 np.minimum(np.maximum(u, act.control_low, out=slot), act.control_high, out=slot)
                 np.copyto(c, ring.advance())
             act.apply(w.model, w.data, c)
+
+    def check_action(self, agent: str, action) -> tuple[int | None, np.ndarray]:
+        """``agent``'s action checked as :meth:`step` checks it, nothing applied: its expression
+        id (None with expressions off) and its motor commands (a float array of the motor Box's
+        shape, finite, not clipped). A ValueError names the agent, the field (``motors``,
+        ``expression``), the value and what is allowed; an unknown agent is a KeyError naming
+        the agents. The recorder checks the actions it is given with it."""
+        return self._checked_action(self._index[self._check_agent(agent)], agent, action)
+
+    def _checked_action(self, i: int, agent: str, action) -> tuple[int | None, np.ndarray]:
+        act = self.actuation[i]
+        expression = None
+        if self.agent_configs[i].expressions:
+            if not (type(action) is dict and action.keys() == _ACTION_KEYS) and (
+                    not isinstance(action, Mapping) or set(action) != _ACTION_KEYS):
+                raise ValueError(f"{agent}: action must be a dict with keys 'motors' and "
+                                 f"'expression' (expressions are on), got {show(action, 120)}")
+            motors, given = action["motors"], action["expression"]
+            expression = _expression_id(agent, given)
+        else:
+            motors = action
+        return expression, self._motor_values(agent, act, motors)
 
     def _check_action_keys(self, actions) -> None:
         """A ValueError unless ``actions`` is a mapping with an action for every live agent

@@ -97,7 +97,7 @@ import pyarrow as pa
 import rerun as rr
 import rerun.blueprint as rrb
 
-from ..util.checks import check_choice, check_int
+from ..util.checks import check_choice, check_int, show
 from .blueprint import blueprint as _blueprint
 from .blueprint import scene_eye
 from .columns import (
@@ -231,6 +231,7 @@ class Recorder:
         self._dt = float(penv.dt)
         self._textured_heads = textured_heads
         self._motor_counts = [self._motor_count(penv.action_space(a)) for a in self.agents]
+        self._motor_index = {a: i for i, a in enumerate(self.agents)}
         self._bodies = visible_bodies(world)
         self._body_ids = self._bodies.ids
         self.body_paths: list[str] = self._bodies.paths
@@ -372,9 +373,12 @@ class Recorder:
         """Record the state right after ``env.step(actions)`` returned ``rewards``.
 
         ``actions`` and ``rewards`` are the dicts given to and returned by ``env.step`` (with a
-        single-agent adapter: that agent's action and reward). Agents missing from them (done)
-        get no reward or action-norm value in that row. ``observations`` (optional): what
-        ``env.step`` returned; eye images are taken from it when it holds them.
+        single-agent adapter: that agent's action and reward). Agents missing from them (done,
+        or scripted) get no reward or action-norm value in that row; the actions are checked as
+        ``env.step`` checks them (``env.check_action``): an unknown agent, a wrong shape, NaN/inf
+        or a bad expression is a ValueError naming the agent, the field, the value and what is
+        allowed. ``observations`` (optional): what ``env.step`` returned; eye images are taken
+        from it when it holds them.
         """
         t0 = time.perf_counter()
         if not self._started:
@@ -385,6 +389,7 @@ class Recorder:
             actions = {self.agents[0]: actions}
             if rewards is not None and not isinstance(rewards, Mapping):
                 rewards = {self.agents[0]: rewards}
+        motors = self._checked_motors(actions)
         self._global_step += 1
         self._episode_steps += 1
         if rewards:
@@ -407,8 +412,24 @@ class Recorder:
                                                observations)
         if self._episode_steps % self.every_k_steps == 0:
             reward, self._reward_acc = self._reward_acc, [math.nan] * len(self.agents)
-            self._append_row(reward, actions)
+            self._append_row(reward, motors)
         self.overhead_s += time.perf_counter() - t0
+
+    def _checked_motors(self, actions) -> dict[str, np.ndarray]:
+        """Each agent's motor commands in ``actions``, checked as ``env.step`` checks them."""
+        if not isinstance(actions, Mapping):
+            raise ValueError(f"Recorder.log_step: actions={show(actions)} not allowed; allowed: "
+                             f"the dict agent -> action given to env.step ({self.agents})")
+        out = {}
+        for a, action in actions.items():
+            if a not in self._motor_index:
+                raise ValueError(f"Recorder.log_step: an action for unknown agent {a!r}; "
+                                 f"allowed: agents of this env {self.agents}")
+            try:
+                out[a] = self.env.check_action(a, action)[1]
+            except ValueError as e:
+                raise ValueError(f"Recorder.log_step: {e}") from None
+        return out
 
     def _note_expressions(self, agents, at_once: bool = False) -> None:
         t = self._now()
@@ -431,7 +452,7 @@ class Recorder:
     def _now(self) -> float:
         return self._time_offset + float(self.world.data.time)
 
-    def _append_row(self, reward, actions) -> None:
+    def _append_row(self, reward, motors) -> None:
         """Copy the poses, time, rewards and motor actions (NaN: none) into the next buffer row."""
         rows = self._rows
         n = rows.n
@@ -448,16 +469,9 @@ class Recorder:
         rows.time.append(self._last_time)
         rows.step.append(self._global_step)
         rows.reward.append(reward)
-        get = actions.get if isinstance(actions, Mapping) else None
         for i, a in enumerate(self.agents):
-            action = get(a) if get is not None else None
-            kind = type(action)
-            if kind is dict or (kind is not np.ndarray and isinstance(action, Mapping)):
-                action = action.get("motors")
-            try:
-                rows.motors[i][n] = np.nan if action is None else action
-            except (ValueError, TypeError):   # not this agent's motor vector: leave it out
-                rows.motors[i][n] = np.nan
+            u = motors.get(a) if motors else None     # checked by log_step; None: no action
+            rows.motors[i][n] = np.nan if u is None else u
         if self._skin is not None:
             self._skin.note(rows, n, self._xmat)
         rows.n = n + 1

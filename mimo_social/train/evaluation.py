@@ -39,6 +39,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from ..core.wrappers import ActionDecoder
 from .envs import make_env, make_parallel_env, make_scripted_env, run_observation
 from .rollouts import evaluate_agents, evaluate_policy, load_vecnormalize, vecnormalize_path
 from .tasks import TrainInputError, algo_class
@@ -295,12 +296,13 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     penv = env.unwrapped.parallel
     outputs = EvalOutputs(env, penv, record, video, frames, frame_every)
     agent = penv.possible_agents[0]
+    decode = ActionDecoder(penv.action_space(agent))   # the flat action as the env takes it
 
     def on_step(action, reward, info, reset):
         if reset:
             outputs.on_reset()
         else:
-            outputs.on_step({agent: np.asarray(action)}, {agent: float(reward)})
+            outputs.on_step({agent: decode(action, agent)}, {agent: float(reward)})
 
     t0 = time.perf_counter()
     bar = _Bar(episodes * (2 if both else 1), progress, f"eval {run.name}")
@@ -325,15 +327,12 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     return res
 
 
-def _motor_slicer(env) -> Callable[[str, np.ndarray], dict]:
-    """Flat action -> ``{"motors": ...}`` for the recorder (its action-norm scalar)."""
+def _action_decoder(env) -> Callable[[str, Any], Any]:
+    """Flat action -> the agent's action as the env takes it, for the recorder (which checks it
+    as ``env.step`` does)."""
     inner = env.unwrapped
-    counts = {}
-    for a in env.possible_agents:
-        space = inner.action_space(a)
-        motors = space["motors"] if hasattr(space, "spaces") and "motors" in space.spaces else space
-        counts[a] = int(np.prod(motors.shape))
-    return lambda a, act: {"motors": np.asarray(act).ravel()[:counts[a]]}
+    decoders = {a: ActionDecoder(inner.action_space(a)) for a in env.possible_agents}
+    return lambda a, act: decoders[a](act, a)
 
 
 def _load_policies(run: Path, config: dict, model: str) -> tuple[dict, dict]:
@@ -366,13 +365,13 @@ def evaluate_with_outputs(policies: Mapping[str, Any], env, inner, episodes: int
     ``record`` / ``video`` / ``frames`` paths given. The multi-agent evaluation of either
     engine."""
     outputs = EvalOutputs(env, inner, record, video, frames, frame_every)
-    motors = _motor_slicer(env)
+    decode = _action_decoder(env)
 
     def on_step(actions, rewards, obs, reset):
         if reset:
             outputs.on_reset()
         else:
-            outputs.on_step({a: motors(a, act) for a, act in actions.items()}, rewards)
+            outputs.on_step({a: decode(a, act) for a, act in actions.items()}, rewards)
 
     t0 = time.perf_counter()
     try:

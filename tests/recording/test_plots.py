@@ -202,9 +202,10 @@ def test_a_failing_plot_names_the_task_and_the_plot(tmp_path):
     with pytest.raises(RuntimeError, match="custom plot 'y'.*ZeroDivisionError"):
         with Recorder(env, tmp_path / "f.rrd") as rec:
             rec.log_reset(obs)                    # no plot values at reset
-            zero = {a: np.zeros(env.action_space(a)["motors"].shape
-                                if hasattr(env.action_space(a), "spaces")
-                                else env.action_space(a).shape) for a in env.agents}
+            # what env.step takes (the recorder checks it): motors and a face with expressions
+            zero = {a: {"motors": np.zeros(env.action_space(a)["motors"].shape), "expression": 0}
+                    if hasattr(env.action_space(a), "spaces")
+                    else np.zeros(env.action_space(a).shape) for a in env.agents}
             rec.log_step(zero, None)
     env.close()
 

@@ -287,6 +287,34 @@ def test_misuse_is_reported(env, tmp_path):
         Recorder(object(), tmp_path / "z.rrd")
 
 
+def test_malformed_actions_are_refused_naming_agent_field_and_value(env, tmp_path):
+    """log_step checks the actions as env.step does: an unknown agent, a wrong shape, NaN, a bad
+    expression or no dict at all is a ValueError naming the agent, the field, the value and what
+    is allowed, and adds no row; a missing agent (done or scripted) is allowed."""
+    u = np.zeros(44, np.float32)
+    bad = [({"infant_9": {"motors": u, "expression": 0}}, ["infant_9", "unknown", "infant_1"]),
+           ({"infant_0": {"motors": np.zeros(3), "expression": 0}},
+            ["infant_0", "'motors'", "shape (3,)", "(44,)"]),
+           ({"infant_1": {"motors": np.full(44, np.nan), "expression": 0}},
+            ["infant_1", "'motors'", "NaN", "finite"]),
+           ({"infant_0": {"motors": u, "expression": 9}}, ["infant_0", "expression=9", "0..6"]),
+           ({"infant_0": u}, ["infant_0", "'motors' and 'expression'"]),
+           ("zeros", ["actions='zeros'", "dict agent -> action"])]
+    path = tmp_path / "checked.rrd"
+    with Recorder(env, path) as rec:
+        env.reset(seed=0)
+        rec.log_reset()
+        for actions, words in bad:
+            with pytest.raises(ValueError) as err:
+                rec.log_step(actions)
+            for word in ["Recorder.log_step", *words]:
+                assert word in str(err.value), f"{word!r} not in {str(err.value)!r}"
+        rec.log_step({"infant_1": {"motors": u + 0.5, "expression": 0}})   # infant_0 done
+    norm = rows(read_rrd(path), "/agents/infant_1/action_norm", "Scalars:scalars")
+    assert [(s, round(v[0], 6)) for s, _, v in norm] == [(1, round(0.5 * 44 ** 0.5, 6))]
+    assert rows(read_rrd(path), "/agents/infant_0/action_norm", "Scalars:scalars") == []
+
+
 def test_single_agent_adapter(tmp_path):
     import gymnasium as gym
 
