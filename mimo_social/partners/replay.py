@@ -101,22 +101,28 @@ class ReplayCaregiver(Partner):
 
     def reset(self, env, agent, rng):
         super().reset(env, agent, rng)
+        self._dict = self.check(env, agent)
+        self.step = self.offset
+
+    def check(self, env, agent: str) -> bool:
+        """Whether the stream fits ``agent`` of ``env`` (its motors, its face, the control
+        step), else a ConfigError saying what differs; returns whether the agent acts with its
+        face. :meth:`reset` runs it; a factory can run it when the env is made."""
         space = env.action_space(agent)
-        self._dict = isinstance(space, spaces.Dict) and "expression" in space.spaces
+        face = isinstance(space, spaces.Dict) and "expression" in space.spaces
         box = space.spaces["motors"] if isinstance(space, spaces.Dict) else space
         n = self._stream["motors"].shape[1]
         if box.shape != (n,):
-            raise ValueError(f"ReplayCaregiver: the stream has {n} motors, {agent}'s action "
-                             f"{box.shape[0]}; replay it for the agent it was recorded from")
-        faces = self._stream["expression"]
-        if self._dict and np.any(faces < 0):
-            raise ValueError(f"ReplayCaregiver: {agent} acts with its face but the stream has no "
-                             "expressions (recorded without them)")
+            raise ConfigError(f"ReplayCaregiver: the stream has {n} motors, {agent}'s action "
+                              f"{box.shape[0]}; replay it for the agent it was recorded from")
+        if face and np.any(self._stream["expression"] < 0):
+            raise ConfigError(f"ReplayCaregiver: {agent} acts with its face but the stream has "
+                              "no expressions (recorded without them)")
         dt = self._stream["dt"]
         if np.isfinite(dt) and abs(dt - float(env.dt)) > 1e-9:
-            raise ValueError(f"ReplayCaregiver: the stream was recorded at dt={dt} s, this env "
-                             f"steps dt={env.dt} s")
-        self.step = self.offset
+            raise ConfigError(f"ReplayCaregiver: the stream was recorded at dt={dt} s, this env "
+                              f"steps dt={env.dt} s")
+        return face
 
     def act(self, env, agent, observation):
         if self.step is None:

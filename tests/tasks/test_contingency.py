@@ -108,10 +108,28 @@ def test_options_conditions_and_bodies():
     s = contingency_v0.scripted_env(per_agent=[{}, {"body": "infant"}]).unwrapped
     assert (s.agent_configs[1].body, s.agent_configs[1].posture) == ("infant", "standing")
     assert s.agent_configs[1].vision is None
-    # replay needs an earlier live episode (or a given stream)
-    env = contingency_v0.scripted_env(task_options={"condition": "replay"}, **FAST)
-    with pytest.raises(RuntimeError, match="run a live episode first"):
-        env.reset(seed=0)
+    # replay needs a stream to play back: none given, refused when the env is made (naming
+    # the field, the value and what is needed), not at the first reset
+    with pytest.raises(ConfigError) as err:
+        contingency_v0.scripted_env(task_options={"condition": "replay"}, **FAST)
+    for words in ("condition='replay'", "stream=", "set_condition('replay')",
+                  "'live', 'non_contingent'"):
+        assert words in str(err.value), str(err.value)
+    # a stream that does not fit the caregiver (its motors, its control step): refused too
+    probe = contingency_v0.scripted_env(**FAST).unwrapped
+    n = probe.action_space(probe.possible_agents[1])["motors"].shape[0]
+    for stream, words in (({"motors": np.zeros((5, n + 2), np.float32),
+                            "expression": np.zeros(5, np.int64), "dt": 0.01}, f"{n + 2} motors"),
+                          ({"motors": np.zeros((5, n), np.float32),
+                            "expression": np.zeros(5, np.int64), "dt": 0.02}, "dt=0.02")):
+        with pytest.raises(ConfigError, match=words):
+            contingency_v0.scripted_env(stream=stream, task_options={"condition": "replay"},
+                                        **FAST)
+    # after a live episode the env's own recording is replayed (set_condition)
+    env = contingency_v0.scripted_env(max_steps=5, **FAST)
+    run(env, Pulses(), "live")
+    faces, info = run(env, Pulses(), "replay")
+    assert info["condition"] == 1 and len(faces) == 5
 
 
 def test_live_caregiver_answers_smiles_with_the_delay_and_probability():

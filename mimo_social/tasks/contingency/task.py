@@ -294,6 +294,22 @@ class ContingencyCaregiver(Partner):
             return live.stream
         return self._recorded
 
+    def check(self, env, agent) -> None:
+        """When the env is made (``scripted_env``): the task's condition "replay" needs a stream
+        to play back, ``stream`` or an earlier live episode's, and a given stream must fit
+        ``agent``; else a ConfigError naming the field, the value and what is needed."""
+        if self.stream is not None:
+            from ...partners.replay import ReplayCaregiver
+            ReplayCaregiver(self.stream).check(env, agent)
+        elif env.task.condition == "replay" and self.recorded is None:
+            raise ConfigError(
+                "contingency: task option condition='replay' needs a recorded caregiver to play "
+                "back, and this env has none: give contingency_v0.scripted_env(stream=...) one "
+                "(ContingencyCaregiver.recorded after a live episode, or load_stream(path)), or "
+                "make the env with condition='live' and switch with env.unwrapped.task."
+                "set_condition('replay') after a live episode; allowed without a stream: "
+                "'live', 'non_contingent'")
+
     def _close_live(self) -> None:
         """Keep the live episode's stream and end its interactive period (the caregiver
         measures its response rates)."""
@@ -351,5 +367,8 @@ def env(**kwargs):
 def scripted_env(partner=None, stream=None, **kwargs):
     from ...partners import ScriptedPartners
     options = with_options(Contingency, kwargs.pop("task_options", None), scripted_partner=True)
-    return ScriptedPartners(parallel_env(task_options=options, **kwargs),
-                            {"infant_1": partner or ContingencyCaregiver(stream=stream)})
+    penv = parallel_env(task_options=options, **kwargs)
+    partner = partner or ContingencyCaregiver(stream=stream)
+    if isinstance(partner, ContingencyCaregiver):   # replay's stream, checked now, not at reset
+        partner.check(penv, "infant_1")
+    return ScriptedPartners(penv, {"infant_1": partner})
