@@ -141,7 +141,7 @@ def _rows(path):
 
 
 def test_shared_policy_on_the_cluster_writes_curves_and_a_checkpoint_eval_reloads(
-        cluster, tmp_path, capsys):
+        cluster, tmp_path, capsys, monkeypatch):
     import ray
 
     out = tmp_path / "hf"
@@ -182,6 +182,9 @@ def test_shared_policy_on_the_cluster_writes_curves_and_a_checkpoint_eval_reload
     again = main(["eval", str(out), "--episodes", "2"])
     assert again == 0
     assert json.loads((out / "eval_results.json").read_text())["returns"] == res["returns"]
+    # the run folder as typed in a shell, relative (RLlib reads checkpoints by URI)
+    monkeypatch.chdir(tmp_path)
+    assert main(["eval", "hf", "--episodes", "1"]) == 0
 
 
 HETERO = {"max_steps": 50, "per_agent": [{"hands": "mitten"}, {"touch": True}]}

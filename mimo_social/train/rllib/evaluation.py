@@ -125,7 +125,8 @@ def load_policies(checkpoint: Path, agent_modules: Mapping[str, str], env) -> di
         path = module_dir(checkpoint, mid)
         if not path.is_dir():
             raise FileNotFoundError(f"RLModule {mid!r} not found in {checkpoint} ({path})")
-        module = RLModule.from_checkpoint(path)
+        # absolute: RLlib reads a checkpoint by URI, and a relative path has no scheme
+        module = RLModule.from_checkpoint(path.resolve())
         module.eval()
         loaded[mid] = module
     agents = list(agent_modules)
