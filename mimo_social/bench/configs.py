@@ -90,7 +90,8 @@ class BenchConfig:
     default: bool = True             # in the default set (no --only)
 
     def make_env(self):
-        return entry(self.task).parallel_env(**deep_copy(self.kwargs))
+        # text infos: the runner reports an instability's reason
+        return entry(self.task).parallel_env(**{"info_text": True, **deep_copy(self.kwargs)})
 
     @property
     def has_touch(self) -> bool:

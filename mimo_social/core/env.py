@@ -6,7 +6,13 @@ per motor; muscles: two values in [0, 1] per motor), or, when expressions are on
 **clipped** (learners' Gaussian policies overshoot); NaN/inf, a wrong shape, an unknown agent or
 an expression id out of range raise ``ValueError`` naming the agent, the field and what is
 allowed. A simulation that goes unstable ends the episode for every agent with the reason in
-``infos[agent]["instability"]``.
+``infos[agent]["instability"]`` (a 1 in the numeric infos).
+
+Infos are numbers by default: each agent's the same keys at reset and at every step
+(:meth:`MimoParallelEnv.info_keys`, what clients that make tensors of them need, e.g. TorchRL's
+``PettingZooWrapper``); ``info_text=True`` gives the text infos they are made from (the
+expression's name, the reason of an instability, touched parts, a task's target part; key ->
+kind: :meth:`MimoParallelEnv.info_spec`; the encoding: :mod:`mimo_social.core.infos`).
 
 The senses come from the registry :data:`mimo_social.senses.SENSES`: for each registered sense
 that an agent has on, a sense of its own, or one shared system for the world (the skin reads the
@@ -37,9 +43,10 @@ from ..expressions.faces import EXPRESSIONS
 from ..render.scene import make_renderer
 from ..scenery import SCENES, check_scene_clear, inside_camera
 from ..senses import SENSES
-from ..util.checks import check_choice, check_seed, number_array, show
+from ..util.checks import check_bool, check_choice, check_seed, number_array, show
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
 from .delays import MotorDelay, SenseDelay, delay_steps, fill_sensor_history
+from .infos import InfoEncoder
 from .task import Task, agent_user_settings, check_start_poses
 from .world import World
 
@@ -108,12 +115,14 @@ class MimoParallelEnv(ParallelEnv):
                  per_agent: Sequence[Mapping[str, Any]] | None = None,
                  render_mode: str | None = None, max_steps: int | None = None,
                  render_size: tuple[int, int] = (480, 640), scene: str = "floor",
-                 **agent_settings):
+                 info_text: bool = False, **agent_settings):
         self.render_mode, self.max_steps, self.render_size = env_settings(
             render_mode, max_steps, render_size, task.default_max_steps,
             self.RENDER_MODES)
         #: where the agents are: "floor" (the bare floor) or "playroom" (docs/playroom.md)
         self.scene = check_choice("env", "scene", scene, SCENES)
+        #: False (default): infos as numbers (info_keys); True: the text infos (info_spec)
+        self.info_text = check_bool("env", "info_text", info_text)
         self.task = task
         n = task.n_agents
         defaults = [task.agent_defaults(i, own) for i, own in
@@ -272,7 +281,7 @@ class MimoParallelEnv(ParallelEnv):
                 ring.reset(c)
         obs = {a: self._observe(i, reset=True) for i, a in enumerate(self.agents)}
         infos = {a: self._info(i) for i, a in enumerate(self.agents)}
-        return obs, infos
+        return obs, self._infos_out(infos)
 
     def step(self, actions: Mapping[str, Any]):
         t0 = time.perf_counter()
@@ -311,7 +320,7 @@ class MimoParallelEnv(ParallelEnv):
                 infos[a]["instability"] = reason
         self.agents = [a for a in self.agents if not (term[a] or trunc[a])]
         timing["other"] += time.perf_counter() - t5
-        return obs, rew, term, trunc, infos
+        return obs, rew, term, trunc, self._infos_out(infos)
 
     def _apply_actions(self, actions):
         if not (type(actions) is dict and actions.keys() == set(self.agents)):
@@ -460,6 +469,21 @@ class MimoParallelEnv(ParallelEnv):
         if hasattr(self.task, "info_spec"):
             spec.update(self.task.info_spec(i))
         return spec
+
+    def info_keys(self, agent) -> tuple[str, ...]:
+        """The keys of ``agent``'s numeric infos (the default; ``info_text=False``), in order:
+        the same at reset and at every step."""
+        return self._encoder().keys(self._check_agent(agent))
+
+    def _encoder(self) -> InfoEncoder:
+        enc = self.__dict__.get("_info_encoder")
+        if enc is None:
+            enc = self._info_encoder = InfoEncoder({a: self.info_spec(a)
+                                                    for a in self.possible_agents})
+        return enc
+
+    def _infos_out(self, infos: dict) -> dict:
+        return infos if self.info_text else self._encoder().encode_all(infos)
 
     def _has_faces(self) -> bool:
         return any(c.expressions for c in self.agent_configs)

@@ -13,7 +13,8 @@ from .config import AgentConfig
 from .env import MimoParallelEnv
 from ..util.checks import ConfigError, show
 
-TASK_ARGS = ("physics", "per_agent", "render_mode", "max_steps", "render_size", "scene")
+TASK_ARGS = ("physics", "per_agent", "render_mode", "max_steps", "render_size", "scene",
+             "info_text")
 #: what ``parallel_env(**kwargs)`` takes besides the agents' settings (:func:`agent_settings`)
 ENV_KEYWORDS = ("n_agents", "task_options", *TASK_ARGS, "max_cycles")
 

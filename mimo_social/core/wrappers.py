@@ -51,6 +51,7 @@ from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
 from ..util.checks import number_array
+from .infos import INFO_KINDS, InfoEncoder
 
 __all__ = ["ParallelWrapper", "FlattenParallel", "NumericInfos", "INFO_KINDS", "FlatActionWrapper",
            "FlatObservationWrapper", "ExpressionActionWrapper", "is_expression_only",
@@ -434,26 +435,17 @@ class FlattenParallel(ParallelWrapper):
 
 # -- numeric infos ------------------------------------------------------------------------------
 #: the kinds of info value an ``info_spec`` names (besides a tuple of strings and a nested dict)
-INFO_KINDS = ("number", "flag", "count", "touch")
-TOUCH_COUNTS = ("parts", "self", "agents", "object")
-
-
 class NumericInfos(ParallelWrapper):
     """Every agent's infos as one fixed set of float numbers: the same keys at reset and at every
     step, for clients that turn infos into tensors (TorchRL's ``PettingZooWrapper``).
 
-    The keys are declared up front by the wrapped env's ``info_spec(agent)`` (the env's, its
-    senses' and its task's, see :meth:`mimo_social.core.env.MimoParallelEnv.info_spec`) and
-    ``extra`` (key -> kind, e.g. ``{"partner_rewards": {"infant_1": "number"}}``). Per kind:
-
-    * ``"number"``: ``float(value)`` (bools 0/1);
-    * ``"flag"``: 1 when the key is there and true, else 0 (``instability``);
-    * ``"count"``: the length of a list (``touched_parts``), 0 for None;
-    * a tuple of strings: the index of the string in it (``expression``, ``target_part``), -1
-      for None or a string not in the tuple;
-    * ``"touch"``: ``key/parts``, ``key/self``, ``key/agents``, ``key/object``: how many body
-      parts are touched, by the agent itself, by other agents, by objects;
-    * a dict sub-key -> kind: ``key/sub-key`` for each (a nested dict flattened).
+    The envs of this package give such infos by default (:mod:`mimo_social.core.infos`); this
+    wrapper encodes their text infos itself, with its own options: it turns the wrapped env's
+    text infos on (``env.unwrapped.info_text = True``). The keys are declared up front by the
+    wrapped env's ``info_spec(agent)`` (the env's, its senses' and its task's, see
+    :meth:`mimo_social.core.env.MimoParallelEnv.info_spec`) and ``extra`` (key -> kind, e.g.
+    ``{"partner_rewards": {"infant_1": "number"}}``); the kinds and their numbers:
+    :class:`mimo_social.core.infos.InfoEncoder`.
 
     A declared key missing from an info (task keys at reset) reads ``missing`` (default 0).
     Keys nobody declared are dropped; with ``strict=True`` they, and strings not in their tuple,
@@ -470,95 +462,30 @@ class NumericInfos(ParallelWrapper):
             raise TypeError(f"NumericInfos needs an env with info_spec(agent) (the envs of this "
                             f"package have one), got {type(env).__name__}")
         self.possible_agents = list(env.possible_agents)
-        self.missing = float(missing)
-        self.strict = bool(strict)
-        self._specs = {}
-        for a in self.possible_agents:
-            spec = {**spec_of(a), **dict(extra or {})}
-            _check_spec(a, spec)
-            self._specs[a] = spec
-        self._keys = {a: tuple(self._encode(a, {})) for a in self.possible_agents}
+        self._encoder = InfoEncoder({a: {**spec_of(a), **dict(extra or {})}
+                                     for a in self.possible_agents}, missing, strict)
+        self.missing, self.strict = self._encoder.missing, self._encoder.strict
+        if getattr(env.unwrapped, "info_text", True) is False:
+            env.unwrapped.info_text = True   # encoded here, with this wrapper's options
 
     def info_keys(self, agent) -> tuple[str, ...]:
         """The keys of ``agent``'s numeric infos, in order."""
         try:
-            return self._keys[agent]
+            return self._encoder.keys(agent)
         except KeyError:
             raise KeyError(f"unknown agent {agent!r}; agents of this env: "
                            f"{self.possible_agents}") from None
 
     def _encode(self, agent: str, info: Mapping[str, Any]) -> dict[str, float]:
-        spec = self._specs[agent]
-        if self.strict:
-            undeclared = sorted(set(info) - set(spec))
-            if undeclared:
-                raise ValueError(f"{agent}: info key(s) {undeclared} not declared by the env's "
-                                 f"info_spec (declared: {sorted(spec)})")
-        out: dict[str, float] = {}
-        for key, kind in spec.items():
-            self._put(agent, key, kind, key in info, info.get(key), out)
-        return out
-
-    def _put(self, agent, key, kind, present, value, out):
-        strict = self.strict
-        if isinstance(kind, Mapping):
-            sub = value if present and isinstance(value, Mapping) else {}
-            if strict and present and (not isinstance(value, Mapping) or set(sub) - set(kind)):
-                raise ValueError(f"{agent}: info {key!r} = {value!r:.120} does not fit its "
-                                 f"declared keys {sorted(kind)}")
-            for k, sub_kind in kind.items():
-                self._put(agent, f"{key}/{k}", sub_kind, k in sub, sub.get(k), out)
-        elif isinstance(kind, tuple):
-            idx = kind.index(value) if present and value in kind else -1
-            if strict and present and value is not None and idx < 0:
-                raise ValueError(f"{agent}: info {key!r} = {value!r:.120} is not one of its "
-                                 f"declared values {list(kind)}")
-            out[key] = float(idx)
-        elif kind == "flag":
-            out[key] = 1.0 if present and value is not None and value is not False else 0.0
-        elif kind == "count":
-            out[key] = float(len(value)) if present and value is not None else 0.0
-        elif kind == "touch":
-            parts = value if present and isinstance(value, Mapping) else {}
-            counts = dict.fromkeys(TOUCH_COUNTS, 0.0)
-            for who in parts.values():
-                counts["parts"] += 1.0
-                counts["self"] += float(bool(who.get("self")))
-                counts["agents"] += float(bool(who.get("agents")))
-                counts["object"] += float(bool(who.get("object")))
-            out.update({f"{key}/{c}": n for c, n in counts.items()})
-        elif not present or value is None:
-            out[key] = self.missing
-        else:
-            try:
-                out[key] = float(value)
-            except (TypeError, ValueError):
-                raise ValueError(f"{agent}: info {key!r} = {value!r:.120} is declared a number "
-                                 "but is not one") from None
-
-    def _numeric(self, infos: Mapping[str, Any]) -> dict:
-        return {a: (self._encode(a, i) if a in self._specs else i) for a, i in infos.items()}
+        return self._encoder.encode(agent, info)
 
     def reset(self, seed: int | None = None, options: dict | None = None):
         obs, infos = self.env.reset(seed=seed, options=options)
-        return obs, self._numeric(infos)
+        return obs, self._encoder.encode_all(infos)
 
     def step(self, actions: Mapping[str, Any]):
         obs, rewards, terminations, truncations, infos = self.env.step(actions)
-        return obs, rewards, terminations, truncations, self._numeric(infos)
-
-
-def _check_spec(agent: str, spec: Mapping[str, Any], prefix: str = "") -> None:
-    for key, kind in spec.items():
-        if isinstance(kind, Mapping):
-            _check_spec(agent, kind, f"{prefix}{key}/")
-        elif isinstance(kind, tuple):
-            if not all(isinstance(v, str) for v in kind):
-                raise TypeError(f"{agent}: info_spec {prefix}{key}: a tuple of kinds must hold "
-                                f"strings, got {kind!r}")
-        elif kind not in INFO_KINDS:
-            raise TypeError(f"{agent}: info_spec {prefix}{key}: kind {kind!r} not allowed; "
-                            f"allowed: {list(INFO_KINDS)}, a tuple of strings or a dict")
+        return obs, rewards, terminations, truncations, self._encoder.encode_all(infos)
 
 
 # -- the Gymnasium side -------------------------------------------------------------------------

@@ -27,7 +27,7 @@ from ..core.env import MimoParallelEnv
 from ..core.factory import make_parallel
 from ..scenery import SCENES
 from ..senses import SENSES
-from ..util.checks import check_choice
+from ..util.checks import check_bool, check_choice
 
 __all__ = ["FieldDoc", "field_docs", "env_setting_docs", "missing", "render", "differs",
            "ENV_SETTINGS"]
@@ -50,6 +50,10 @@ ENV_SETTINGS = {
     "render_size": ("(height, width) of `env.render()`'s image", None),
     "scene": ("where the agents are: a bare checkered floor or the furnished play room "
               "([the play room](../playroom.md))", None),
+    "info_text": ("`True`: the infos as text (the expression's name, an instability's reason, "
+                  "the touched parts, a task's target by name); `False`: every agent's infos as "
+                  "numbers, the same keys at reset and every step (`env.info_keys(agent)`)",
+                  None),
 }
 
 INTRO = """\
@@ -191,6 +195,7 @@ def env_setting_docs() -> list[FieldDoc]:
         "max_steps": lambda v: env_settings(None, v, (8, 8), 1, ()),
         "render_size": lambda v: env_settings(None, None, v, 1, ()),
         "scene": lambda v: check_choice("env", "scene", v, SCENES),
+        "info_text": lambda v: check_bool("env", "info_text", v),
     }
     out = []
     for name, default in _env_defaults().items():

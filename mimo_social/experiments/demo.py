@@ -93,7 +93,7 @@ def demo_env(scene: str = DEFAULT_SCENE, eye_size: int = EYE_SIZE):
     return make_parallel(HighFiveThenHandover, per_agent=[{}, dict(CAREGIVER)],
                          expressions=True, vision={"width": eye_size, "height": eye_size},
                          task_options={"end_on_success": False}, max_steps=10**9,
-                         scene=check_scene(scene))
+                         scene=check_scene(scene), info_text=True)   # a reason if unstable
 
 
 def check_scene(scene) -> str:

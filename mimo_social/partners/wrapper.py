@@ -63,6 +63,22 @@ class ScriptedPartners(ParallelWrapper):
         return {**self.env.info_spec(agent),
                 "partner_rewards": {name: "number" for name in self.partners}}
 
+    def info_keys(self, agent) -> tuple[str, ...]:
+        """The keys of a learner's numeric infos (the env's default): the env's, then
+        ``partner_rewards/<scripted agent>`` (0 at reset)."""
+        self._check(agent)
+        return (*self.env.info_keys(agent), *(f"partner_rewards/{n}" for n in self.partners))
+
+    def _with_partner_rewards(self, infos: dict, rewards: Mapping[str, float]) -> dict:
+        """The learners' infos with the scripted agents' rewards of the step: one dict
+        ``partner_rewards`` in text infos, ``partner_rewards/<agent>`` numbers in numeric ones
+        (the same keys at reset, 0 there)."""
+        if getattr(self.env.unwrapped, "info_text", True):
+            given = {a: float(rewards[a]) for a in self.partners if a in rewards}
+            return {a: dict(info, partner_rewards=given) for a, info in infos.items()}
+        flat = {f"partner_rewards/{n}": float(rewards.get(n, 0.0)) for n in self.partners}
+        return {a: {**info, **flat} for a, info in infos.items()}
+
     def _check(self, agent):
         if agent not in self.possible_agents:
             raise KeyError(f"unknown agent {agent!r}; learners of this env: {self.possible_agents}"
@@ -83,7 +99,10 @@ class ScriptedPartners(ParallelWrapper):
         for (name, partner), rng in zip(self.partners.items(), rngs):
             partner.reset(inner, name, rng)
         self._partner_obs = {a: obs[a] for a in self.partners if a in obs}
-        return self._split(obs), self._split(infos)
+        infos = self._split(infos)
+        if not getattr(self.env.unwrapped, "info_text", True):
+            infos = self._with_partner_rewards(infos, {})
+        return self._split(obs), infos
 
     def step(self, actions: Mapping[str, Any]):
         if not isinstance(actions, Mapping):
@@ -101,9 +120,6 @@ class ScriptedPartners(ParallelWrapper):
                 full[name] = partner.act(inner, name, self._partner_obs.get(name))
         obs, rewards, terms, truncs, infos = self.env.step(full)
         self._partner_obs = {a: obs[a] for a in self.partners if a in obs}
-        partner_rewards = {a: float(rewards[a]) for a in self.partners if a in rewards}
-        infos = self._split(infos)
-        for a in infos:
-            infos[a] = dict(infos[a], partner_rewards=partner_rewards)
+        infos = self._with_partner_rewards(self._split(infos), rewards)
         return (self._split(obs), self._split(rewards), self._split(terms), self._split(truncs),
                 infos)

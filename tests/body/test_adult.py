@@ -194,7 +194,7 @@ def test_an_adult_kneels_face_to_face_with_an_infant_in_free_play():
         zero[a] = {"motors": np.zeros(sp["motors"].shape, np.float32), "expression": 0}
     for _ in range(int(round(2.0 / env.dt))):
         _, _, _, _, infos = env.step(zero)
-        assert not any("instability" in i for i in infos.values())
+        assert not any(i["instability"] for i in infos.values())
 
 
 def test_an_env_with_an_adult_pickles_and_continues_exactly():
@@ -227,7 +227,7 @@ def test_the_adult_survives_bang_bang_actions():
             acts[a] = {"motors": rng.choice([-1.0, 1.0], n).astype(np.float32),
                        "expression": 0}
         _, _, _, _, infos = env.step(acts)
-        assert not any("instability" in i for i in infos.values())
+        assert not any(i["instability"] for i in infos.values())
 
 
 def figures(hands="mitten"):
@@ -275,7 +275,7 @@ def stress(hands="mitten", actuation="spring_damper", strength=1.0, posture="sta
     spring_damper 3 standing 50000``)."""
     env = free_play_v0.parallel_env(n_agents=1, body=body, hands=hands, actuation=actuation,
                                     strength=float(strength), posture=posture,
-                                    max_steps=int(steps))
+                                    max_steps=int(steps), info_text=True)   # the reasons
     env.reset(seed=int(seed))
     rng = np.random.default_rng(int(seed))
     m, d = env.world.model, env.world.data

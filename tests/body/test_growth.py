@@ -215,7 +215,7 @@ def test_every_age_holds_a_posture_and_plays_stably(age):
         env.action_space(a).seed(age)
     for _ in range(int(round(2.0 / env.dt))):
         _, _, _, _, infos = env.step(random_actions(env))
-        assert not any("instability" in i for i in infos.values())
+        assert not any(i["instability"] for i in infos.values())
 
 
 @pytest.mark.parametrize("hands, actuation", [
@@ -239,4 +239,4 @@ def test_newborn_at_full_strength_survives_bang_bang_actions(hands, actuation):
         u = u.astype(np.float32)
         action = {"motors": u, "expression": 0} if dict_space else u
         _, _, _, _, infos = env.step({agent: action})
-        assert "instability" not in infos[agent]
+        assert not infos[agent]["instability"]

@@ -51,7 +51,7 @@ def bang_bang(steps, seed=0, **settings):
             u = u.astype(np.float32)
             actions[agent] = {"motors": u, "expression": 0} if hasattr(space, "spaces") else u
         _, _, _, _, infos = env.step(actions)
-        if any("instability" in info for info in infos.values()):
+        if any(info["instability"] for info in infos.values()):
             flagged.append(step)
             env.reset(seed=seed + step + 1)
     return flagged

@@ -42,7 +42,7 @@ def step_checked(env, u, steps):
     act, d = env.actuation[0], env.world.data
     for _ in range(steps):
         _, _, _, _, infos = env.step({"infant_0": u})
-        assert "instability" not in infos["infant_0"], infos["infant_0"]["instability"]
+        assert not infos["infant_0"]["instability"], infos["infant_0"]["instability"]
         f = d.actuator_force[act.actuator_ids]
         assert np.all(f <= act.torque_pos + 1e-9) and np.all(f >= -act.torque_neg - 1e-9)
     return infos["infant_0"]

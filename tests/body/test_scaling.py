@@ -218,7 +218,7 @@ def test_free_play_with_a_larger_partner_is_stable_and_grounded(posture):
     z = zero_actions(env)
     for t in range(300):              # 2 s stepping, then 1 s more to settle: the unactuated
         _, _, term, trunc, infos = env.step(z)   # infants slump (a sitting one falls back onto
-        assert not any("instability" in infos[a] for a in infos)  # its hands, at every scale)
+        assert not any(infos[a]["instability"] for a in infos)  # its hands, at every scale)
         assert not any(term.values())
     assert np.isfinite(d.qpos).all() and np.abs(d.qvel).max() < 1.0  # at rest
     low = _support_below(m, d, big.geom_ids).min()
@@ -254,7 +254,7 @@ def test_five_fingers_muscle_scaled_body_steps_stably():
     start = w.data.xpos[w.agents[0].root_body].copy()
     for _ in range(200):
         _, _, _, _, infos = env.step({"infant_0": space.sample()})
-        assert "instability" not in infos["infant_0"]
+        assert not infos["infant_0"]["instability"]
     assert np.isfinite(w.data.qvel).all() and np.abs(w.data.qvel).max() < 50
     assert _support_below(w.model, w.data, w.agents[0].geom_ids).min() > -0.01
     assert np.linalg.norm(w.data.xpos[w.agents[0].root_body] - start) > 1e-3  # it moved
@@ -310,7 +310,7 @@ def test_mixed_bodies_build_and_step():
         sp[a].seed(k)
     for _ in range(50):
         obs, _, term, trunc, infos = env.step({a: sp[a].sample() for a in env.agents})
-        assert not any("instability" in infos[a] for a in infos)
+        assert not any(infos[a]["instability"] for a in infos)
         for a in obs:
             assert env.observation_space(a).contains(obs[a]), a
     assert all(trunc.values())

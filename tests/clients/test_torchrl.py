@@ -1,6 +1,9 @@
-"""TorchRL's PettingZooWrapper on every catalogue env: its infos become tensors, so it needs the
-same numeric info keys at reset and at every step (NumericInfos), and ``return_state=True`` reads
-``state_space`` as a space."""
+"""TorchRL's PettingZooWrapper on every catalogue env as made: its infos become tensors, so it
+needs the same numeric info keys at reset and at every step (the envs' default; the text infos
+are behind ``info_text=True``), and ``return_state=True`` reads ``state_space`` as a space.
+TorchRL's default grouping (by name: ``infant``, ``caregiver``) stacks a group's agents, so it
+needs the same spaces within a group: social touch's toucher (its right arm) and touched infant
+(its whole body) differ and take one group per agent."""
 
 import pytest
 
@@ -10,42 +13,60 @@ from mimo_social.core.wrappers import NumericInfos
 torchrl_pz = pytest.importorskip("torchrl.envs.libs.pettingzoo")
 from torchrl.envs.utils import check_env_specs  # noqa: E402
 
+#: envs whose agents of one name group have different spaces
+PER_AGENT_GROUPS = ("social_touch",)
 
-def _group_map(env):
-    """TorchRL's default (agents grouped by name: "infant") where every agent has the same
-    spaces; one group per agent where they differ (a toucher and a touched infant)."""
+
+def _group_map(entry):
+    """TorchRL's default (None: agents grouped by name) but where agents of one group differ."""
     from torchrl.envs.utils import MarlGroupMapType
-    first = env.possible_agents[0]
-    same = all(env.observation_space(a) == env.observation_space(first)
-               and env.action_space(a) == env.action_space(first) for a in env.possible_agents)
-    return None if same else MarlGroupMapType.ONE_GROUP_PER_AGENT
+    return MarlGroupMapType.ONE_GROUP_PER_AGENT if entry.name in PER_AGENT_GROUPS else None
 
 
 @pytest.mark.parametrize("entry", entries())
-def test_pettingzoo_wrapper_specs_and_rollout(entry):
-    numeric = NumericInfos(parallel(entry), strict=True)
-    env = torchrl_pz.PettingZooWrapper(numeric, return_state=True, use_mask=True,
-                                       group_map=_group_map(numeric))
+def test_pettingzoo_wrapper_specs_and_rollout_on_the_env_as_made(entry):
+    made = parallel(entry)
+    env = torchrl_pz.PettingZooWrapper(made, return_state=True, use_mask=True,
+                                       group_map=_group_map(entry))
     check_env_specs(env, seed=0)
     rollout = env.rollout(SHORT + 3, break_when_any_done=False)
     assert rollout["state"].shape[-1] == env.state_space.shape[0]
-    group = next(iter(env.group_map))
-    info = rollout["next", group, "info"]
-    assert "step" in info.keys() and "instability" in info.keys()
+    for group, agents in env.group_map.items():
+        info = rollout["next", group, "info"]
+        assert set(info.keys()) == set(made.info_keys(agents[0]))
+        assert "step" in info.keys() and "instability" in info.keys()
     env.close()
 
 
-def test_plain_infos_are_not_tensor_friendly_numeric_ones_are():
-    """Without NumericInfos TorchRL cannot build the env (strings in infos); with it, the
-    task's keys are there at reset too."""
+def test_the_default_grouping_separates_only_agents_whose_spaces_differ():
+    """Every env but social touch: agents of one name group have the same spaces, so TorchRL's
+    default grouping stacks them."""
+    for e in entries():
+        entry = e.values[0]
+        env = parallel(entry)
+        by_group = {}
+        for a in env.possible_agents:
+            by_group.setdefault(a.rsplit("_", 1)[0], []).append(a)
+        same = all(env.observation_space(a) == env.observation_space(g[0])
+                   and env.action_space(a) == env.action_space(g[0])
+                   for g in by_group.values() for a in g)
+        assert same == (entry.name not in PER_AGENT_GROUPS), entry.name
+        env.close()
+
+
+def test_text_infos_are_behind_an_option():
+    """``info_text=True``: strings and dicts in infos, which TorchRL cannot make tensors of;
+    the env as made (and NumericInfos over the text env) can."""
     from mimo_social.envs import selfbody_v0
     with pytest.raises(Exception):
-        torchrl_pz.PettingZooWrapper(selfbody_v0.parallel_env(max_steps=SHORT))
-    env = torchrl_pz.PettingZooWrapper(NumericInfos(selfbody_v0.parallel_env(max_steps=SHORT)))
-    td = env.reset(seed=0)
-    info = td["infant", "info"] if ("infant", "info") in td.keys(True) else \
-        td[next(iter(env.group_map)), "info"]
-    assert {"is_success", "distance", "target_part", "touch/parts"} <= set(info.keys())
+        torchrl_pz.PettingZooWrapper(selfbody_v0.parallel_env(max_steps=SHORT, info_text=True))
+    for made in (selfbody_v0.parallel_env(max_steps=SHORT),
+                 NumericInfos(selfbody_v0.parallel_env(max_steps=SHORT, info_text=True))):
+        env = torchrl_pz.PettingZooWrapper(made)
+        td = env.reset(seed=0)
+        info = td[next(iter(env.group_map)), "info"]
+        assert {"is_success", "distance", "target_part", "touch/parts"} <= set(info.keys())
+        env.close()
 
 
 # -- NumericInfos itself --------------------------------------------------------------------------
@@ -110,9 +131,9 @@ def test_numeric_infos_extra_keys_flatten_a_nested_dict():
 
 def test_numeric_infos_keep_scripted_partners_rewards():
     """A scripted-partner env declares ``partner_rewards`` itself: the numeric view carries the
-    partner's reward of each step (0 at reset), equal to the plain info's."""
+    partner's reward of each step (0 at reset), equal to the text info's."""
     from mimo_social.envs import high_five_v0
-    plain = high_five_v0.scripted_env()
+    plain = high_five_v0.scripted_env(info_text=True)
     numeric = NumericInfos(high_five_v0.scripted_env())
     (learner,) = plain.possible_agents
     _, info = numeric.reset(seed=3)

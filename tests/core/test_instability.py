@@ -18,6 +18,11 @@ from mimo_social.envs import free_play_v0
 OBS_BOUND = 1e5
 
 
+def free_play_text(**kwargs):
+    """Free play with text infos: an instability's reason."""
+    return free_play_v0.parallel_env(info_text=True, **kwargs)
+
+
 def bang_bang(env, rng):
     """Every motor at its lowest or highest command, drawn anew each step."""
     actions = {}
@@ -61,7 +66,7 @@ def run_bang_bang(env, steps: int, seed: int) -> tuple[int, float]:
 def test_a_speed_past_the_limit_is_flagged_in_the_same_step():
     """5 km/s is far beyond any body part's speed yet far below MuJoCo's own check (1e10): it
     used to run on unflagged."""
-    env = free_play_v0.parallel_env(n_agents=2, expressions=False)
+    env = free_play_text(n_agents=2, expressions=False)
     env.reset(seed=0)
     w = env.world
     dof = w.agents[0].free_dof                    # infant_0 flung along x
@@ -83,7 +88,7 @@ def test_a_speed_past_the_limit_is_flagged_in_the_same_step():
 def test_a_nan_is_flagged_and_the_world_restarts_from_its_initial_pose():
     """MuJoCo meets the NaN and resets the data to the model's default pose; the world goes on to
     its own initial pose (the posture the episode started in), and the next episode runs."""
-    env = free_play_v0.parallel_env(n_agents=1, expressions=False)
+    env = free_play_text(n_agents=1, expressions=False)
     env.reset(seed=0)
     w = env.world
     w.data.qvel[10] = np.nan
@@ -97,7 +102,7 @@ def test_a_nan_is_flagged_and_the_world_restarts_from_its_initial_pose():
 
 
 def test_instability_reads_the_state_without_changing_it():
-    env = free_play_v0.parallel_env(n_agents=1, expressions=False)
+    env = free_play_text(n_agents=1, expressions=False)
     env.reset(seed=0)
     w = env.world
     assert w.instability() is None
@@ -111,7 +116,7 @@ def test_a_diverging_solver_never_returns_huge_observations_unflagged():
     """Two solver iterations for a small five-fingered body (set in the compiled model: the
     config refuses fewer than 10): the simulation diverges again and again; every step either
     carries the flag or returns sane values."""
-    env = free_play_v0.parallel_env(n_agents=1, hands="five_fingers", scale=0.5, strength=3)
+    env = free_play_text(n_agents=1, hands="five_fingers", scale=0.5, strength=3)
     env.world.model.opt.iterations = 2
     flagged, top = run_bang_bang(env, steps=300, seed=0)
     assert flagged >= 3                        # it did diverge, more than once
@@ -122,7 +127,7 @@ def test_a_diverging_solver_never_returns_huge_observations_unflagged():
 def test_bang_bang_at_the_top_allowed_strength_does_not_diverge(scale):
     """The strongest allowed body, smallest and standard size, at the default physics: no
     instability and no huge value in 2000 bang-bang steps (strength 10 diverged every ~160)."""
-    env = free_play_v0.parallel_env(n_agents=1, strength=STRENGTH_RANGE[1], scale=scale)
+    env = free_play_text(n_agents=1, strength=STRENGTH_RANGE[1], scale=scale)
     flagged, top = run_bang_bang(env, steps=2000, seed=1)
     assert flagged == 0
     assert top <= OBS_BOUND

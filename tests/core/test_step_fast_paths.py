@@ -57,7 +57,8 @@ def test_a_float32_array_of_the_wrong_shape_is_refused():
 
 
 def _expr_env():
-    env = free_play_v0.parallel_env(n_agents=1, vision=False, touch=False, expressions=True)
+    env = free_play_v0.parallel_env(n_agents=1, vision=False, touch=False, expressions=True,
+                                    info_text=True)
     env.reset(seed=0)
     return env, np.zeros(env.action_space("infant_0")["motors"].shape[0], np.float32)
 

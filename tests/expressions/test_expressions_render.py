@@ -6,6 +6,8 @@ import pytest
 
 from mimo_social.envs import free_play_v0
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 
 def face_camera(env, i):
     d = env.world.data

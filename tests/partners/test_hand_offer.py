@@ -13,6 +13,11 @@ from mimo_social.tasks.handover.controller import ReceiveController, hand_frame,
 from mimo_social.tasks.reach.controller import ReachController
 
 
+def handover_text(*args, **kwargs):
+    """The handover's scripted env with text infos (the holder by name)."""
+    return handover_v0.scripted_env(*args, info_text=True, **kwargs)
+
+
 def _palm(env, i=1):
     w = env.unwrapped.world
     return w.data.site_xpos[w.agents[i].palm_sites[0]].copy()
@@ -94,7 +99,7 @@ def _finger_flexion(env):
 @pytest.mark.parametrize("delay", [0.0, 0.2])
 def test_fingers_open_after_the_partners_touch(delay):
     partner = HandOffer(target=OFFER_TARGET, release="on_touch", release_delay=delay)
-    env = handover_v0.scripted_env(partner, task_options={"end_on_success": False})
+    env = handover_text(partner, task_options={"end_on_success": False})
     env.reset(seed=0)
     closed = _finger_flexion(env)
     assert closed > np.deg2rad(30)                     # the grasp: fingers curled on the ball
@@ -113,7 +118,7 @@ def test_fingers_open_after_the_partners_touch(delay):
 
 def test_no_touch_no_release_and_the_ball_stays_held():
     partner = HandOffer(target=OFFER_TARGET, release="on_touch")
-    env = handover_v0.scripted_env(partner)
+    env = handover_text(partner)
     env.reset(seed=0)
     closed = _finger_flexion(env)
     idle = {"infant_0": zero_action(env.action_space("infant_0"))}
@@ -126,7 +131,7 @@ def test_no_touch_no_release_and_the_ball_stays_held():
 
 def test_without_release_the_grip_is_kept_after_a_touch():
     partner = HandOffer(target=OFFER_TARGET, release=None)
-    env = handover_v0.scripted_env(partner)
+    env = handover_text(partner)
     env.reset(seed=0)
     _take_touch(env)
     env.step({"infant_0": zero_action(env.action_space("infant_0"))})
@@ -184,7 +189,7 @@ def test_pour_tips_the_palm_toward_the_fingers_after_release():
     for pour in (0.0, 1.0):
         partner = HandOffer(target=OFFER_TARGET, release="on_touch", pour=pour,
                             withdraw=(0.0, 0.0))
-        env = handover_v0.scripted_env(partner, task_options={"end_on_success": False,
+        env = handover_text(partner, task_options={"end_on_success": False,
                                                               "drop_height": 0.0})
         env.reset(seed=0)
         _take_touch(env)
@@ -237,7 +242,7 @@ class _Hold(HandOffer):
 
 def _handover(receiver, steps, seed=0, **task):
     giver = scripted_giver()
-    env = handover_v0.scripted_env(giver, task_options={"end_on_success": False, **task})
+    env = handover_text(giver, task_options={"end_on_success": False, **task})
     env.reset(seed=seed)
     inner = env.unwrapped
     receiver.reset(inner, "infant_0", np.random.default_rng(seed))
@@ -294,7 +299,7 @@ def test_the_tip_needs_the_open_hand_held_there():
     # an open hand beside the giver's for 0.1 s only: no tip; held on: the palm tips
     receiver = _Hold((0.01, -0.055, -0.047), (-0.3, -0.1, 1.0))
     giver = scripted_giver()
-    env = handover_v0.scripted_env(giver)
+    env = handover_text(giver)
     env.reset(seed=0)
     inner = env.unwrapped
     receiver.reset(inner, "infant_0", None)

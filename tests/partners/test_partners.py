@@ -23,7 +23,7 @@ class Recording(Partner):
 
 def test_only_learners_are_exposed_and_partner_acts():
     partner = Recording()
-    env = ScriptedPartners(high_five_v0.parallel_env(), {"infant_1": partner})
+    env = ScriptedPartners(high_five_v0.parallel_env(info_text=True), {"infant_1": partner})
     assert env.possible_agents == ["infant_0"]
     obs, infos = env.reset(seed=3)
     assert set(obs) == {"infant_0"} and set(infos) == {"infant_0"}

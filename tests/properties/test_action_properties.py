@@ -50,6 +50,7 @@ ENVS = [e.name for e in CATALOG] + ["mirror_8x8_eyes"]
 
 
 def make_env(name: str, **kwargs):
+    kwargs = {"info_text": True, **kwargs}   # the checks read the text infos
     if name == "mirror_8x8_eyes":
         return entry("mirror").parallel_env(vision={"width": 8, "height": 8}, **kwargs)
     return entry(name).parallel_env(vision=False, **kwargs)

@@ -152,7 +152,7 @@ def op_step(m: Model, seed):
     assert env.agents == [a for a in alive if not (term[a] or trunc[a])]
     if env.steps >= MAX_STEPS:
         assert env.agents == []
-    if not any("instability" in i for i in infos.values()):
+    if not any(i["instability"] for i in infos.values()):
         assert_finite(obs, env)
 
 

@@ -19,6 +19,8 @@ from mimo_social.scenery.playroom import ROOM_HALF, WALL_HEIGHT
 from mimo_social.scenery.toys import TOYS
 from mimo_social.util.checks import ConfigError
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 ADULT = [{}, {"body": "adult", "posture": "kneeling"}]
 
 

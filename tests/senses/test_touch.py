@@ -26,6 +26,8 @@ from mimo_social.senses import skin as skin_module
 from mimo_social.senses.touch import save_skin_png
 from mimo_social.senses.contact_forces import contact_forces
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 G = 9.81
 # right arm forward, palm up (deg), sitting
 PALM_UP = {"right_shoulder_horizontal": -26.0, "right_shoulder_abduction": -29.0,

@@ -11,6 +11,8 @@ from mimo_social.tasks.handover.controller import ARM, ReceiveController, hand_f
 from mimo_social.partners import ScriptedPartners, zero_action
 from mimo_social.partners.hand_offer import HandOffer
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 RECEIVER_TARGET = (0.10, 0.0, -0.12)   # a palm-up hand in front of the receiver, clear of the giver
 
 

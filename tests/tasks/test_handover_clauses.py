@@ -22,6 +22,8 @@ from mimo_social.tasks.handover import OFFER_TARGET, OpenPalm, ReceiveController
 from mimo_social.tasks.handover.controller import ARM, hand_frame, palm_posture
 from test_receive_controller import episode  # this folder is on the path (rootdir-less tests)
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 HOLD = 30                       # hold_time 0.3 s at the default control step (0.01 s)
 
 

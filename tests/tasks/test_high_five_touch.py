@@ -14,6 +14,8 @@ from mimo_social.tasks.high_five.controller import ArmSweep, HighFiveController
 from mimo_social.tasks.high_five.task import OFFER_AT
 from learner_episodes import learner_episode  # this folder is on the path (rootdir-less)
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 HAND = {"right_hand", "right_fingers"}
 CLOSE = 0.35  # m between the infants in tests that put the hands together by hand
 

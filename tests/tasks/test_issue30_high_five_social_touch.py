@@ -26,6 +26,8 @@ from mimo_social.tasks.high_five.controller import palm_depth, palm_posture
 from mimo_social.tasks.social_touch import SocialTouchController
 from learner_episodes import learner_episode  # this folder is on the path (rootdir-less)
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 SEEDS = range(1000, 1030)
 UP = np.array([0.0, 0.0, 1.0])
 MEET = np.array([0.19, 0.0, 0.55])   # where the hands are put together (world, m)

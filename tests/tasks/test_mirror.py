@@ -13,6 +13,8 @@ from mimo_social.partners import Partner
 from mimo_social.partners.expression import ExpressionShow
 from mimo_social.tasks.mirror.controller import MirrorController
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 NO_MOTORS = np.zeros(0, np.float32)
 
 

@@ -12,6 +12,8 @@ from mimo_social.tasks.handover.controller import (ARM, CupAndLeave, OpenPalm, R
                                                       hand_frame, palm_posture)
 from mimo_social.tasks.handover import HandoverOptions, scripted_giver
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 SEEDS = range(1000, 1030)
 
 

@@ -10,6 +10,8 @@ from mimo_social.envs.task_docs import parse_docstring
 from mimo_social.tasks import selfbody
 from mimo_social.tasks.selfbody import task
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 A = "infant_0"
 
 

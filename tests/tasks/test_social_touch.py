@@ -9,6 +9,8 @@ from mimo_social.partners import Still
 from mimo_social.tasks.social_touch.controller import hand_posture, reach_posture
 from mimo_social.tasks.social_touch import task as social_touch
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 #: the first versions' start: no random arm postures, the distance as given (tests that build
 #: a touch by IK from the start posture)
 FIXED_START = {"start_spread": 0.0, "partner_spread": 0.0, "distance_spread": 0.0}

@@ -55,6 +55,9 @@ import numpy as np
 
 from mimo_social.core.kinematics import hand_geoms
 from mimo_social.envs import catch_v0, selfbody_v0, standup_v0
+import pytest
+
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
 
 A = "infant_0"
 

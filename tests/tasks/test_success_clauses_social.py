@@ -100,6 +100,8 @@ from mimo_social.tasks.imitation.demonstrator import PoseScript
 from mimo_social.tasks.imitation.task import PUSH, RAISE_MARGIN
 from mimo_social.tasks.social_touch.controller import reach_posture
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 HAPPY = EXPRESSIONS.index("happy")
 NO_EYES = [{"vision": False}, {}]        # no policy here reads the learner's eyes
 FIXED_START = {"start_spread": 0.0, "partner_spread": 0.0, "distance_spread": 0.0}

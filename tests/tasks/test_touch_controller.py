@@ -12,6 +12,8 @@ from mimo_social.tasks.social_touch.controller import (
 )
 from mimo_social.tasks.social_touch import task as social_touch
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 
 def _episode(policy, seed, **kwargs):
     """One episode of the scripted env (``Still`` partner) with ``policy`` acting for infant_0
