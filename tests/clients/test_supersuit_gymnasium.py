@@ -4,7 +4,9 @@ env checker (render check included) on the Gymnasium ids.
 ``normalize_obs_v0`` needs a Box observation with finite bounds: flatten the Dict
 (FlattenParallel; eye pixels become [0, 1]) and keep the bounded parts of the senses (joint
 angles, limit sensors, the spring-damper state, eyes, task one-hots); velocities, torques,
-forces and accelerations have no bound, and an env with them is refused by SuperSuit."""
+forces and accelerations have no bound, and an env with them is refused by SuperSuit. Touch
+tasks cannot do without their skin's forces: their observations are normalised by the package's
+running normaliser instead."""
 
 import warnings
 
@@ -69,3 +71,34 @@ def test_gymnasium_env_checker_with_render(entry):
         check_env(env)
     assert env.render().shape == (24, 32, 3)
     env.close()
+
+
+def test_touch_forces_have_no_bound_so_normalise_with_running_norm():
+    """A touch task's skin forces are >= 0 with no upper bound (the force of a contact grows with
+    how hard it is pressed; MuJoCo's soft contacts set no maximum, and a made-up one would clip
+    real readings): SuperSuit's ``normalize_obs_v0`` needs finite bounds and refuses them. The
+    package's ``RunningNorm`` (running mean and variance, inside the policy) takes any Box."""
+    torch = pytest.importorskip("torch")
+    from mimo_social.train.obs_norm import RunningNorm
+    raw = high_five_v0.parallel_env(max_steps=SHORT, expressions=False)
+    touch = raw.observation_space("infant_0")["touch"]
+    assert np.all(touch.low == 0.0) and np.all(np.isinf(touch.high))
+    env = FlattenParallel(raw)
+    with pytest.raises(AssertionError, match="infinite bounds"):
+        ss.normalize_obs_v0(env)
+    rng = np.random.default_rng(0)
+    obs, _ = env.reset(seed=0)
+    rows = [obs["infant_0"]]
+    while env.agents:
+        actions = {a: rng.uniform(-1, 1, env.action_space(a).shape).astype(np.float32)
+                   for a in env.agents}
+        obs = env.step(actions)[0]
+        rows += [obs[a] for a in ("infant_0",) if a in obs]
+    batch = torch.as_tensor(np.stack(rows))
+    norm = RunningNorm(env.observation_space("infant_0"))
+    norm.train()
+    out = norm(batch)            # learns the batch's statistics, then normalises it
+    assert out.shape == batch.shape and torch.isfinite(out).all()
+    assert float(out.abs().max()) <= 10.0
+    varying = batch.std(0) > 1e-3
+    assert varying.any() and float(out[:, varying].mean(0).abs().max()) < 1e-3
