@@ -24,7 +24,8 @@ from .columns import SIM_TIME, STEP, entity
 from .contacts import CONTACTS_PATH
 from .eyes import EYES
 
-__all__ = ["CEILING_PATH", "blueprint", "scene_eye"]
+__all__ = ["CEILING_PATH", "EYE_AZIMUTHS", "EYE_ELEVATIONS", "blueprint", "face_visibility",
+           "scene_eye"]
 
 #: the play room's ceiling as the recorder logs it (a static geom of the world body)
 CEILING_PATH = entity("world", "scene", "playroom/ceiling")
@@ -134,14 +135,56 @@ def blueprint(agents: list[str], face_paths: list[str],
         collapse_panels=False)
 
 
+def face_visibility(heads: np.ndarray, faces: np.ndarray, position) -> np.ndarray:
+    """How much of each face a camera at ``position`` sees: the cosine of the angle between where
+    the face looks (``faces``, unit vectors) and the direction from its head (``heads``) to the
+    camera (1: face on, 0.7: three quarters, 0: profile, < 0: the back of the head)."""
+    to_camera = np.asarray(position, np.float64) - heads
+    to_camera /= np.linalg.norm(to_camera, axis=1, keepdims=True)
+    return np.einsum("ij,ij->i", faces, to_camera)
+
+
+#: the camera directions :func:`scene_eye` tries: azimuths and elevations (degrees, MuJoCo's)
+EYE_AZIMUTHS = np.arange(0.0, 360.0, 5.0)
+EYE_ELEVATIONS = np.arange(-15.0, -46.0, -5.0)
+
+
 def scene_eye(env) -> rrb.EyeControls3D | None:
-    """The 3D view's starting camera: the env's scene camera (which shows every agent)."""
+    """The 3D view's starting camera: it looks where the env's scene camera looks (which shows
+    every agent), from the direction (:data:`EYE_AZIMUTHS` x :data:`EYE_ELEVATIONS`) that shows
+    the agents' faces best at the recording's start (the largest :func:`face_visibility` of the
+    face seen least; inside the play room, at least 80 % of the scene camera's distance from
+    what it looks at, so that the scene still fits)."""
     scene_camera = getattr(env, "scene_camera", None)
     if scene_camera is None:
         return None
     cam = scene_camera()
-    az, el = np.deg2rad(cam.azimuth), np.deg2rad(cam.elevation)
-    forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
     look = np.array(cam.lookat, dtype=np.float64)
-    return rrb.EyeControls3D(position=look - cam.distance * forward, look_target=look,
+    world = getattr(env, "world", None)
+    best = (-np.inf, cam.azimuth, cam.elevation, cam.distance)
+    if world is not None and world.agents:
+        from ..scenery import inside_camera
+
+        d = world.data
+        sites = [a.head_site for a in world.agents]
+        heads = d.site_xpos[sites].astype(np.float64)
+        faces = d.site_xmat[sites].reshape(-1, 3, 3)[:, :, 0].astype(np.float64)
+        room = getattr(world, "room", None)
+        for az in EYE_AZIMUTHS:
+            for el in EYE_ELEVATIONS:
+                dist = cam.distance if room is None else inside_camera(
+                    room.centre, look, cam.distance, az, el)
+                if dist < 0.8 * cam.distance:
+                    continue
+                seen = face_visibility(heads, faces, look - dist * _forward(az, el)).min()
+                if seen > best[0] + 1e-9:
+                    best = (seen, az, el, dist)
+    _, az, el, dist = best
+    return rrb.EyeControls3D(position=look - dist * _forward(az, el), look_target=look,
                              eye_up=[0.0, 0.0, 1.0])
+
+
+def _forward(azimuth: float, elevation: float) -> np.ndarray:
+    """The direction a MuJoCo free camera at ``azimuth`` / ``elevation`` (degrees) looks."""
+    az, el = np.deg2rad(azimuth), np.deg2rad(elevation)
+    return np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])

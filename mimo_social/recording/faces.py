@@ -12,11 +12,29 @@ import numpy as np
 import pyarrow as pa
 import rerun as rr
 
-from ..expressions.faces import EXPRESSIONS, face_images
+from ..expressions.faces import EXPRESSIONS, SKIN_RGB, face_images
 from .columns import Rows, component_field, entity, index_fields
 from .geometry import RGB_ROLE
 
-__all__ = ["FaceLog"]
+__all__ = ["HEAD_SKIN_RGB", "HEAD_TEXTURE_SIZE", "FaceLog", "head_texture"]
+
+#: the skin of a head in the 3D view: warmer and darker than the face images' (the viewer's
+#: light washes a pale albedo out to grey), so that the face stands out from the room
+HEAD_SKIN_RGB = (222, 160, 118)
+#: the head textures' edge (pixels; at least): lines stay sharp on a head seen close up
+HEAD_TEXTURE_SIZE = 128
+#: how much stronger a feature (brow, lash line, mouth, cheek) departs from the skin on a head
+_HEAD_CONTRAST = 1.4
+
+
+def head_texture(face: np.ndarray) -> np.ndarray:
+    """A face image (H x W x 3 uint8, on :data:`~mimo_social.expressions.faces.SKIN_RGB`) as a
+    head's texture in the 3D view: the skin :data:`HEAD_SKIN_RGB`, every feature's departure
+    from the skin made stronger. The face images of the recording and the model's own texture
+    (what the agents' eyes see) are unchanged."""
+    departure = face[..., :3].astype(np.float64) - np.array(SKIN_RGB, np.float64)
+    out = np.array(HEAD_SKIN_RGB, np.float64) + _HEAD_CONTRAST * departure
+    return np.clip(np.round(out), 0, 255).astype(np.uint8)
 
 
 class FaceLog:
@@ -46,11 +64,12 @@ class FaceLog:
         The values of each component are stacked over the expressions (row e: expression e).
         """
         images = face_images(face_size)
+        textures = [head_texture(img) for img in face_images(max(face_size, HEAD_TEXTURE_SIZE))]
         per_expression = {
             "expression": [rr.TextLog(name) for name in EXPRESSIONS],
             "face": [rr.Image(img) for img in images],
             "texture": [rr.Mesh3D(vertex_positions=np.zeros((1, 3), np.float32), albedo_texture=img)
-                        for img in images]}
+                        for img in textures]}
         stacked: dict[str, list] = {}
         for kind, archetypes in per_expression.items():
             batches = [a.as_component_batches() for a in archetypes]

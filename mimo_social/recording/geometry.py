@@ -16,6 +16,8 @@ import rerun as rr
 from .columns import entity
 
 __all__ = [
+    "EYE_PARTS",
+    "EYE_SCALE",
     "HIDDEN_GEOM_GROUP",
     "RGB_ROLE",
     "WXYZ_TO_XYZW",
@@ -31,6 +33,12 @@ __all__ = [
 HIDDEN_GEOM_GROUP = 3             # MuJoCo geom group left out of recordings (a user's hidden geoms)
 RGB_ROLE = int(mujoco.mjtTextureRole.mjTEXROLE_RGB)
 WXYZ_TO_XYZW = np.array([1, 2, 3, 0])  # MuJoCo: (w, x, y, z); Rerun: (x, y, z, w)
+
+#: the eyeballs (sclera, iris, pupil: geoms of an eye body, named ``<side>_eye[_part]``) are
+#: drawn this much larger than the model's, about their centre, so that where an agent looks
+#: shows at the 3D view's default zoom; the model, its physics and every eye's images keep them
+EYE_SCALE = 1.5
+EYE_PARTS = ("_eye", "_eye_iris", "_eye_pupil")
 
 _DEFAULT_GEOM_RGBA = (0.5, 0.5, 0.5, 1.0)   # a geom left at this colour shows its material's
 _PLANE_HALF_THICKNESS = 0.0025              # a plane becomes a thin box below z = 0 of its frame
@@ -73,8 +81,9 @@ def _rotate(quat_wxyz: np.ndarray, vec) -> np.ndarray:
     return out
 
 
-def geom_archetype(model: mujoco.MjModel, g: int, rgba=None) -> Any | None:
-    """A Rerun archetype drawing geom ``g`` in its body's frame (None for height fields, SDFs).
+def geom_archetype(model: mujoco.MjModel, g: int, rgba=None, scale: float = 1.0) -> Any | None:
+    """A Rerun archetype drawing geom ``g`` in its body's frame (None for height fields, SDFs),
+    ``scale`` times its size and its distance from the body's origin.
 
     Spheres and ellipsoids become Ellipsoids3D, boxes Boxes3D, capsules Capsules3D (which start
     at their translation and extend along +z), cylinders Cylinders3D, planes a thin box whose top
@@ -82,8 +91,8 @@ def geom_archetype(model: mujoco.MjModel, g: int, rgba=None) -> Any | None:
     vertices.
     """
     t = int(model.geom_type[g])
-    size = model.geom_size[g].astype(np.float64)
-    pos = model.geom_pos[g].astype(np.float64)
+    size = scale * model.geom_size[g].astype(np.float64)
+    pos = scale * model.geom_pos[g].astype(np.float64)
     q_wxyz = model.geom_quat[g].astype(np.float64)
     quat = rr.Quaternion(xyzw=q_wxyz[WXYZ_TO_XYZW])
     color = _to_rgba8(geom_rgba(model, g) if rgba is None else rgba)
@@ -214,6 +223,7 @@ def log_shapes(rec: rr.RecordingStream, world, bodies: Bodies,
             rec.log(entity("world", "scene", m.geom(g).name or f"geom_{g}"), shape, static=True)
     head_of = {int(a.head_geom): i for i, a in enumerate(world.agents)}
     head_paths: list[str | None] = [None] * len(world.agents)
+    agent_bodies = {int(b) for a in world.agents for b in a.body_ids}
     for b, path in zip(bodies.ids, bodies.paths):
         prefix = m.body(int(b)).name.split("/")[0] + "/"
         for g in bodies.geoms_of[int(b)]:
@@ -222,6 +232,8 @@ def log_shapes(rec: rr.RecordingStream, world, bodies: Bodies,
             if textured_heads and g in head_of and m.geom_type[g] == _G.mjGEOM_SPHERE:
                 shape = face_head_mesh(m, g)
                 head_paths[head_of[g]] = geom_path
+            elif name.endswith(EYE_PARTS) and int(b) in agent_bodies:
+                shape = geom_archetype(m, g, scale=EYE_SCALE)    # readable at the default zoom
             else:
                 shape = geom_archetype(m, g)
             if shape is not None:
