@@ -135,12 +135,13 @@ def save_hand_ball_png(path, steps: int = 100) -> str:
     side = d.xmat[m.site_bodyid[w.agents[0].palm_sites[0]]].reshape(3, 3)[:, 0]
     fig = plt.figure(figsize=(8.0, 6.5), dpi=120)
     ax = fig.add_subplot(projection="3d")
+    ax.computed_zorder = False        # drawn in order: the solids, then the skin points on them
     for part, colour in zip(parts, ("#e8c4a8", "#f0c8a8", "#f4d0b0")):
         body = m.body(f"{w.names[0]}/{part}").id
         tris = np.concatenate([geom_triangles(m, d, g) for g in range(m.ngeom)
                                if m.geom_bodyid[g] == body])
         ax.add_collection3d(Poly3DCollection(tris, facecolor=colour, edgecolor="none",
-                                             alpha=0.35))
+                                             alpha=0.3))
         centre = tris.reshape(-1, 3).mean(0)
         ax.text(*centre, part.replace("right_", "right ").replace("_", " "), fontsize=8,
                 color="0.25", zorder=10)
