@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Install everything mimo_social needs on a fresh Debian/Ubuntu machine with Python >= 3.11:
 # Mesa's headless OpenGL (EGL, OSMesa) for rendering, the CPU build of torch, and the package
-# with its training and development extras. Safe to run again.
+# with its training, development and documentation extras. Safe to run again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,6 +26,6 @@ if ! $PY -c "import torch" >/dev/null 2>&1; then
   echo "[setup] installing torch==2.13.0 (CPU build)"
   $PY -m pip install -q "torch==2.13.0"
 fi
-echo "[setup] installing mimo-social with its train and dev extras"
-$PY -m pip install -q -e ".[train,dev]"
+echo "[setup] installing mimo-social with its train, dev and docs extras"
+$PY -m pip install -q -e ".[train,dev,docs]"
 echo "[setup] done"

@@ -83,7 +83,8 @@ task holds (at `/plots/<name>/<agent>`) and its Rerun layout shows, one view eac
 OUTRO = """\
 ## Training and evaluation
 
-```
+<!-- not run: trains policies for 300k and 60k steps (the baselines below were measured so) -->
+```bash
 mimo-social train --task reach --algo ppo --steps 300000 --seed 0 --out runs/reach_ppo
 mimo-social eval runs/reach_ppo --episodes 100
 mimo-social eval runs/reach_ppo --episodes 2 --record reach.rrd --frames frames/

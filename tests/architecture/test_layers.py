@@ -193,7 +193,8 @@ def test_tasks_and_partners_use_the_public_env_view():
 def test_tests_mirror_the_package():
     """Each folder of tests/ is a unit of the package, or one of the suites that span them."""
     tests = Path(__file__).resolve().parents[1]
-    spanning = {"architecture", "conformance", "properties", "clients", "data", "__pycache__"}
+    spanning = {"architecture", "conformance", "properties", "clients", "data", "docs",
+                "__pycache__"}
     folders = {p.name for p in tests.iterdir() if p.is_dir()} - spanning
     assert folders <= set(LAYERS), f"test folders that are no unit: {sorted(folders - set(LAYERS))}"
     loose = sorted(p.name for p in tests.glob("test_*.py"))
