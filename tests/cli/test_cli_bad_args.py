@@ -100,6 +100,7 @@ BAD = [
     (["figure", "skin-hand-ball", "{file}/x.png"], "OUT.png"),
     (["docs", "--out", "{file}/tasks.md"], "--out"),
     (["docs", "--out", "{dir}"], "--out"),
+    (["docs", "--config-out", "{dir}"], "--config-out"),
     (["paradigm", "mirror"], "task"),
     (["paradigm", "still_face", "--episodes", "0"], "--episodes"),
     (["paradigm", "still_face", "--seed", "-1"], "--seed"),
