@@ -230,14 +230,14 @@ def save_partner_gaze_png(path, eye_size: int = 96, seconds: float = 0.4) -> str
         learner, partner = env.agents
         zero = np.zeros(env.action_space(partner).shape, np.float32)
         turn = zero.copy()
-        turn[[3, 6]], turn[[4, 7]] = h, v          # both eyes: horizontal, vertical
+        # both eyes the same way: a horizontal motor turns its eye outward at +1 (the right eye
+        # to the right, the left eye to the left), a vertical one up
+        turn[[3, 6]], turn[[4, 7]] = (-h, h), v
         steps = max(1, round(seconds / env.dt))
         for _ in range(steps):
             obs, *_ = env.step({learner: zero, partner: turn})
         w = env.world
-        names = list(w.agents[1].joint_names)
-        q = [np.degrees(w.data.qpos[w.agents[1].qpos_adr[names.index(f"left_eye_{k}")]])
-             for k in ("horizontal", "vertical")]
+        across, up = _gaze_angles(w, 1)
         face = env.render_rgb(_face_camera(w, 1, 0.3))
         eye = obs[learner]["eye_left"]
         r, c = _pixel_of(w, int(w.agents[0].eye_cameras[1]), w.data.site_xpos[
@@ -248,8 +248,8 @@ def save_partner_gaze_png(path, eye_size: int = 96, seconds: float = 0.4) -> str
         crop = eye[r0:r0 + 2 * half, c0:c0 + 2 * half].repeat(4, 0).repeat(4, 1)
         env.close()
         axes[0, col].imshow(face)
-        _bare(axes[0, col], f"eyes {label}\n(left eye {q[0]:+.0f}\u00b0 across, "
-                            f"{q[1]:+.0f}\u00b0 up)",
+        _bare(axes[0, col], f"eyes {label}\n(gaze {across:+.0f}\u00b0 to its left, "
+                            f"{up:+.0f}\u00b0 up)",
               "the partner's face\n(render, 0.3 m in front)" if col == 0 else None)
         axes[1, col].imshow(crop, interpolation="nearest")
         _bare(axes[1, col], None, (f"in the learner's left eye\n({eye_size}x{eye_size}; "
@@ -260,6 +260,18 @@ def save_partner_gaze_png(path, eye_size: int = 96, seconds: float = 0.4) -> str
     fig.savefig(path)
     plt.close(fig)
     return str(path)
+
+
+def _gaze_angles(world, i: int) -> tuple[float, float]:
+    """Where agent ``i``'s eyes look, in its head's frame: degrees to its left and up (the mean
+    of its two eyes' lines of sight)."""
+    m, d = world.model, world.data
+    prefix = world.names[i]
+    gaze = sum(d.xmat[m.body(f"{prefix}/{side}_eye").id].reshape(3, 3)[:, 0]
+               for side in ("right", "left"))
+    head = d.site_xmat[world.agents[i].head_site].reshape(3, 3)
+    x, y, z = gaze @ head
+    return float(np.degrees(np.arctan2(y, x))), float(np.degrees(np.arctan2(z, np.hypot(x, y))))
 
 
 def _pixel_of(world, cam: int, point, size: int) -> tuple[float, float]:
