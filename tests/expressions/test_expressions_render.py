@@ -6,8 +6,6 @@ import pytest
 
 from mimo_social.envs import free_play_v0
 
-pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
-
 
 def face_camera(env, i):
     d = env.world.data
@@ -25,7 +23,8 @@ def face_camera(env, i):
 
 @pytest.fixture(scope="module")
 def env():
-    e = free_play_v0.parallel_env(n_agents=2, render_mode="rgb_array", render_size=(96, 96))
+    e = free_play_v0.parallel_env(n_agents=2, render_mode="rgb_array", render_size=(96, 96),
+                                  info_text=True)   # the expressions by name
     e.reset(seed=0)
     yield e
     e.close()

@@ -11,6 +11,8 @@ from mimo_social.tasks.joint_attention.controller import GazeFollowController
 from mimo_social.partners.gaze import GazeAtTarget
 from mimo_social.train.envs import make_sb3_single
 
+pytestmark = pytest.mark.text_infos   # these tests read the text infos (info_text=True)
+
 STILL = np.zeros(9, np.float32)
 SHARED = {"two_learners": "shared"}
 
