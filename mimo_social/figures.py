@@ -15,9 +15,9 @@ from .body.joint_groups import held_posture
 from .core.world import AgentSetup, Prop
 from .tasks.free_play import FreePlay
 
-__all__ = ["GAZE_TURNS", "HOLD_BALL_ARM", "THREE_SIZES", "geom_triangles", "hand_ball_scene",
-           "save_expressions_png", "save_hand_ball_png", "save_partner_gaze_png",
-           "save_three_sizes_png", "FIGURES"]
+__all__ = ["GAZE_TURNS", "HOLD_BALL_ARM", "THREE_SIZES", "eye_turn", "geom_triangles",
+           "hand_ball_scene", "save_expressions_png", "save_hand_ball_png",
+           "save_partner_gaze_png", "save_three_sizes_png", "FIGURES"]
 
 
 # the right arm held forward, palm up, the hand tilted 12 degrees towards the fingertips
@@ -214,6 +214,17 @@ GAZE_TURNS = (("ahead", 0.0, 0.0), ("to its left", 1.0, 0.0), ("to its right", -
               ("up", 0.0, 1.0), ("down", 0.0, -1.0))
 
 
+def eye_turn(n_motors: int, left: float, up: float) -> np.ndarray:
+    """A head agent's motor action that turns both eyes the same way, ``left`` (to its left, -1:
+    to its right) and ``up`` (-1: down), in [-1, 1], every other motor at 0. A horizontal eye
+    motor turns its eye outward at +1 (the right eye to the right, the left eye to the left), so
+    the right eye's takes ``-left``; the head's motors are swivel, tilt, side tilt, then each
+    eye's horizontal, vertical and torsional ones (right eye first)."""
+    action = np.zeros(n_motors, np.float32)
+    action[[3, 6]], action[[4, 7]] = (-left, left), up
+    return action
+
+
 def save_partner_gaze_png(path, eye_size: int = 96, seconds: float = 0.4) -> str:
     """The joint-attention partner (``infant_1``) turns only its eyes (its eye motors at +-1 for
     ``seconds``; head and learner still): top, its face from 0.3 m in front; bottom, the same
@@ -229,10 +240,7 @@ def save_partner_gaze_png(path, eye_size: int = 96, seconds: float = 0.4) -> str
         env.reset(seed=0)
         learner, partner = env.agents
         zero = np.zeros(env.action_space(partner).shape, np.float32)
-        turn = zero.copy()
-        # both eyes the same way: a horizontal motor turns its eye outward at +1 (the right eye
-        # to the right, the left eye to the left), a vertical one up
-        turn[[3, 6]], turn[[4, 7]] = (-h, h), v
+        turn = eye_turn(len(zero), h, v)
         steps = max(1, round(seconds / env.dt))
         for _ in range(steps):
             obs, *_ = env.step({learner: zero, partner: turn})

@@ -46,3 +46,25 @@ def test_a_figure_is_written(name, tmp_path, capsys):
     img = np.asarray(Image.open(out).convert("RGB"))
     assert img.shape[0] > 200 and img.shape[1] > 1000
     assert (img.min(axis=2) < 60).mean() > 0.005          # dark text and lines, not blank
+
+
+@pytest.mark.parametrize("left, up", [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0)])
+def test_the_partners_eyes_turn_together(left, up):
+    """The gaze figure's turn moves both eyes the same way (a horizontal eye motor at +1 turns
+    its eye outward, so one sign for both eyes made them diverge or converge)."""
+    from mimo_social.envs import joint_attention_v0
+
+    env = joint_attention_v0.parallel_env()
+    env.reset(seed=0)
+    learner, partner = env.agents
+    still = np.zeros(env.action_space(partner).shape, np.float32)
+    turn = figures.eye_turn(len(still), left, up)
+    for _ in range(40):
+        env.step({learner: still, partner: turn})
+    w = env.world
+    head = w.data.site_xmat[w.agents[1].head_site].reshape(3, 3)
+    for side in ("right", "left"):
+        gaze = w.data.xmat[w.model.body(f"{w.names[1]}/{side}_eye").id].reshape(3, 3)[:, 0]
+        assert gaze @ head[:, 1] == pytest.approx(0.7 * left, abs=0.1), side    # to its left
+        assert gaze @ head[:, 2] == pytest.approx(0.5 * up, abs=0.1), side      # up
+    env.close()
