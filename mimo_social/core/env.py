@@ -269,6 +269,7 @@ class MimoParallelEnv(ParallelEnv):
             self._bind_task()
         self.task.reset(self, self._rng)
         mujoco.mj_forward(w.model, w.data)
+        check_start_poses(w, w.data, "after reset")   # a task placed agents inside each other
         fill_sensor_history(w.model, w.data, w.delayed_sensors)   # delayed vestibular sensors
         for system in self.systems.values():
             system.reset(w.model, w.data)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any, Callable, ClassVar, Mapping, Sequence
 
+import mujoco
 import numpy as np
 from gymnasium import spaces
 
@@ -19,13 +20,13 @@ from .config import AgentConfig
 from .world import AgentSetup, Prop
 
 __all__ = ["Task", "TaskOptions", "Plot", "REWARD", "agent_user_settings", "check_start_poses",
-           "OVERLAP_DEPTH", "TRUNK_PARTS"]
+           "deepest_overlap", "OVERLAP_DEPTH"]
 
-#: m: how deep the trunks (:data:`TRUNK_PARTS`) of two agents may interpenetrate in their start
-#: poses; deeper: a ConfigError (agents placed inside each other; MuJoCo would push them apart
-#: violently at the first step). Crossing limbs are allowed (a pair made touching on purpose).
+#: m: how deep any part of one agent may be inside any part of another when the env is made and
+#: after every reset; deeper: a ConfigError (agents placed inside each other: MuJoCo pushes them
+#: apart violently at the first step, and a head inside a thigh or crossed limbs are no start).
+#: Contacts' own softness (millimetres) and a touch placed on purpose stay within it.
 OVERLAP_DEPTH = 0.01
-TRUNK_PARTS = ("hip", "lower_body", "upper_body", "head")
 
 #: what a hook's ``env`` is: the :class:`~mimo_social.core.env.MimoParallelEnv` running the task
 #: (its public view: ``world``, ``systems``, ``system(name)``, ``actuation``, ``controls``,
@@ -195,41 +196,64 @@ def _xy(p) -> str:
     return f"({p[0]:.3g}, {p[1]:.3g})"
 
 
-def check_start_poses(world) -> None:
-    """A ConfigError naming both agents when the trunks (:data:`TRUNK_PARTS`) of two agents
-    interpenetrate in their start poses by more than :data:`OVERLAP_DEPTH` (placed inside each
-    other), and naming the agent when it was told to face its own position. Reads a scratch
-    copy of the world's state."""
+def deepest_overlap(world, data, depth: float = OVERLAP_DEPTH):
+    """The deepest interpenetration deeper than ``depth`` (m) between geoms of different agents
+    that collide (``contype`` or ``conaffinity`` set) in ``data``'s kinematics, as ``(depth, (i,
+    geom), (j, geom))`` with agent ``i < j``; None if there is none. MuJoCo's own distance
+    (``mj_geomDistance``) for the pairs whose bounding spheres overlap that deep: contacts alone
+    would miss two held bodies (both welded to the world, MuJoCo makes no contact between
+    them)."""
+    m = world.model
+    solid = (m.geom_contype | m.geom_conaffinity) != 0
+    geoms = [np.flatnonzero(solid & (world.geom_agent == i)) for i in range(len(world.agents))]
+    best = None
+    for i, gi in enumerate(geoms):
+        for j in range(i + 1, len(geoms)):
+            gj = geoms[j]
+            gap = (np.linalg.norm(data.geom_xpos[gi][:, None] - data.geom_xpos[gj][None], axis=2)
+                   - m.geom_rbound[gi][:, None] - m.geom_rbound[gj][None])
+            for p, q in zip(*np.nonzero(gap < -depth)):
+                dist = mujoco.mj_geomDistance(m, data, int(gi[p]), int(gj[q]), 0.0, None)
+                if -dist > depth and (best is None or -dist > best[0]):
+                    best = (-dist, (i, int(gi[p])), (j, int(gj[q])))
+    return best
+
+
+def _who(name: str, config) -> str:
+    age = "" if config.age_months is None else f", age_months={config.age_months:g}"
+    return (f"{name} (body={config.body!r}{age}, posture={config.posture!r}, "
+            f"scale={config.scale:g})")
+
+
+def check_start_poses(world, data=None, when: str = "at the start") -> None:
+    """A ConfigError naming both agents, the two body parts, how deep and where the agents
+    stand when any part of one agent is more than :data:`OVERLAP_DEPTH` inside any part of
+    another (:func:`deepest_overlap` in ``data``, e.g. right after a reset's ``mj_forward``,
+    else in a scratch copy of the world's start state); naming the agent when it was told to
+    face its own position. ``when`` says which state it was."""
     setups = world.agent_setups
-    for name, s in zip(world.names, setups):
-        if s.config.facing is not None and np.allclose(s.facing, s.position):
-            raise ConfigError(f"agent {name}: facing={_xy(s.facing)} is its own position; "
-                              "allowed: None or a point (x, y) other than where it stands")
+    if data is None:
+        for name, s in zip(world.names, setups):
+            if s.config.facing is not None and np.allclose(s.facing, s.position):
+                raise ConfigError(f"agent {name}: facing={_xy(s.facing)} is its own position; "
+                                  "allowed: None or a point (x, y) other than where it stands")
     if len(setups) < 2:
         return
-    m = world.model
-    d = world.scratch_contacts()
-    n = d.ncon
-    if not n:
+    d = world.scratch_contacts() if data is None else data
+    found = deepest_overlap(world, d)
+    if found is None:
         return
-    owner = np.full(m.ngeom, -1, dtype=np.intp)   # the agent of each trunk geom, else -1
-    for i, (name, a) in enumerate(zip(world.names, world.agents)):
-        trunk = {m.body(f"{name}/{part}").id for part in TRUNK_PARTS}
-        owner[[g for g in a.geom_ids if int(m.geom_bodyid[g]) in trunk]] = i
-    c = d.contact
-    a, b, depth = owner[c.geom1[:n]], owner[c.geom2[:n]], -c.dist[:n]
-    bad = np.flatnonzero((a >= 0) & (b >= 0) & (a != b) & (depth > OVERLAP_DEPTH))
-    if len(bad):
-        k = bad[np.argmax(depth[bad])]
-        i, j = sorted((int(a[k]), int(b[k])))
-        who = [f"{world.names[k]} (posture={setups[k].config.posture!r}, scale="
-               f"{setups[k].config.scale:g})" for k in (i, j)]
-        raise ConfigError(
-            f"agents {who[0]} and {who[1]} overlap: placed at "
-            f"{_xy(setups[i].position)} and {_xy(setups[j].position)} m, their trunks "
-            f"interpenetrate by {100 * depth[k]:.1f} cm at the start (allowed: at most "
-            f"{100 * OVERLAP_DEPTH:g} cm); place them farther apart (their position settings) "
-            "or leave position=None to the task")
+    depth, (i, gi), (j, gj) = found
+    m, names = world.model, world.names
+    part = [m.body(int(m.geom_bodyid[g])).name[len(names[x]) + 1:] for x, g in ((i, gi), (j, gj))]
+    where = [_xy(d.xpos[world.agents[x].root_body]) for x in (i, j)]
+    raise ConfigError(
+        f"agents {_who(names[i], setups[i].config)} and {_who(names[j], setups[j].config)} "
+        f"overlap: placed at {where[0]} and {where[1]} m, the {part[0]} of {names[i]} is "
+        f"{100 * depth:.1f} cm inside the {part[1]} of {names[j]} {when} (allowed: at most "
+        f"{100 * OVERLAP_DEPTH:g} cm, any two parts of different agents); place them farther "
+        "apart (their position settings, or the task's distance option) or leave position=None "
+        "to the task")
 
 
 class Task:

@@ -2,8 +2,10 @@
 
 The social tasks were tuned for two published 18-month-olds (``body="infant"``,
 ``age_months=None``, ``scale=1``) in the task's own posture; for such a pair every function here
-gives exactly what the tasks used before (same distance, same held angles). Any other pair (an
-adult caregiver, another age or scale, another posture) is measured in the compiled world:
+gives exactly what the tasks used before (same distance, same held angles), but where the two
+would start inside each other (the still face's sitting pair: moved from 0.6 to 0.696 m). Any
+other pair (an adult caregiver, another age or scale, another posture) is measured in the
+compiled world:
 
 - **distance**: the pair meets where the tuned pair meets (the task's meeting point, by
   default where the high five's scripted 18-month-old holds its palm for the other:
@@ -16,7 +18,10 @@ adult caregiver, another age or scale, another posture) is measured in the compi
   bodies' forward depths (plus :data:`CLEARANCE`), so no two bodies start inside each other
   (:func:`pair_distance`). Social touch, where
   one touches the other's body, keeps instead the floor between the two bodies' forward depths
-  as it is for two 18-month-olds (:func:`gap_distance`).
+  as it is for two 18-month-olds (:func:`gap_distance`). Either way the pair, placed in its held
+  postures on a measuring copy, is then moved apart until no part of one is inside any part of
+  the other (:func:`clear_distance`: forward depths alone miss a head over another's legs, or
+  feet of other sizes that meet instead of passing side by side).
 - **gaze**: where a task holds head and eyes looking "straight ahead at the partner", a pair of
   other bodies holds them at the angles that look at the partner's face (head centre), from
   :class:`~mimo_social.core.kinematics.LookAt` on a measuring copy of the pair.
@@ -43,12 +48,13 @@ from ..body.postures import posture_joints
 from ..body.tables import load_body
 from ..core.config import AgentConfig
 from ..core.kinematics import LookAt
+from ..core.task import deepest_overlap
 from ..core.world import AgentSetup, World
 from ..partners.offer_target import REACH_TO
 
 __all__ = ["CLEARANCE", "ADULT_LEAN_DEG", "LAWS", "Extent", "is_standard", "tables_of",
-           "held_angles", "measure", "pair_distance", "gap_distance", "facing_gaze", "DyadPlan",
-           "plan_dyad", "task_plan"]
+           "held_angles", "measure", "pair_distance", "gap_distance", "clear_distance",
+           "facing_gaze", "DyadPlan", "plan_dyad", "task_plan"]
 
 #: m: the least gap between the two bodies' forward depths when the distance is scaled
 CLEARANCE = 0.03
@@ -61,6 +67,11 @@ ADULT_LEAN_DEG = 15.0
 #: rounds of :func:`facing_gaze` (mirror, kneeling adult: the second round moves the head
 #: angles by up to 5 degrees, the third by 0.2, a fourth by 0.01)
 GAZE_ROUNDS = 3
+#: m: how much farther than the depth found :func:`clear_distance` moves a pair each round;
+#: and the rounds it takes at most (one or two suffice: the depth is measured along the contact
+#: normal, mostly along the line between the two)
+CLEAR_MARGIN = 0.005
+CLEAR_ROUNDS = 5
 #: words naming the leg joints (hip, knee, ankle, toes)
 LEG_WORDS = ("_hip_", "_knee", "_ankle_", "_toes")
 #: the distance laws of :func:`plan_dyad`
@@ -216,6 +227,33 @@ def gap_distance(distance: float, extents: Sequence[Extent], standard: Extent) -
     return float(distance - 2.0 * standard.front + sum(e.front for e in extents))
 
 
+def clear_distance(configs: Sequence[AgentConfig], frozen: Sequence[Mapping[str, float]],
+                   distance: float, slack: float = 0.0) -> float:
+    """``distance``, or more: what a pair face to face in its held postures (``frozen``) needs
+    for no part of one to be inside any part of the other when placed ``distance - slack``
+    apart (``slack``: how much closer a task may draw them at reset), measured on a copy of
+    the pair (:func:`~mimo_social.core.task.deepest_overlap`)."""
+    bodies = tuple((c.hands, c.body, c.age_months, c.scale, c.posture) for c in configs)
+    return _clear(bodies, tuple(_frozen_key(f) for f in frozen), round(float(distance), 9),
+                  round(float(slack), 9))
+
+
+@lru_cache(maxsize=64)
+def _clear(bodies, frozen_keys, distance, slack) -> float:
+    for _ in range(CLEAR_ROUNDS):
+        d = distance - slack
+        w = World([AgentSetup(_measuring_config(AgentConfig(hands=h, body=b, age_months=a,
+                                                            scale=sc, posture=p)),
+                              (0.0, 0.0) if i == 0 else (d, 0.0),
+                              (d, 0.0) if i == 0 else (0.0, 0.0), dict(f), base="fixed")
+                   for i, ((h, b, a, sc, p), f) in enumerate(zip(bodies, frozen_keys))])
+        found = deepest_overlap(w, w.data, 0.0)
+        if found is None:
+            break
+        distance += found[0] + CLEAR_MARGIN
+    return float(distance)
+
+
 def facing_gaze(setups: Sequence[AgentSetup], which: Sequence[int]) -> list[dict]:
     """For agents ``which`` of a pair, the head and eye angles (joint -> rad) that look at the
     other's face (head centre), measured on a copy of the pair with those joints free; a few
@@ -260,16 +298,21 @@ class DyadPlan:
 
 def plan_dyad(configs: Sequence[AgentConfig], posture: str, distance: float,
               frozen_of: Callable[[int, AgentConfig], Mapping[str, float]],
-              look: Sequence[int] = (0, 1), meet=REACH_TO, law: str = "reach") -> DyadPlan:
+              look: Sequence[int] = (0, 1), meet=REACH_TO, law: str = "reach",
+              slack: float = 0.0) -> DyadPlan:
     """The placement of a pair in a task tuned for two standard bodies in ``posture`` at
     ``distance``: for a standard pair exactly that (no extra angles); else the scaled distance
     (:func:`pair_distance`) and, for agents ``look`` (whose head and eyes the task holds), the
-    angles that look at the partner's face. ``law``: ``"reach"`` (:func:`pair_distance`, where
-    ``meet`` is the meeting point) or ``"gap"`` (:func:`gap_distance`). ``frozen_of(i,
-    config)``: the task's held angles (joint -> rad) of agent ``i`` with that config."""
-    if all(is_standard(c, posture) for c in configs):
-        return DyadPlan(float(distance), ({}, {}), True)
+    angles that look at the partner's face. Either distance is moved out until the pair is
+    clear of each other even ``slack`` closer (:func:`clear_distance`). ``law``: ``"reach"``
+    (:func:`pair_distance`, where ``meet`` is the meeting point) or ``"gap"``
+    (:func:`gap_distance`). ``frozen_of(i, config)``: the task's held angles (joint -> rad) of
+    agent ``i`` with that config."""
     frozen = [frozen_of(i, c) for i, c in enumerate(configs)]
+    if all(is_standard(c, posture) for c in configs):
+        # as tuned, unless the two would start inside each other (the still face's two sitting
+        # infants at 0.6 m: feet 3.6 cm in each other)
+        return DyadPlan(clear_distance(configs, frozen, distance, slack), ({}, {}), True)
     ref = AgentConfig(hands=configs[0].hands, posture=posture)
     standard = measure(ref, frozen_of(0, ref))
     extents = [measure(c, f) for c, f in zip(configs, frozen)]
@@ -277,6 +320,7 @@ def plan_dyad(configs: Sequence[AgentConfig], posture: str, distance: float,
         raise ValueError(f"plan_dyad: law={law!r}; allowed: {list(LAWS)}")
     dist = pair_distance(distance, extents, standard, meet) if law == "reach" \
         else gap_distance(distance, extents, standard)
+    dist = clear_distance(configs, frozen, dist, slack)
     if not look:
         return DyadPlan(dist, ({}, {}))
     setups = [AgentSetup(c, (0.0, 0.0) if i == 0 else (dist, 0.0),
@@ -288,7 +332,8 @@ def plan_dyad(configs: Sequence[AgentConfig], posture: str, distance: float,
 
 def task_plan(task, posture: str, distance: float,
               frozen_of: Callable[[int, AgentConfig], Mapping[str, float]],
-              look: Sequence[int] = (0, 1), meet=REACH_TO, law: str = "reach") -> DyadPlan:
+              look: Sequence[int] = (0, 1), meet=REACH_TO, law: str = "reach",
+              slack: float = 0.0) -> DyadPlan:
     """:func:`plan_dyad` for a two-agent task's current ``task.configs`` (set by the env before
     it calls ``setup``), computed once per env; without two configs (a task's ``setup`` called
     alone), the standard plan."""
@@ -298,7 +343,7 @@ def task_plan(task, posture: str, distance: float,
     cached = _PLANS.get(task)
     if cached is not None and cached[0] is task.configs:
         return cached[1]
-    plan = plan_dyad(configs, posture, distance, frozen_of, look, meet, law)
+    plan = plan_dyad(configs, posture, distance, frozen_of, look, meet, law, slack)
     _PLANS[task] = (task.configs, plan)
     return plan
 

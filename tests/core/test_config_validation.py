@@ -95,12 +95,52 @@ def test_overlapping_agents_name_both():
         free_play_v0.parallel_env(n_agents=3, per_agent=[{"position": (-1, 0)},
                                                          {"position": (1, 0)},
                                                          {"position": (1.05, 0.02)}])
-    # limbs that cross (a pair made touching on purpose) are allowed; so is a bigger body that
-    # the task places (the task's circle grows with scale)
-    free_play_v0.parallel_env(posture="lying",
-                              per_agent=[{"position": (0.0, -0.09), "facing": (1.0, -0.09)},
-                                         {"position": (0.0, 0.09), "facing": (-1.0, 0.09)}])
+    # a bigger body that the task places is fine (the task's circle grows with scale)
     free_play_v0.parallel_env(n_agents=4, scale=2.2)
+
+
+def _lying_pair(y):
+    return free_play_v0.parallel_env(
+        posture="lying", per_agent=[{"position": (0.0, -y), "facing": (1.0, -y)},
+                                    {"position": (0.0, y), "facing": (-1.0, y)}])
+
+
+def test_any_part_inside_another_agents_part_is_refused():
+    """Not only trunks: any part of one agent more than 1 cm inside any part of another (a
+    forearm in the other's thigh, toes in toes) is refused when the env is made, naming both
+    agents, both parts and the depth; a touch within 1 cm is fine."""
+    with pytest.raises(ConfigError, match=r"agents infant_0 \(body='infant', posture='lying'"
+                                          r".* and infant_1 .* overlap: placed at \(0, -0.09\) "
+                                          r"and \(0, 0.09\) m, the left_lower_arm of infant_0 is "
+                                          r"4.9 cm inside the left_upper_leg of infant_1 at the "
+                                          r"start \(allowed: at most 1 cm"):
+        _lying_pair(0.09)
+    _lying_pair(0.14)            # side by side, the fingertips within 1 cm: allowed
+    # two held bodies (hips fixed, every joint held: MuJoCo makes no contact between them, so
+    # a check of contacts alone misses them): the toes of two standing infants 0.22 m apart
+    with pytest.raises(ConfigError, match=r"the left_toes of infant_0 is 1.9 cm inside the "
+                                          r"right_toes of infant_1 at the start"):
+        entry("mirror").parallel_env(vision=False, per_agent=[{"position": (-0.11, 0.0)},
+                                                              {"position": (0.11, 0.0)}])
+
+
+def test_agents_a_task_places_inside_each_other_at_reset_are_refused():
+    """The check runs again after every reset (the task may place agents there): a task that
+    moves infant_1 onto infant_0 at reset gets a ConfigError naming both, 'after reset'."""
+    from mimo_social.core.env import MimoParallelEnv
+    from mimo_social.tasks.free_play import FreePlay
+
+    class Onto(FreePlay):
+        def reset(self, env, rng):
+            w = env.world
+            m, d = w.model, w.data
+            roots = [int(m.jnt_qposadr[m.body_jntadr[a.root_body]]) for a in w.agents]
+            d.qpos[roots[1]:roots[1] + 2] = d.qpos[roots[0]:roots[0] + 2] + (0.05, 0.0)
+
+    env = MimoParallelEnv(Onto(2))
+    with pytest.raises(ConfigError, match=r"agents infant_0 .* and infant_1 .* overlap: .* cm "
+                                          r"inside the .* after reset"):
+        env.reset(seed=0)
 
 
 def test_facing_its_own_position_is_an_error():

@@ -335,3 +335,52 @@ def test_the_infants_sit_apart_at_rest_over_the_distance_range(distance):
         for a in info:
             assert not any(e["agents"] for e in info[a]["touch"].values())
         assert info["infant_0"]["first_touch"] is None
+
+
+def _overlap_cm(world) -> float:
+    """The deepest interpenetration (cm) between geoms of the two agents that collide, by
+    MuJoCo's own distance (two held bodies make no contacts, so contacts would miss it)."""
+    m, d = world.model, world.data
+    solid = (m.geom_contype | m.geom_conaffinity) != 0
+    first, second = (np.flatnonzero(solid & (world.geom_agent == i)) for i in (0, 1))
+    worst = 0.0
+    for g in first:
+        for h in second:
+            if np.linalg.norm(d.geom_xpos[g] - d.geom_xpos[h]) < (m.geom_rbound[g]
+                                                                   + m.geom_rbound[h]):
+                dist = mujoco.mj_geomDistance(m, d, int(g), int(h), 0.0, None)
+                worst = max(worst, -100.0 * dist)
+    return worst
+
+
+@pytest.mark.parametrize("per_agent", [[{}, {"age_months": 6}], [{"age_months": 33}, {}],
+                                       [{"posture": "lying"}, {"body": "adult",
+                                                               "posture": "kneeling"}]])
+def test_other_bodies_start_clear_of_each_other(per_agent):
+    """Other bodies keep the floor between their forward depths as two 18-month-olds have it;
+    that left a 6-month-old partner's head 3.5 cm in the toucher's, a 33-month-old toucher's
+    feet 2.5 cm in the partner's, a lying toucher's feet 5 cm in the kneeling adult's thighs.
+    The pair is now moved apart until clear, even at the closest distance a reset draws: after
+    every reset nothing of one is inside the other (a touch within the check's 1 cm aside)."""
+    env = social_touch_v0.scripted_env(per_agent=per_agent)
+    for seed in range(6):
+        env.reset(seed=seed)
+        assert _overlap_cm(env.unwrapped.world) < 1.0, (per_agent, seed)
+    env.close()
+
+
+def test_the_scripted_toucher_touches_a_younger_partner():
+    """With the 6-month-old partner placed clear, the scripted toucher still touches its
+    target (seeds 0-1; 4 / 4 over seeds 0-3 when measured)."""
+    from mimo_social.tasks.social_touch import SocialTouchController
+    env = social_touch_v0.scripted_env(per_agent=[{}, {"age_months": 6}])
+    inner = env.unwrapped
+    for seed in range(2):
+        obs, _ = env.reset(seed=seed)
+        toucher = SocialTouchController()
+        toucher.reset(inner, "infant_0", np.random.default_rng(seed))
+        while env.agents:
+            obs, _, _, _, info = env.step({"infant_0": toucher.act(inner, "infant_0",
+                                                                   obs["infant_0"])})
+        assert info["infant_0"]["is_success"], (seed, info["infant_0"])
+    env.close()

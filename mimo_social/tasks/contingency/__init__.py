@@ -93,7 +93,7 @@ infos:
     learner's own gaze (held, `gaze_free=False`: always 1)
 options:
     `condition` ("live", "replay", "non_contingent"; "replay" when the env is made needs
-    `scripted_env(stream=...)`, else a ConfigError), `distance` (0.3 m, 0.22 to 2.0),
+    `scripted_env(stream=...)`, else a ConfigError), `distance` (0.3 m, 0.25 to 2.0),
     `response_delay_s` (0.5 s, 0 to 5), `response_probability` (0.8, 0 to 1), `response_duration_s`
     (1.0 s, 0.01 to 10), `timer_rate_hz` (0.5, 0 to 10: the non-contingent rate before any live
     episode), `window_s` (1.5 s, 0.05 to 10: the contingency index's window; keep it above the

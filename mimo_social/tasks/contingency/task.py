@@ -56,7 +56,7 @@ class ContingencyOptions(TaskOptions):
 
     def __post_init__(self):
         self._choice("condition", CONDITIONS)
-        self._number("distance", 0.22, 2.0)
+        self._number("distance", 0.25, 2.0)   # closer, two infants' toes overlap
         self._number("response_delay_s", 0.0, 5.0)
         self._number("response_probability", 0.0, 1.0)
         self._number("response_duration_s", 0.01, 10.0)

@@ -52,7 +52,7 @@ success:
 termination:
     none; truncation at 500 steps (5 s)
 options:
-    `distance` (0.6-1.5 m), `n_toys` (2-4), `margin_deg` (0-30), `shaping` (0-100, default 0.1),
+    `distance` (0.7-1.5 m), `n_toys` (2-4), `margin_deg` (0-30), `shaping` (0-100, default 0.1),
     `success_share` (0.05-1, 0.6), `partner_head_share` (0-1, 0.3), `partner_head_jitter` (0-0.5,
     0.3), `two_learners` ("leader" or "shared"), `min_separation_deg` (0-35), `head_support` (True),
     `scripted_partner` (False)

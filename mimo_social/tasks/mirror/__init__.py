@@ -51,7 +51,7 @@ infos:
     `match` (the faces are equal this step), `matched_steps` (so far this episode), `is_success`,
     `is_leader` (this agent's face is set by the task this episode)
 options:
-    `distance` (0.3 m, 0.22 to 2.0), `scripted_partner` (False), `assisted_gaze` (False), `roles`
+    `distance` (0.3 m, 0.25 to 2.0), `scripted_partner` (False), `assisted_gaze` (False), `roles`
     (`"leader"`, or `"free"`), `leader_hold_s` ((1.0, 2.0) s), `success_fraction` (0.8, 0.01 to 1)
 privileged cues:
     none by default: the partner's face reaches the learner only through its eyes, which look

@@ -28,7 +28,7 @@ N_FACES = len(EXPRESSIONS)
 
 @dataclass(frozen=True)
 class MirrorOptions(TaskOptions):
-    """Distance between the faces (m, from 0.22: closer and the faces touch), whether
+    """Distance between the faces (m, from 0.25: closer and the toes overlap), whether
     ``infant_1`` is a scripted partner (no eyes, no reward), whether the task aims head and eyes
     at the partner's face (``assisted_gaze``), the two learners' roles (``"leader"``: one agent's
     face is set by the task each episode, only the other is rewarded; ``"free"``: both act and
@@ -45,7 +45,7 @@ class MirrorOptions(TaskOptions):
     success_fraction: float = 0.8
 
     def __post_init__(self):
-        self._number("distance", 0.22, 2.0)
+        self._number("distance", 0.25, 2.0)   # closer, the toes overlap (1.9 cm at 0.22)
         self._bool("scripted_partner")
         self._bool("assisted_gaze")
         self._choice("roles", ROLES)

@@ -194,8 +194,11 @@ class SocialTouch(Task):
         # two 18-month-olds sit `distance` apart; other bodies keep the floor between their
         # forward depths as two 18-month-olds have it; a partner of another body turns its head
         # to the toucher's face (tasks/dyad.py)
-        plan = task_plan(self, "sitting", self.options.distance, self.held_joints, (TOUCHED,),
-                         law="gap")
+        # other bodies: clear of each other even at the closest distance a reset draws
+        o = self.options
+        slack = min(o.distance_spread, o.distance - DISTANCE_RANGE[0])
+        plan = task_plan(self, "sitting", o.distance, self.held_joints, (TOUCHED,), law="gap",
+                         slack=slack)
         dist = plan.distance
         pos = (0.0, 0.0) if i == TOUCHER else (dist, 0.0)
         facing = (dist, 0.0) if i == TOUCHER else (0.0, 0.0)

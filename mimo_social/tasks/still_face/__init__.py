@@ -15,9 +15,11 @@ body:
     Both have faces (expressions on). With `head_support` (on) the task cancels gravity on both
     agents' head and eye joints (neck tone: a zero action does not let the head drop)
 scene:
-    the pair face to face; two sitting 18-month-olds `distance` (0.6 m) apart, their feet just short
-    of each other (at 0.45 m the scripted infant's hands caught on the partner's toes on their way
-    to its chest); other bodies placed by measured reach (`tasks/dyad.py`): the kneeling adult's hip
+    the pair face to face; two sitting 18-month-olds `distance` (0.6 m) apart, or farther where
+    their feet would start inside each other (at 0.6 m a foot was 3.6 cm in the other's shin: they
+    sit 0.696 m apart, `tasks/dyad.py` `clear_distance`; at 0.45 m the scripted infant's hands
+    caught on the partner's toes on their way to its chest); other bodies placed by measured
+    reach (`tasks/dyad.py`): the kneeling adult's hip
     1.01 m from the infant's, at arm's length, its eyes (1.13 m high) 1.0 m from the sitting
     infant's (0.42 m high), 45 degrees above them; its head (0.18 m across) spans 10 degrees, 11
     pixels of a 64x64 eye (60 degree field; `per_agent=[{"vision": {"width": 128, "height": 128}},
