@@ -52,7 +52,7 @@ def test_flatten_parallel_passes_parallel_api_test():
 
 def test_flatten_parallel_observations_actions_and_passthrough():
     raw = high_five_v0.parallel_env()
-    env = FlattenParallel(high_five_v0.parallel_env())
+    env = FlattenParallel(high_five_v0.parallel_env(info_text=True))   # expressions by name
     raw_obs, _ = raw.reset(seed=5)
     obs, infos = env.reset(seed=5)
     assert env.agents == env.possible_agents == raw.possible_agents
