@@ -25,6 +25,7 @@ from ..senses.vestibular import VestibularConfig
 from ..senses.vision import VisionConfig
 from ..util.checks import (ConfigError, check_bool, check_choice, check_int, check_number,
                            check_numbers, show)
+from ..util.names import agent_names
 
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig", "AgentConfig",
@@ -191,7 +192,8 @@ def resolve_agents(n_agents: int, common: Mapping[str, Any],
             if not isinstance(per_agent[i], Mapping):
                 raise ConfigError(f"per_agent[{i}] must be a mapping, got {show(per_agent[i])}")
             settings.update(per_agent[i])
-        out.append(_agent_config(settings, f"agent infant_{i}"))
+        who = agent_names([c.body for c in out] + [settings.get("body")])[-1]
+        out.append(_agent_config(settings, f"agent {who}"))
     return out
 
 

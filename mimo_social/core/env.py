@@ -44,6 +44,7 @@ from ..render.scene import make_renderer
 from ..scenery import SCENES, check_scene_clear, inside_camera
 from ..senses import SENSES
 from ..util.checks import check_bool, check_choice, check_seed, number_array, show
+from ..util.names import reject_old_names
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
 from .delays import MotorDelay, SenseDelay, delay_steps, fill_sensor_history
 from .infos import InfoEncoder
@@ -252,6 +253,7 @@ class MimoParallelEnv(ParallelEnv):
 
     def _check_agent(self, agent):
         if agent not in self._index:
+            reject_old_names(agent, self.possible_agents)
             raise KeyError(f"unknown agent {agent!r}; agents of this env: {self.possible_agents}")
         return agent
 
@@ -380,6 +382,7 @@ class MimoParallelEnv(ParallelEnv):
             raise ValueError(f"actions must be a dict agent -> action, got {type(actions).__name__}")
         unknown = [a for a in actions if a not in self._index]
         if unknown:
+            reject_old_names(unknown, self.possible_agents)
             raise ValueError(f"actions for unknown agent(s) {unknown}; agents: {self.possible_agents}")
         missing = [a for a in self.agents if a not in actions]
         if missing:

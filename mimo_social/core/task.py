@@ -16,6 +16,7 @@ from gymnasium import spaces
 from ..util.checks import (ConfigError, check_bool, check_choice, check_int, check_number,
                            check_numbers)
 from ..body.tables import load_body
+from ..util.names import agent_names
 from .config import AgentConfig
 from .world import AgentSetup, Prop
 
@@ -284,6 +285,11 @@ class Task:
         self.configs: Sequence[AgentConfig] = ()  # every agent's config, set by the env
 
     # -- building ------------------------------------------------------------------------------
+    def agent_name(self, i: int) -> str:
+        """Agent i's name in the world being built (``infant_<j>`` or, for an adult,
+        ``caregiver_<j>``), from :attr:`configs`, for messages before the world exists."""
+        return agent_names([c.body for c in self.configs])[i]
+
     def agent_defaults(self, i: int, settings: Mapping[str, Any]) -> dict:
         """Default settings of agent i that this task wants; the user's settings override them.
 

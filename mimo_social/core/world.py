@@ -1,7 +1,8 @@
 """Compose N infants and a scene into one MuJoCo model, with integer index tables per agent.
 
 Each infant is built by :func:`mimo_social.body.builder.build_infant` with unprefixed names and
-attached with ``MjSpec.attach`` under the prefix ``infant_<i>/``. After compiling, every name an
+attached with ``MjSpec.attach`` under its agent's name as prefix (``infant_<i>/``, an adult
+``caregiver_<i>/``: :mod:`mimo_social.util.names`). After compiling, every name an
 agent needs is resolved to integer ids and address arrays (:class:`AgentIndex`); no string
 lookups or MuJoCo accessor views are kept, so a world pickles: its MjData travels whole, with its
 model (every model field a task wrote, every quantity of the last step), and the index tables
@@ -25,6 +26,7 @@ from ..body.postures import posture_joints, posture_pitch
 from ..expressions.switch import FaceTextures
 from ..scenery import SCENES, add_playroom, clear_toys
 from ..util.checks import check_choice
+from ..util.names import agent_names
 from .config import AgentConfig, PhysicsConfig
 from .delays import check_delay_steps, delay_sensors, fill_sensor_history
 
@@ -152,7 +154,8 @@ class World:
         self.agent_setups = tuple(agents)
         self.props = tuple(props)
         self.physics = physics
-        self.names = [f"infant_{i}" for i in range(len(agents))]
+        # infants infant_<i>, adults caregiver_<i>, each kind counted in world order
+        self.names = agent_names([s.config.body for s in agents])
         self._build()
 
     # -- pickling: the recipe rebuilds the index tables; MjData (with its model) travels whole --

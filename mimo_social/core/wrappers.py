@@ -52,6 +52,7 @@ from pettingzoo import ParallelEnv
 
 from ..util.checks import number_array
 from .infos import INFO_KINDS, InfoEncoder
+from ..util.names import reject_old_names
 
 __all__ = ["ParallelWrapper", "FlattenParallel", "NumericInfos", "INFO_KINDS", "FlatActionWrapper",
            "FlatObservationWrapper", "ExpressionActionWrapper", "is_expression_only",
@@ -402,6 +403,7 @@ class FlattenParallel(ParallelWrapper):
         try:
             return self._obs_spaces[agent]
         except KeyError:
+            reject_old_names(agent, self.possible_agents)
             raise KeyError(f"unknown agent {agent!r}; agents of this env: "
                            f"{self.possible_agents}") from None
 
@@ -409,6 +411,7 @@ class FlattenParallel(ParallelWrapper):
         try:
             return self._act_spaces[agent]
         except KeyError:
+            reject_old_names(agent, self.possible_agents)
             raise KeyError(f"unknown agent {agent!r}; agents of this env: "
                            f"{self.possible_agents}") from None
 
@@ -473,6 +476,7 @@ class NumericInfos(ParallelWrapper):
         try:
             return self._encoder.keys(agent)
         except KeyError:
+            reject_old_names(agent, self.possible_agents)
             raise KeyError(f"unknown agent {agent!r}; agents of this env: "
                            f"{self.possible_agents}") from None
 

@@ -2,7 +2,7 @@
 the infant a ball; recorded, with both agents' eyes and skin, to one Rerun ``.rrd`` file.
 
 One env (:func:`demo_env`: :class:`~mimo_social.experiments.demo_task.HighFiveThenHandover`,
-``infant_0`` the published 18-month-old, ``infant_1`` the adult body kneeling, both with 64x64
+``infant_0`` the published 18-month-old, ``caregiver_0`` the adult body kneeling, both with 64x64
 eyes, skin on both arms and hands, faces), in the play room by default (``scene="playroom"``;
 ``"floor"``: the bare floor), runs two episodes one after the other, recorded by one
 :class:`~mimo_social.recording.recorder.Recorder` on one continuous timeline (one recording):
@@ -48,7 +48,7 @@ DEFAULT_SECONDS = 6.0
 DEFAULT_SCENE = "playroom"
 #: the shortest run: one control step
 MIN_SECONDS = 0.01
-#: the caregiver's settings (``infant_1``)
+#: the caregiver's settings (``caregiver_0``)
 CAREGIVER = {"body": "adult", "posture": "kneeling"}
 #: edge of the eye images (pixels)
 EYE_SIZE = 64
@@ -83,12 +83,12 @@ class DemoRun:
     eye_frames: int
     faces: tuple = field(default_factory=tuple)
     stopped: str | None = None
-    agents: tuple = ("infant_0", "infant_1")
+    agents: tuple = ("infant_0", "caregiver_0")
     phases: tuple = PHASES
 
 
 def demo_env(scene: str = DEFAULT_SCENE, eye_size: int = EYE_SIZE):
-    """The demo's env: the infant ``infant_0`` and the kneeling caregiver ``infant_1`` with
+    """The demo's env: the infant ``infant_0`` and the kneeling caregiver ``caregiver_0`` with
     faces, ``eye_size`` eyes and the handover's skin, in ``scene``."""
     return make_parallel(HighFiveThenHandover, per_agent=[{}, dict(CAREGIVER)],
                          expressions=True, vision={"width": eye_size, "height": eye_size},

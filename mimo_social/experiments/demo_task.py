@@ -2,7 +2,7 @@
 
 :class:`HighFiveThenHandover` is the handover task (:mod:`mimo_social.tasks.handover`: two
 agents face to face, five-finger hands, skin on both arms and hands, a ball the giver
-``infant_1`` holds out to the receiver ``infant_0``) with a first phase before it, in the same
+``caregiver_0`` holds out to the receiver ``infant_0``) with a first phase before it, in the same
 world: a high five. Its :attr:`~HighFiveThenHandover.phase` (set before ``env.reset``) says what
 the next episode is:
 
@@ -14,14 +14,14 @@ the next episode is:
         episode does not end
     scripted agents (:func:`phase_partners`): ``infant_0``:
         :class:`~mimo_social.tasks.high_five.HighFiveController` with the first versions' palm
-        goal (``palm="forward"``); ``infant_1``: ``HandOffer(grip=False, release=None,
+        goal (``palm="forward"``); ``caregiver_0``: ``HandOffer(grip=False, release=None,
         palm="forward")``
 ``"handover"``:
     reset: the handover's own: the ball in the giver's palm, its fingers closed on it
     success (``is_success`` in the infos): the handover's (the receiver's hand holds the ball, the
         giver's no longer touches it, for 0.3 s)
     scripted agents (:func:`phase_partners`): ``infant_0``:
-        :class:`~mimo_social.tasks.handover.ReceiveController`; ``infant_1``: the handover's
+        :class:`~mimo_social.tasks.handover.ReceiveController`; ``caregiver_0``: the handover's
         :func:`~mimo_social.tasks.handover.scripted_giver`
 
 Both phases keep running after success (the handover's ``end_on_success`` is off); a ball that

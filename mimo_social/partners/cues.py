@@ -31,6 +31,7 @@ import numpy as np
 
 from ..core.kinematics import hand_geoms
 from ..expressions.faces import EXPRESSIONS
+from ..util.names import reject_old_names
 
 __all__ = ["Cues", "learner_cues", "gaze_line", "touching_hands", "GAZE_ON_FACE_DEG", "GAZE_RANGE", "HAPPY",
            "NEUTRAL"]
@@ -63,6 +64,7 @@ class Cues:
 def _index(env, name: str, what: str) -> int:
     names = list(env.possible_agents)
     if name not in names:
+        reject_old_names(name, names)
         raise ValueError(f"learner_cues: {what}={name!r} is not an agent of this env; agents: "
                          f"{names}")
     return names.index(name)

@@ -1,4 +1,5 @@
-"""``ScriptedPartners(env, {"infant_1": ExpressionShow()})``: some agents driven by scripts.
+"""``ScriptedPartners(env, {"infant_1": ExpressionShow()})``: some agents driven by scripts
+(an adult partner is ``caregiver_0``: :mod:`mimo_social.util.names`).
 
 A PettingZoo ParallelEnv around a :class:`~mimo_social.core.env.MimoParallelEnv` whose
 agents are only the learners; every scripted agent's action is filled in by its
@@ -17,6 +18,7 @@ from pettingzoo import ParallelEnv
 
 from ..core.wrappers import ParallelWrapper
 from ..util.checks import check_seed
+from ..util.names import reject_old_names
 from .base import Partner
 
 __all__ = ["ScriptedPartners"]
@@ -30,6 +32,7 @@ class ScriptedPartners(ParallelWrapper):
                              f"{partners!r}")
         unknown = [a for a in partners if a not in env.possible_agents]
         if unknown:
+            reject_old_names(unknown, env.possible_agents)
             raise ValueError(f"scripted agent(s) {unknown} are not agents of this env; "
                              f"agents: {env.possible_agents}")
         for a, p in partners.items():
@@ -81,6 +84,7 @@ class ScriptedPartners(ParallelWrapper):
 
     def _check(self, agent):
         if agent not in self.possible_agents:
+            reject_old_names(agent, self.env.possible_agents)
             raise KeyError(f"unknown agent {agent!r}; learners of this env: {self.possible_agents}"
                            f" (scripted: {list(self.partners)})")
 

@@ -108,7 +108,7 @@ def summarize(path: str | Path) -> dict:
                      if p.strip("/").split("/")[0] in _AGENT_GROUPS
                      and len(p.strip("/").split("/")) > 1
                      and p.strip("/").split("/")[1] not in ("scene", "props")},
-                    key=_natural)
+                    key=_agent_order)
     groups: dict[str, list[str]] = defaultdict(list)
     for p in sorted(entities, key=_natural):
         parts = p.strip("/").split("/")
@@ -143,6 +143,14 @@ def summarize(path: str | Path) -> dict:
 def _natural(s: str):
     """Sort key that puts infant_2 before infant_10."""
     return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", s)]
+
+
+def _agent_order(name: str):
+    """Sort key of agent names: infants (``infant_<i>``) before adult caregivers
+    (``caregiver_<i>``), each by number, as the tasks place them."""
+    kinds = ("infant_", "caregiver_")
+    kind = next((k for k, p in enumerate(kinds) if name.startswith(p)), len(kinds))
+    return (kind, _natural(name))
 
 
 def format_summary(s: dict, max_contacts: int = 10) -> str:

@@ -67,6 +67,7 @@ from gymnasium import spaces
 
 from ..util.checks import (ConfigError, check_bool, check_choice, check_names,
                            check_number)
+from ..util.names import reject_old_names
 from .base import SenseEntry
 from .contact_forces import AR4, PYRAMID, PYRAMIDAL_CONE, SKEW, body_dofs, contact_forces
 from .skin import GRID_CELL, Skin, build_skin
@@ -470,6 +471,7 @@ class TouchSystem:
     def _agent_index(self, agent) -> int:
         if isinstance(agent, str):
             if agent not in self.names:
+                reject_old_names(agent, self.names)
                 raise KeyError(f"unknown agent {agent!r}; agents: {self.names}")
             agent = self.names.index(agent)
         if self.skins[agent] is None:

@@ -47,6 +47,7 @@ from gymnasium import spaces
 from ..render.eye_renderer import Tile, TileRenderer
 from ..render.png import write_png
 from ..util.checks import check_bool, check_int
+from ..util.names import reject_old_names
 from .acuity import acuity_blur, check_acuity, cutoff_for
 from .base import SenseEntry
 
@@ -199,6 +200,7 @@ def _agent_index(env, agent) -> int:
     try:
         return base.possible_agents.index(agent)
     except ValueError:
+        reject_old_names(agent, base.possible_agents)
         raise KeyError(f"unknown agent {agent!r}; agents: {base.possible_agents}") from None
 
 

@@ -177,7 +177,7 @@ def _measure(hands, body, age_months, scale, posture, frozen_key) -> Extent:
     a = w.agents[0]
     front = float(np.max(d.geom_xpos[a.geom_ids, 0] + _half_extent_x(m, d, a.geom_ids)))
     head = tuple(float(x) for x in d.site_xpos[a.head_site])
-    shoulder = tuple(float(x) for x in d.xpos[m.body("infant_0/right_upper_arm").id])
+    shoulder = tuple(float(x) for x in d.xpos[m.body(f"{w.names[0]}/right_upper_arm").id])
     for k, n in enumerate(a.joint_names):   # the right arm straight: elbow and wrist at 0
         if n in _ARM_STRAIGHT:
             d.qpos[a.qpos_adr[k]] = np.clip(0.0, *a.joint_range[k])

@@ -166,14 +166,15 @@ def test_held_postures_stay_put_for_two_seconds(body, posture):
     knees and the toe tips; the adult stands on its soles and sits on its thighs."""
     world = held_world(body, posture)
     m, d = world.model, world.data
-    hip = m.body("infant_0/hip").id
+    me = world.names[0]   # caregiver_0 for the adult
+    hip = m.body(f"{me}/hip").id
     x0, q0 = d.xpos[hip].copy(), d.xquat[hip].copy()
     assert world.step(int(round(2.0 / m.opt.timestep))) is None
     assert np.abs(d.xpos[hip] - x0).max() < 0.003
     tilt = 2 * np.degrees(np.arccos(min(1.0, abs(float(np.dot(q0, d.xquat[hip]))))))
     assert tilt < 0.2
     touching = {m.geom(int(g)).name.split("/")[1] for c in d.contact[:d.ncon]
-                for g in (c.geom1, c.geom2) if m.geom(int(g)).name.startswith("infant_0/")}
+                for g in (c.geom1, c.geom2) if m.geom(int(g)).name.startswith(f"{me}/")}
     if posture == "kneeling":
         assert touching == {"right_upper_leg", "left_upper_leg", "right_toe_tips",
                             "left_toe_tips"}
@@ -186,7 +187,7 @@ def test_an_adult_kneels_face_to_face_with_an_infant_in_free_play():
                                                                 "posture": "kneeling"}])
     env.reset(seed=0)
     m, d = env.world.model, env.world.data
-    eye = d.xpos[m.body("infant_1/right_eye").id, 2]
+    eye = d.xpos[m.body("caregiver_0/right_eye").id, 2]
     assert eye == pytest.approx(1.15, abs=0.01)
     zero = {}
     for a in env.agents:
@@ -255,12 +256,12 @@ def figures(hands="mitten"):
     env = free_play_v0.parallel_env(n_agents=2, touch=True, hands=hands,
                                     per_agent=[{}, {"body": "adult"}])
     obs, _ = env.reset(seed=0)
-    print(f"  touch points: adult {obs['infant_1']['touch'].size}, infant "
+    print(f"  touch points: adult {obs['caregiver_0']['touch'].size}, infant "
           f"{obs['infant_0']['touch'].size}")
     for body, posture in (("adult", "standing"), ("adult", "sitting"), ("adult", "kneeling"),
                           ("infant", "standing"), ("infant", "sitting"), ("infant", "kneeling")):
         world = held_world(body, posture, hands)
-        eye = world.model.body("infant_0/right_eye").id
+        eye = world.model.body(f"{world.names[0]}/right_eye").id
         mujoco.mj_forward(world.model, world.data)
         start = world.data.xpos[eye, 2]
         world.step(int(round(2.0 / world.model.opt.timestep)))

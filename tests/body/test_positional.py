@@ -38,14 +38,16 @@ def joint_errors_deg(env, u):
 
 
 def step_checked(env, u, steps):
-    """Step agent 0 with ``u``; the servo torques stay within the limits at every step."""
+    """Step agent 0 (``infant_0``, or ``caregiver_0`` for an adult) with ``u``; the servo
+    torques stay within the limits at every step."""
     act, d = env.actuation[0], env.world.data
+    agent = env.possible_agents[0]
     for _ in range(steps):
-        _, _, _, _, infos = env.step({"infant_0": u})
-        assert not infos["infant_0"]["instability"], infos["infant_0"]["instability"]
+        _, _, _, _, infos = env.step({agent: u})
+        assert not infos[agent]["instability"], infos[agent]["instability"]
         f = d.actuator_force[act.actuator_ids]
         assert np.all(f <= act.torque_pos + 1e-9) and np.all(f >= -act.torque_neg - 1e-9)
-    return infos["infant_0"]
+    return infos[agent]
 
 
 # -- the mapping and the servo ---------------------------------------------------------------------

@@ -69,7 +69,9 @@ class FaceTask(Task):
 def face_env(partner, caregiver=None, distance=0.45, lean=0.0):
     per_agent = [{"actuation": "positional"}, dict(caregiver or {})]
     task = FaceTask(2, {"distance": distance, "lean": lean})
-    return ScriptedPartners(MimoParallelEnv(task, per_agent=per_agent), {"infant_1": partner})
+    penv = MimoParallelEnv(task, per_agent=per_agent)
+    # the caregiver: caregiver_0 for an adult body, infant_1 for an infant
+    return ScriptedPartners(penv, {penv.possible_agents[1]: partner})
 
 
 class Learner:
@@ -180,8 +182,9 @@ def test_caregiver_looks_where_the_learner_looks_then_back_at_its_face(caregiver
 
     def after(k):
         inner = env.unwrapped
-        seen[k] = (learner_cues(inner, "infant_1", "infant_0"),
-                   learner_cues(inner, "infant_0", "infant_1"))
+        care = inner.possible_agents[1]
+        seen[k] = (learner_cues(inner, care, "infant_0"),
+                   learner_cues(inner, "infant_0", care))
 
     run(env, policy, 300, after=after)
     assert len(p.events) == 1 and p.events[0]["cue"] == "gaze"
@@ -214,7 +217,7 @@ def test_touch_is_answered_with_a_pat_toward_the_touching_arm():
     p = ContingentCaregiver(cues=("touch",), delay_s=0.2, duration_s=1.0)
     env = face_env(p, ADULT_POS, distance=0.3, lean=15.0)
     env.reset(seed=0)
-    reach = _reach_pose(env, "infant_1/left_upper_leg")
+    reach = _reach_pose(env, "caregiver_0/left_upper_leg")
     w = env.unwrapped.world
     arm_geom = w.model.geom("infant_0/right_lower_arm").id
     dist = []
@@ -385,7 +388,7 @@ def test_bad_uses_are_named():
     with pytest.raises(ValueError, match="motors"):
         face_env(ReplayCaregiver(bad)).reset(seed=0)
     with pytest.raises(RuntimeError, match="reset"):
-        ContingentCaregiver().act(None, "infant_1", None)
+        ContingentCaregiver().act(None, "caregiver_0", None)
 
 
 def test_expression_only_in_the_mirror_task_with_the_adult():
@@ -416,7 +419,7 @@ def test_pickled_mid_episode_continues_exactly():
         lr = Learner(e)
         for k in range(60, 140):
             e.step({"infant_0": _smile_and_look(k, lr)})
-        streams.append(e.partners["infant_1"].stream["motors"])
+        streams.append(e.partners["caregiver_0"].stream["motors"])
     np.testing.assert_array_equal(streams[0], streams[1])
 
 

@@ -15,7 +15,7 @@ from mimo_social.experiments.demo_task import PHASES
 from mimo_social.recording.summary import read_batches, summarize
 from mimo_social.util.checks import ConfigError
 
-INFANT, CAREGIVER = "infant_0", "infant_1"
+INFANT, CAREGIVER = "infant_0", "caregiver_0"
 
 
 def series(data, path: str, component: str) -> list[tuple[float, object]]:

@@ -55,7 +55,7 @@ class LooksAtFace(Partner):
 
     def __init__(self, face_of):
         self.face_of = face_of
-        self.gaze = GazeAtTarget(targets=["infant_1/head_centre"], hold_s=(3600.0, 3600.0),
+        self.gaze = GazeAtTarget(targets=["caregiver_0/head_centre"], hold_s=(3600.0, 3600.0),
                                  head_share=1.0)
 
     def reset(self, env, agent, rng):
@@ -153,7 +153,7 @@ def test_live_caregiver_answers_smiles_with_the_delay_and_probability():
 def test_replay_and_non_contingent_ignore_the_learner():
     env = contingency_v0.scripted_env(max_steps=800, **FAST)
     live, _ = run(env, ContingencyDetectorController(), "live")
-    recorded = env.partners["infant_1"].recorded
+    recorded = env.partners["caregiver_0"].recorded
     assert np.array_equal(recorded["expression"], live)
     replays = [run(env, learner, "replay", seed=s)[0]
                for learner, s in ((Pulses(), 0), (Random(), 1), (Pulses(80, 5, 13), 2))]
@@ -172,7 +172,7 @@ def test_a_saved_stream_replays_in_a_new_env_and_a_copy_continues_exactly(tmp_pa
     from mimo_social.partners.replay import load_stream, save_stream
     env = contingency_v0.scripted_env(max_steps=300, **FAST)
     live, _ = run(env, ContingencyDetectorController(), "live")
-    path = save_stream(tmp_path / "caregiver", env.partners["infant_1"].recorded)
+    path = save_stream(tmp_path / "caregiver", env.partners["caregiver_0"].recorded)
     other = contingency_v0.scripted_env(max_steps=300, stream=load_stream(path),
                                         task_options={"condition": "replay"}, **FAST)
     faces, info = run(other, Random(), "replay", seed=9)

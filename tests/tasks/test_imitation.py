@@ -67,7 +67,7 @@ def test_spaces_and_nothing_privileged():
     # two learners: the demonstrator alone is told the action (its own task)
     two = imitation_v0.parallel_env(per_agent=[BLIND, BLIND])
     obs, _ = two.reset(seed=seeds["clap"])
-    assert obs["infant_1"]["instruction"].tolist() == [0, 0, 1, 0]
+    assert obs["caregiver_0"]["instruction"].tolist() == [0, 0, 1, 0]
     assert obs["infant_0"]["instruction"].tolist() == [0, 0, 0, 0]
 
 
@@ -134,16 +134,16 @@ def test_two_learners_the_demonstrator_is_rewarded_for_its_instruction():
     env = imitation_v0.parallel_env(per_agent=[BLIND, BLIND])
     obs, _ = env.reset(seed=3)
     demo = Demonstrator()
-    demo.reset(env, "infant_1", np.random.default_rng(0))
-    total = {"infant_0": 0.0, "infant_1": 0.0}
+    demo.reset(env, "caregiver_0", np.random.default_rng(0))
+    total = {"infant_0": 0.0, "caregiver_0": 0.0}
     while env.agents:
         act = {"infant_0": np.zeros(16, np.float32),
-               "infant_1": demo.act(env, "infant_1", obs["infant_1"])}
+               "caregiver_0": demo.act(env, "caregiver_0", obs["caregiver_0"])}
         obs, rew, term, trunc, info = env.step(act)
         for a in rew:
             total[a] += rew[a]
-    assert total == {"infant_0": 0.0, "infant_1": 1.0}
-    assert info["infant_1"]["is_success"] and not info["infant_0"]["is_success"]
+    assert total == {"infant_0": 0.0, "caregiver_0": 1.0}
+    assert info["caregiver_0"]["is_success"] and not info["infant_0"]["is_success"]
 
 
 def test_every_action_has_a_pose():

@@ -63,7 +63,7 @@ def gaze_fraction(policy, steps=300, **kwargs):
 
 # -- contingency: the gaze measure ------------------------------------------------------------
 def test_contingency_gaze_measure_follows_the_learners_head_and_eyes():
-    looks = gaze_fraction(Looks("infant_1/head_centre"), **FREE)
+    looks = gaze_fraction(Looks("caregiver_0/head_centre"), **FREE)
     away = gaze_fraction(Looks("infant_0/right_hand"), **FREE)
     random, zero = gaze_fraction(Random(), **FREE), gaze_fraction(Zero(), **FREE)
     scripted = gaze_fraction(ContingencyDetectorController(), **FREE)

@@ -33,7 +33,7 @@ STANDARD_DISTANCE = {"high_five": 0.35, "mirror": 0.3, "joint_attention": 0.7,
 
 def run_episodes(task, seeds, per_agent=ADULT, **kwargs):
     """Successes of the catalogue's scripted controller (infant_0) with the task's scripted
-    partner (infant_1) over ``seeds``."""
+    partner (caregiver_0 for an adult, else infant_1) over ``seeds``."""
     e = entry(task)
     env = e.scripted_env(per_agent=per_agent, **kwargs)
     inner = env.unwrapped
@@ -122,7 +122,7 @@ def test_adult_offers_its_hand_where_the_infant_reaches():
     env.reset(seed=0)
     inner = env.unwrapped
     w = inner.world
-    partner = env.partners["infant_1"]
+    partner = env.partners["caregiver_0"]
     ref = entry("high_five").scripted_env()
     ref.reset(seed=0)
     rw = ref.unwrapped.world
@@ -130,7 +130,7 @@ def test_adult_offers_its_hand_where_the_infant_reaches():
     adult_offer = partner.target_position - shoulder[0]
     infant_offer = ref.partners["infant_1"].target_position - shoulder[1]
     assert np.linalg.norm(adult_offer - infant_offer) < 0.01
-    assert agent_index(inner, "infant_1") == 1
+    assert agent_index(inner, "caregiver_0") == 1
     env.close()
     ref.close()
 
@@ -173,7 +173,7 @@ def test_postures_the_tasks_cannot_use_are_refused_by_name():
     with pytest.raises(ConfigError, match="posture='standing' not allowed for body='adult'"):
         entry("social_touch").parallel_env(per_agent=[{}, {"body": "adult",
                                                            "posture": "standing"}])
-    with pytest.raises(ValueError, match="infant_1: posture='lying' not allowed"):
+    with pytest.raises(ValueError, match="caregiver_0: posture='lying' not allowed"):
         entry("handover").parallel_env(per_agent=[{}, {"body": "adult", "posture": "lying"}])
 
 

@@ -67,7 +67,7 @@ def test_bad_options_raise_clear_errors():
 
 def test_agents_bodies_spaces_and_episode_length():
     env = still_face_v0.parallel_env()
-    assert env.possible_agents == ["infant_0", "infant_1"]
+    assert env.possible_agents == ["infant_0", "caregiver_0"]
     learner, caregiver = env.agent_configs
     assert (learner.body, learner.posture) == ("infant", "sitting")
     assert (caregiver.body, caregiver.posture) == ("adult", "kneeling")
@@ -127,8 +127,8 @@ def test_still_phase_caregiver_face_neutral_and_joints_held(form):
     for step in range(100):
         acts = {"infant_0": learner.act(inner, "infant_0", None)}
         if form == "two_learners":
-            acts["infant_1"] = {"motors": rng.uniform(-1, 1, 16).astype(np.float32),
-                                "expression": HAPPY}
+            acts["caregiver_0"] = {"motors": rng.uniform(-1, 1, 16).astype(np.float32),
+                                   "expression": HAPPY}
         env.step(acts)
         faces.append(inner.world.expression_of(1))
         angles.append(inner.world.data.qpos[qadr].copy())

@@ -334,7 +334,7 @@ def _episode(env, learner, record=lambda inner, info: info):
 # -- still face -----------------------------------------------------------------------------------
 #: 50 interaction, 30 still-face and 50 reunion steps: 100 interactive steps of 130
 SF_PHASES = (0.5, 0.3, 0.5)
-FACE = "infant_1/head_centre"
+FACE = "caregiver_0/head_centre"
 
 
 def _still_face(learner, caregiver=None, **options):
@@ -434,7 +434,7 @@ def test_contingency_a_shared_smile_needs_the_learners_gaze_on_the_face():
     learner's own head and eyes): the same smiles, renewed every 0.5 s, looking at the
     caregiver's face share most steps and succeed; looking at its own hand they share none and
     fail, though both faces are happy on most steps."""
-    looks = _contingency(Looks("infant_1/head_centre", _dips), 300)
+    looks = _contingency(Looks("caregiver_0/head_centre", _dips), 300)
     assert looks[-1][0]["gaze_fraction"] > 0.8 and looks[-1][0]["shared_fraction"] > 0.6
     assert looks[-1][0]["is_success"]
     away = _contingency(Looks("infant_0/right_hand", _dips), 300)
@@ -644,15 +644,15 @@ def test_imitation_the_demonstrators_success_is_its_first_act_being_its_instruct
             obs, _ = env.reset(seed=seed)
             if env.task.demonstrated_action == "clap":
                 break
-        assert obs["infant_1"]["instruction"][ACTIONS.index("clap")] == 1.0
+        assert obs["caregiver_0"]["instruction"][ACTIONS.index("clap")] == 1.0
         demo = Shows(shown)
-        demo.reset(env, "infant_1", None)
+        demo.reset(env, "caregiver_0", None)
         total = 0.0
         while env.task.step_count < env.task.demo_steps - 1:
             _, r, _, _, info = env.step({"infant_0": np.zeros(16, np.float32),
-                                         "infant_1": demo.act(env, "infant_1", None)})
-            total += r["infant_1"]
-        results[shown] = (info["infant_1"], total)
+                                         "caregiver_0": demo.act(env, "caregiver_0", None)})
+            total += r["caregiver_0"]
+        results[shown] = (info["caregiver_0"], total)
     clap, total = results["clap"]
     assert clap["demonstration"] == ACTIONS.index("clap") and clap["is_success"] and total == 1.0
     touch, total = results["head_touch"]

@@ -38,8 +38,8 @@ class ContingencyOptions(TaskOptions):
     """The condition (live, replay, non-contingent), the distance between the faces (m), the
     scripted caregiver's response delay (s) and probability, the contingency index's window (s),
     the share of shared-smile steps for success, reward-free mode, whether the learner's head
-    and eyes are free (``gaze_free``, on) and whether ``infant_1`` is the scripted caregiver (no
-    eyes, no reward)."""
+    and eyes are free (``gaze_free``, on) and whether the caregiver (``caregiver_0``) is scripted
+    (no eyes, no reward)."""
 
     task = "contingency"
     condition: str = "live"
@@ -368,7 +368,8 @@ def scripted_env(partner=None, stream=None, **kwargs):
     from ...partners import ScriptedPartners
     options = with_options(Contingency, kwargs.pop("task_options", None), scripted_partner=True)
     penv = parallel_env(task_options=options, **kwargs)
+    # the partner: the second agent (caregiver_0 when it is the adult)
     partner = partner or ContingencyCaregiver(stream=stream)
     if isinstance(partner, ContingencyCaregiver):   # replay's stream, checked now, not at reset
-        partner.check(penv, "infant_1")
-    return ScriptedPartners(penv, {"infant_1": partner})
+        partner.check(penv, penv.possible_agents[1])
+    return ScriptedPartners(penv, {penv.possible_agents[1]: partner})

@@ -137,12 +137,13 @@ class Handover(Task):
                 "expressions": False, "touch": arms_only_touch(load_body("five_fingers"))}
 
     def setup(self, i, config):
+        who = self.agent_name(i)
         if config.hands != "five_fingers":
-            raise ConfigError(f"handover: infant_{i}: hands={config.hands!r} not allowed; the task "
+            raise ConfigError(f"handover: {who}: hands={config.hands!r} not allowed; the task "
                               "needs hands='five_fingers' (the ball is held between the fingers)")
         allowed = ("standing", "kneeling", "sitting") if config.body == "adult" else ("standing",)
         if config.posture not in allowed:
-            raise ConfigError(f"handover: infant_{i}: posture={config.posture!r} not allowed; "
+            raise ConfigError(f"handover: {who}: posture={config.posture!r} not allowed; "
                               f"allowed for body={config.body!r}: {list(allowed)} (the task "
                               "places infants standing, hip fixed)")
         # two 18-month-olds stand `distance` apart; other bodies at the distance scaled with
@@ -442,4 +443,4 @@ def scripted_env(partner=None, **kwargs):
     penv = parallel_env(**kwargs)
     if partner is None:
         partner = scripted_giver(penv.task.options)
-    return ScriptedPartners(penv, {"infant_1": partner})
+    return ScriptedPartners(penv, {penv.possible_agents[1]: partner})

@@ -156,7 +156,7 @@ class HighFive(Task):
                          () if self.options.assisted_gaze else (0, 1))
         pos, facing = face_to_face(i, plan.distance)
         tables = tables_of(config)
-        require_skin(self.name, f"infant_{i}", config, right_hand_parts(tables),
+        require_skin(self.name, self.agent_name(i), config, right_hand_parts(tables),
                      "the high five (the right hands meeting)")
         arm = right_arm_joints(tables)
         gaze = GAZE_JOINTS if self.options.assisted_gaze else ()
@@ -309,5 +309,7 @@ def default_partner():
 
 def scripted_env(partner=None, **kwargs):
     from ...partners import ScriptedPartners
-    return ScriptedPartners(parallel_env(**kwargs),
-                            {"infant_1": partner if partner is not None else default_partner()})
+    penv = parallel_env(**kwargs)
+    # the partner: the second agent (caregiver_0 when it is the adult)
+    partner = partner if partner is not None else default_partner()
+    return ScriptedPartners(penv, {penv.possible_agents[1]: partner})

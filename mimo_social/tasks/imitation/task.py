@@ -47,9 +47,9 @@ SEVERAL = len(ACTIONS)
 class ImitationOptions(TaskOptions):
     """The demonstrated actions (names from :data:`ACTIONS`; one is drawn per episode), the
     distance between the agents (m, for two 18-month-olds; scaled for other bodies), the
-    demonstration's length (s), the reward for a wrong action (<= 0), whether ``infant_1`` is
-    a scripted demonstrator (no eyes, no reward) and reward-free mode (rewards 0, measures
-    kept)."""
+    demonstration's length (s), the reward for a wrong action (<= 0), whether the
+    demonstrator (``caregiver_0``) is scripted (no eyes, no reward) and reward-free mode
+    (rewards 0, measures kept)."""
 
     task = "imitation"
     actions: tuple | None = None
@@ -368,5 +368,7 @@ def scripted_env(partner=None, **kwargs):
     from ...partners import ScriptedPartners
     from .demonstrator import Demonstrator
     options = with_options(Imitation, kwargs.pop("task_options", None), scripted_partner=True)
-    return ScriptedPartners(parallel_env(task_options=options, **kwargs),
-                            {"infant_1": partner if partner is not None else Demonstrator()})
+    penv = parallel_env(task_options=options, **kwargs)
+    # the partner: the second agent (caregiver_0 when it is the adult)
+    partner = partner if partner is not None else Demonstrator()
+    return ScriptedPartners(penv, {penv.possible_agents[1]: partner})

@@ -317,5 +317,6 @@ def scripted_env(partner=None, **kwargs):
     from ...partners import ScriptedPartners
     from ...partners.gaze import GazeAtTarget
     options = with_options(JointAttention, kwargs.pop("task_options", None), scripted_partner=True)
-    return ScriptedPartners(parallel_env(task_options=options, **kwargs),
-                            {"infant_1": partner or GazeAtTarget()})
+    penv = parallel_env(task_options=options, **kwargs)
+    # the partner: the second agent (caregiver_0 when it is the adult)
+    return ScriptedPartners(penv, {penv.possible_agents[1]: partner or GazeAtTarget()})

@@ -133,7 +133,7 @@ class SocialTouch(Task):
         if isinstance(n_agents, (int, np.integer)) and not isinstance(n_agents, bool) \
                 and n_agents != 2:
             raise ConfigError(f"social_touch: n_agents={n_agents!r} not allowed; allowed: 2 to 2 "
-                              "(a dyad: the toucher infant_0 and the touched infant_1)")
+                              "(a dyad: the toucher infant_0 and the touched partner)")
         super().__init__(n_agents, options, **values)
         self.targets: tuple[str, ...] = ()
 
@@ -151,8 +151,9 @@ class SocialTouch(Task):
         reachable, defaults = REACHABLE, DEFAULT_TARGETS
         if config is not None and config.body == "adult":
             if config.posture not in ADULT_REACHABLE:
-                raise ConfigError(f"social_touch: infant_1: posture={config.posture!r} not "
-                                  f"allowed for body='adult'; allowed: {list(ADULT_REACHABLE)}")
+                raise ConfigError(f"social_touch: {self.agent_name(TOUCHED)}: posture="
+                                  f"{config.posture!r} not allowed for body='adult'; allowed: "
+                                  f"{list(ADULT_REACHABLE)}")
             reachable = defaults = ADULT_REACHABLE[config.posture]
         if given is None:
             targets = tuple(p for p in defaults if p in parts)
@@ -205,11 +206,11 @@ class SocialTouch(Task):
         tables = tables_of(config)
         actuated = self._actuated(i, tables)
         if i == TOUCHER:
-            require_skin(self.name, "infant_0", config, right_hand_parts(tables),
+            require_skin(self.name, self.agent_name(i), config, right_hand_parts(tables),
                          "the touch it gives")
         else:
             self.targets = self._resolve_targets(tables, config)
-            require_skin(self.name, "infant_1", config, self.targets,
+            require_skin(self.name, self.agent_name(i), config, self.targets,
                          "the touch it receives on every target part")
         head = {k: v for k, v in plan.gaze[i].items() if k in HEAD_GAZE_JOINTS}
         frozen = {**self.held_joints(i, config), **head}
@@ -446,5 +447,7 @@ def env(**kwargs):
 
 def scripted_env(partner=None, **kwargs):
     from ...partners import ScriptedPartners, Still
-    return ScriptedPartners(parallel_env(**kwargs),
-                            {"infant_1": partner if partner is not None else Still()})
+    penv = parallel_env(**kwargs)
+    # the partner: the second agent (caregiver_0 when it is the adult)
+    partner = partner if partner is not None else Still()
+    return ScriptedPartners(penv, {penv.possible_agents[1]: partner})

@@ -113,16 +113,17 @@ class Standup(Task):
         h = self.options.rail_height
         wood = (0.72, 0.52, 0.32, 1.0)
         post = h / 2 + RAIL_RADIUS / 2
+        me = self.agent_name(0) if self.configs else "infant_0"
         return [
             Prop("crib_rail", "box", (RAIL_RADIUS, RAIL_HALF_WIDTH, RAIL_RADIUS), (RAIL_X, 0.0, h),
-                 1.0, wood, fixed=True, welds=("infant_0/right_hand", "infant_0/left_hand")),
+                 1.0, wood, fixed=True, welds=(f"{me}/right_hand", f"{me}/left_hand")),
             Prop("crib_post_right", "box", (RAIL_RADIUS, RAIL_RADIUS, post),
                  (RAIL_X, -RAIL_HALF_WIDTH - RAIL_RADIUS, post), 1.0, wood, fixed=True),
             Prop("crib_post_left", "box", (RAIL_RADIUS, RAIL_RADIUS, post),
                  (RAIL_X, RAIL_HALF_WIDTH + RAIL_RADIUS, post), 1.0, wood, fixed=True),
             # under the floor, out of sight: the feet are welded to it (i.e. to the floor)
             Prop("crib_base", "box", (0.3, 0.3, 0.01), (0.1, 0.0, -0.02), 1.0, wood, fixed=True,
-                 welds=("infant_0/right_foot", "infant_0/left_foot")),
+                 welds=(f"{me}/right_foot", f"{me}/left_foot")),
         ]
 
     # -- the start pose (computed once per world) -----------------------------------------------

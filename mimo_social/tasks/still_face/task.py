@@ -51,7 +51,8 @@ class StillFaceOptions(TaskOptions):
     """The phases' lengths (s: interaction, still face, reunion), the standard pair's distance
     (m), whether the learner's arms are free, head support, the share of interactive steps that
     must be engaged for success, the reward of a still-phase step with the classic response,
-    reward-free mode and whether ``infant_1`` is a scripted caregiver (no eyes, no reward)."""
+    reward-free mode and whether the caregiver (``caregiver_0``) is scripted (no eyes, no
+    reward)."""
 
     task = "still_face"
     phases_s: tuple = (5.0, 5.0, 5.0)
@@ -350,4 +351,6 @@ def scripted_env(partner=None, **kwargs):
     if partner is None:
         from ...partners.contingent import ContingentCaregiver
         partner = ContingentCaregiver()
-    return PhasedPartners(parallel_env(task_options=options, **kwargs), {"infant_1": partner})
+    penv = parallel_env(task_options=options, **kwargs)
+    # the partner: the second agent (caregiver_0 when it is the adult)
+    return PhasedPartners(penv, {penv.possible_agents[1]: partner})
