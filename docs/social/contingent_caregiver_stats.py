@@ -24,6 +24,7 @@ for name, body in BODIES.items():
     # gaze: the learner looks at a floor point for 1.5 s; the caregiver follows for 1.5 s
     p = ContingentCaregiver(cues=("gaze",), delay_s=0.2, duration_s=1.5)
     env = face_env(p, body)
+    care = env.unwrapped.possible_agents[1]     # caregiver_0 (an adult) or infant_1
     log = {}
     spent = []
     inner_act = p.act
@@ -35,8 +36,8 @@ for name, body in BODIES.items():
         return out
     p.act = timed
     run(env, lambda k, lr: lr.looking_at(FLOOR) if 100 <= k < 250 else lr.at_face(), 400,
-        after=lambda k: log.__setitem__(k, (learner_cues(env.unwrapped, "infant_1", "infant_0"),
-                                            learner_cues(env.unwrapped, "infant_0", "infant_1"))))
+        after=lambda k: log.__setitem__(k, (learner_cues(env.unwrapped, care, "infant_0"),
+                                            learner_cues(env.unwrapped, "infant_0", care))))
     ms = np.median(spent) * 1e3
     s = p.responses[0]["step"]
     err = {k: np.linalg.norm(c.gaze_point[:2] - lr_.gaze_point[:2]) if c.gaze_point is not None
@@ -71,7 +72,7 @@ for name, body in list(BODIES.items())[:2]:
     p = ContingentCaregiver(cues=("touch",), delay_s=0.2, duration_s=1.0)
     env = face_env(p, body, distance=0.3, lean=15.0)
     env.reset(seed=0)
-    reach = _reach_pose(env, "infant_1/left_upper_leg")
+    reach = _reach_pose(env, "caregiver_0/left_upper_leg")
     w = env.unwrapped.world
     arm = [w.model.geom(f"infant_0/right_{g}").id for g in ("lower_arm", "upper_arm")]
     dist = []

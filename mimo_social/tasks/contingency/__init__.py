@@ -1,8 +1,9 @@
 """Contingency: smiling with a caregiver who answers live, replays a session or smiles on a timer.
 
 agents:
-    2: `infant_0` (the learner, an 18-month-old) and `infant_1` (the caregiver: by default the adult
-    body, kneeling; an infant partner is allowed with `per_agent=[{}, {"body": "infant"}]`).
+    2: `infant_0` (the learner, an 18-month-old) and `caregiver_0` (the caregiver: by default the
+    adult body, kneeling; an infant partner, then named `infant_1`, is allowed with
+    `per_agent=[{}, {"body": "infant"}]`).
     `scripted_env` drives the caregiver (`ContingencyCaregiver`, below); `parallel_env` makes it a
     second learner (condition "live" only)
 body:
@@ -39,14 +40,14 @@ conditions:
     regardless of the learner (`ReplayCaregiver`): by default the last live episode of this env (run
     one first), or the `stream` given to `scripted_env` (a stream dict, e.g.
     `mimo_social.partners.replay.load_stream(path)` of one saved with `save_stream(path,
-    env.partners["infant_1"].recorded)`); Murray and Trevarthen's double video: the same caregiver
-    behaviour, out of sync with the infant. **non_contingent**: the caregiver smiles, each smile
-    held `response_duration_s`, at the rate it answered in this env's last live episode (before any
-    live episode: `timer_rate_hz`, 0.5 per second), started on a random timer independent of the
-    learner (mode "non_contingent"; a Poisson process from the partner's seeded generator). In
-    replay and non-contingent nothing the learner does changes the caregiver (tested). Two learners:
-    "live" only (the caregiver is the other learner's policy; replay and non-contingent need the
-    script: a ConfigError)
+    env.partners["caregiver_0"].recorded)`); Murray and Trevarthen's double video: the same
+    caregiver behaviour, out of sync with the infant. **non_contingent**: the caregiver smiles, each
+    smile held `response_duration_s`, at the rate it answered in this env's last live episode
+    (before any live episode: `timer_rate_hz`, 0.5 per second), started on a random timer
+    independent of the learner (mode "non_contingent"; a Poisson process from the partner's seeded
+    generator). In replay and non-contingent nothing the learner does changes the caregiver
+    (tested). Two learners: "live" only (the caregiver is the other learner's policy; replay and
+    non-contingent need the script: a ConfigError)
 reset:
     both faces neutral; nothing random in the task (the scripted caregiver draws its responses and
     timer from the env's seed)
@@ -183,10 +184,10 @@ reads the learner's face before the learner's action of a step applies, so its a
 control step (10 ms) after `response_delay_s`.
 
 ``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns a
-:class:`~mimo_social.core.env.MimoParallelEnv` with two learners (the caregiver ``infant_1`` an
+:class:`~mimo_social.core.env.MimoParallelEnv` with two learners (the caregiver ``caregiver_0`` an
 adult learner by default; condition "live" only); ``env(...)`` the AEC version;
 ``scripted_env(partner=None, stream=None, **kwargs)`` a one-learner env (``infant_0`` learns) whose
-caregiver ``infant_1`` is driven by :class:`~mimo_social.tasks.contingency.ContingencyCaregiver`
+caregiver ``caregiver_0`` is driven by :class:`~mimo_social.tasks.contingency.ContingencyCaregiver`
 (live, replay of the last live episode or of ``stream``, non-contingent, as the task's condition
 says), or by ``partner``.
 """

@@ -1,9 +1,9 @@
 """Handover: one infant holds out a ball in its right hand, the other takes it into its own.
 
 agents:
-    2: `infant_0` the receiver, `infant_1` the giver (scripted: :func:`scripted_giver`, a
-    :class:`~mimo_social.partners.HandOffer` with `release="on_hold"`, in `scripted_env`; or a
-    learner); standing face to face, `distance` (0.34 m) hip to hip
+    2: `infant_0` the receiver, `infant_1` the giver (an adult giver is `caregiver_0`; scripted:
+    :func:`scripted_giver`, a :class:`~mimo_social.partners.HandOffer` with `release="on_hold"`, in
+    `scripted_env`; or a learner); standing face to face, `distance` (0.34 m) hip to hip
 body:
     five-fingered hands (`hands="five_fingers"` is required), spring-damper motors by default
     (`actuation="muscle"`, for all or per agent, works too); standing, hip fixed in the world;

@@ -1,7 +1,8 @@
 """High five: two standing infants, face to face, bring their right hands together and feel it.
 
 agents:
-    2 (`infant_0`, `infant_1`), `distance` (0.35 m) apart hip to hip, facing each other
+    2 (`infant_0`, `infant_1`; an adult partner is `caregiver_0`), `distance` (0.35 m) apart hip to
+    hip, facing each other
 body:
     standing, hip fixed in the world; trunk, legs, left arm held; head and eyes held at rest,
     looking straight ahead at the partner (no gaze joint in the model). With `assisted_gaze` (the

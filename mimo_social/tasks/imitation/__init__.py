@@ -1,10 +1,10 @@
 """Imitation: the learner reproduces an action its partner demonstrated, seen through its eyes.
 
 agents:
-    2: `infant_0` (the learner, an 18-month-old) and `infant_1` (the demonstrator: by default the
-    adult caregiver, `body="adult"`, kneeling; an infant demonstrator with `per_agent=[{}, {"body":
-    "infant"}]`, then standing); with `scripted_env` `infant_1` is the scripted `Demonstrator`, else
-    a second learner
+    2: `infant_0` (the learner, an 18-month-old) and `caregiver_0` (the demonstrator: by default
+    the adult caregiver, `body="adult"`, kneeling; an infant demonstrator, then named `infant_1`,
+    with `per_agent=[{}, {"body": "infant"}]`, then standing); with `scripted_env` the
+    demonstrator is the scripted `Demonstrator`, else a second learner
 body:
     hip fixed in the world; every joint held but both arms (shoulder 3, elbow, wrist 3, mitten
     fingers each: 16 motors), `actuation="positional"` (the controls are target angles across each
@@ -53,8 +53,8 @@ observation:
     `eye_left`, `eye_right` (64x64x3 RGB: the only way the demonstration reaches the learner),
     `proprioception` (96: its own arm joints, `[u, torque]` per motor and angles), `turn` (1: 0
     during the demonstration, 1 from the learner's turn on: the experimenter's "your turn"); with
-    two learners also `instruction` (4: one-hot of the action to demonstrate for `infant_1`, zeros
-    for `infant_0`)
+    two learners also `instruction` (4: one-hot of the action to demonstrate for the
+    demonstrator, zeros for `infant_0`)
 reward:
     the learner: on its act in its turn, +1 if it is the demonstrated action's outcome alone, else
     `wrong_reward` (0; -10 to 0); nothing on any other step (sparse, once per episode). Two
@@ -87,10 +87,10 @@ privileged cues:
     phase, not the action. The scripted `ImitationController` reads the action from the task (an
     oracle baseline); the reward reads outcomes from the world
 two learners:
-    `parallel_env()`: `infant_1` (the adult by default) sees its `instruction` and is rewarded for
-    demonstrating it, `infant_0` for reproducing the demonstrator's act; the same learner in both
-    roles needs an infant demonstrator (`per_agent=[{}, {"body": "infant"}]`: both 18-month-olds;
-    the poses work for both bodies, tested)
+    `parallel_env()`: `caregiver_0` (the adult by default) sees its `instruction` and is rewarded
+    for demonstrating it, `infant_0` for reproducing the demonstrator's act; the same learner in
+    both roles needs an infant demonstrator (`per_agent=[{}, {"body": "infant"}]`: both
+    18-month-olds; the poses work for both bodies, tested)
 baselines:
     scripted demonstrator, learner's eyes rendered, 30 episodes (seeds 1000-1029: head_touch 4,
     hand_raise 6, clap 15, push_box 5 demonstrated): scripted `ImitationController` (reads the
@@ -122,10 +122,10 @@ read only each agent's own body and its own box: contacts of its hands with its 
 other, its right palm's height over its head, how far its box slid away from it.
 
 ``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns a
-:class:`~mimo_social.core.env.MimoParallelEnv` with two learners (``infant_1`` demonstrates the
+:class:`~mimo_social.core.env.MimoParallelEnv` with two learners (``caregiver_0`` demonstrates the
 action of its ``instruction``, ``infant_0`` reproduces it); ``env(...)`` the AEC version;
 ``scripted_env(partner=None, **kwargs)`` a one-learner env (``infant_0`` learns) whose demonstrator
-``infant_1`` (the kneeling adult caregiver by default) is driven by a scripted
+``caregiver_0`` (the kneeling adult caregiver by default) is driven by a scripted
 :class:`~mimo_social.partners.Partner`, by default
 :class:`~mimo_social.tasks.imitation.demonstrator.Demonstrator` (the task option
 ``scripted_partner`` is set: the demonstrator has no eyes and no reward).

@@ -2,7 +2,7 @@
 
 agents:
     2: `infant_0` (the learner) and `infant_1` (the partner: scripted, by default `GazeAtTarget`,
-    which looks at one toy after another, or a second learner)
+    which looks at one toy after another, or a second learner; an adult partner is `caregiver_0`)
 body:
     sitting, hip fixed in the world, every joint held except the head (swivel, tilt, sideways tilt)
     and the eyes (horizontal, vertical, torsional), which are motors: each agent turns its own head

@@ -2,7 +2,7 @@
 
 agents:
     2: `infant_0` (the learner) and `infant_1` (the partner: scripted, e.g. `ExpressionShow`, or a
-    second learner)
+    second learner; an adult partner is `caregiver_0`)
 body:
     standing, hip fixed in the world, every joint held; head and eyes held at rest, looking straight
     ahead: the partner's face (at the same height, `distance` away) is in the middle of both eye

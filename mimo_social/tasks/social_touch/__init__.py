@@ -1,9 +1,9 @@
 """Social touch: a sitting infant touches a named part of its partner's body, who feels it.
 
 agents:
-    2: the toucher `infant_0` and the touched infant `infant_1`, sitting cross-legged face to face,
-    `distance` (0.37 m; 0.35 to 0.40) apart hip to hip: sitting infants at play, arms' length and a
-    lean apart; exactly two (a third raises an error)
+    2: the toucher `infant_0` and the touched infant `infant_1` (an adult is `caregiver_0`), sitting
+    cross-legged face to face, `distance` (0.37 m; 0.35 to 0.40) apart hip to hip: sitting infants
+    at play, arms' length and a lean apart; exactly two (a third raises an error)
 body:
     hips fixed on the floor, legs crossed, knees bent to -145 deg (the crossed feet of the two stay
     apart); the toucher: everything but the right arm and the eyes held, the trunk bent forward

@@ -1,10 +1,11 @@
 """Still face: face-to-face play, then the caregiver's still, unresponsive face, then reunion.
 
 agents:
-    2: `infant_0` (the learner infant) and `infant_1` (the caregiver: by default the adult body
-    kneeling, `body="adult"`, `posture="kneeling"`; an infant partner is allowed, e.g.
-    `per_agent=[{}, {"body": "infant", "posture": "sitting"}]`); scripted (`scripted_env`: by
-    default a `ContingentCaregiver`, `partners/contingent.py`) or a second learner
+    2: `infant_0` (the learner infant) and `caregiver_0` (the caregiver: by default the adult body
+    kneeling, `body="adult"`, `posture="kneeling"`; an infant partner, then named `infant_1`, is
+    allowed, e.g. `per_agent=[{}, {"body": "infant", "posture": "sitting"}]`); scripted
+    (`scripted_env`: by default a `ContingentCaregiver`, `partners/contingent.py`) or a second
+    learner
 body:
     the learner sits (the infant seat of the paradigm), hip fixed in the world, every joint held
     except head and eyes (9 motors) and, with `arms_free` (on), both shoulders and elbows (8
@@ -146,9 +147,9 @@ version history:
 
 ``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns a
 :class:`~mimo_social.core.env.MimoParallelEnv` with two learners (the infant ``infant_0`` and the
-caregiver ``infant_1``, by default the kneeling adult; the task holds the caregiver still in the
+caregiver ``caregiver_0``, by default the kneeling adult; the task holds the caregiver still in the
 still phase, whatever its actions); ``env(...)`` the AEC version; ``scripted_env(partner=None,
-**kwargs)`` a one-learner env (``infant_0`` learns) whose caregiver ``infant_1`` is driven by a
+**kwargs)`` a one-learner env (``infant_0`` learns) whose caregiver ``caregiver_0`` is driven by a
 scripted :class:`~mimo_social.partners.Partner`, by default
 :class:`~mimo_social.partners.contingent.ContingentCaregiver`: before every step the wrapper sets a
 partner that has ``set_mode`` to ``"still"`` in the still phase and to ``"interactive"`` in the
