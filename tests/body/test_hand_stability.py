@@ -19,10 +19,12 @@ import pytest
 
 from mimo_social.envs import free_play_v0
 
-# Two infants sitting face to face 0.26 m apart, their legs touching: a start where MuJoCo
-# 4.0.0's sparse factorization went wrong in the very first physics step.
-FACE_TO_FACE = [{"position": [-0.13, 0.0], "facing": [1.0, 0.0]},
-                {"position": [0.13, 0.0], "facing": [-1.0, 0.0]}]
+# Two infants sitting face to face 0.69 m apart, their toes touching (within the start check's
+# 1 cm). Until issue 31 they sat 0.26 m apart, a thigh 7.4 cm inside the other's, which the env
+# now refuses: the start where MuJoCo 4.0.0's sparse factorization went wrong in the very
+# first physics step.
+FACE_TO_FACE = [{"position": [-0.345, 0.0], "facing": [1.0, 0.0]},
+                {"position": [0.345, 0.0], "facing": [-1.0, 0.0]}]
 
 
 def first_steps(hands, physics=None, n=5):
