@@ -204,27 +204,31 @@ def test_caregiver_looks_where_the_learner_looks_then_back_at_its_face(caregiver
                                                                           lr.gaze_point)
 
 
-def _reach_pose(env, target_geom):
-    """The learner's right shoulder and elbow angles that bring its palm to ``target_geom``."""
+def _reach_pose(env, target_geom, depth=0.04):
+    """The learner's right shoulder and elbow angles that bring its palm toward the point
+    ``depth`` m inside ``target_geom`` from its surface point nearest the palm (aimed at the
+    geom's centre, an adult's thigh is out of an infant's reach)."""
     w = env.unwrapped.world
     m, d = w.model, w.data
     a0 = w.agents[0]
     idx = [a0.joint_names.index(n) for n in RIGHT_SHOULDER_ELBOW]
+    g = m.geom(target_geom).id
+    ends = np.zeros(6)
+    mujoco.mj_geomDistance(m, d, g, m.geom("infant_0/right_palm").id, 1.0, ends)
+    inward = d.geom_xpos[g] - ends[:3]
+    point = ends[:3] + depth * inward / np.linalg.norm(inward)
     s = mujoco.MjData(m)
     s.qpos[:] = d.qpos
     reach_sites(m, s, a0.qpos_adr[idx], a0.dof_adr[idx], *a0.joint_range[idx].T,
-                int(a0.palm_sites[0]), d.geom_xpos[m.geom(target_geom).id])
+                int(a0.palm_sites[0]), point)
     return {n: float(s.qpos[a0.qpos_adr[k]]) for n, k in zip(RIGHT_SHOULDER_ELBOW, idx)}
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "its start had the learner's shin 8.4 cm inside the kneeling adult's thigh (0.3 m apart), "
-    "which the env now refuses; placed clear (0.33 m, the learner cross-legged) the scripted "
-    "reach no longer touches the thigh: the reach needs redoing (issue 31)"))
 def test_touch_is_answered_with_a_pat_toward_the_touching_arm():
-    """The learner reaches for the kneeling adult's thigh (0.3 m apart, the adult leaning 15
-    degrees): the touch onset is an event, answered after the delay with a pat whose palm comes
-    at least 15 cm nearer the learner's touching arm than it starts."""
+    """The learner reaches for the kneeling adult's thigh (asked 0.3 m apart, moved out to 0.33 m
+    where the learner's shin would start inside the thigh; the adult leaning 15 degrees): the
+    touch onset is an event, answered after the delay with a pat whose palm comes at least 15
+    cm nearer the learner's touching arm than it starts."""
     p = ContingentCaregiver(cues=("touch",), delay_s=0.2, duration_s=1.0)
     env = face_env(p, ADULT_POS, distance=0.3, lean=15.0)
     env.reset(seed=0)
