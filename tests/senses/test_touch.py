@@ -296,10 +296,12 @@ def test_density_scales_point_counts():
 
 
 def _lying_pair(**touch):
+    """Two infants lying side by side, head to feet, their fingertips touching (0.18 m apart a
+    forearm started 4.9 cm inside the other's thigh, which the env refuses)."""
     return free_play_v0.parallel_env(
         n_agents=2, touch=touch or True, expressions=False,
-        per_agent=[{"position": (0.0, -0.09), "facing": (1.0, -0.09), "posture": "lying"},
-                   {"position": (0.0, 0.09), "facing": (-1.0, 0.09), "posture": "lying"}])
+        per_agent=[{"position": (0.0, -0.14), "facing": (1.0, -0.14), "posture": "lying"},
+                   {"position": (0.0, 0.14), "facing": (-1.0, 0.14), "posture": "lying"}])
 
 
 def _rollout(env, seed, steps):
