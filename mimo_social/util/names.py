@@ -24,11 +24,13 @@ _OLD = re.compile(r"infant_(\d+)")
 
 def agent_names(bodies: Sequence[str]) -> list[str]:
     """The agents' names from their body kinds in world order (``["infant", "adult"]`` ->
-    ``["infant_0", "caregiver_0"]``); a body that is not ``"adult"`` counts as an infant."""
+    ``["infant_0", "caregiver_0"]``); anything but the string ``"adult"`` counts as an infant
+    (a malformed body, e.g. an array, is named so and then refused by the config's check)."""
     counts: dict[str, int] = {}
     names = []
     for body in bodies:
-        prefix = KIND_PREFIX["adult"] if body == "adult" else KIND_PREFIX["infant"]
+        adult = isinstance(body, str) and body == "adult"
+        prefix = KIND_PREFIX["adult"] if adult else KIND_PREFIX["infant"]
         names.append(f"{prefix}_{counts.get(prefix, 0)}")
         counts[prefix] = counts.get(prefix, 0) + 1
     return names

@@ -74,9 +74,11 @@ class Statues(Task):
 
 
 def statues(places, posture, arm=None, props=(), **touch):
-    """An env of statues; ``touch`` settings as keyword arguments."""
+    """An env of statues; ``touch`` settings as keyword arguments; text infos (the touched parts
+    by name), also where a module-scoped fixture makes it before the text_infos mark applies."""
     env = MimoParallelEnv(Statues(len(places), places, arm, props), touch=touch or True,
-                          posture=posture, expressions=False, proprioception=False)
+                          posture=posture, expressions=False, proprioception=False,
+                          info_text=True)
     env.reset(seed=0)
     return env
 
