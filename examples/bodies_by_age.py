@@ -17,6 +17,7 @@ from mimo_social.body.postures import posture_joints
 from mimo_social.body.tables import load_body
 from mimo_social.core.env import MimoParallelEnv
 from mimo_social.core.world import AgentSetup
+from mimo_social.figures import free_camera_pixel
 from mimo_social.tasks.free_play import FreePlay
 
 #: (label, agent settings) from left to right
@@ -50,20 +51,6 @@ def standing_height(env, i: int) -> float:
     return top - float(_support_below(m, d, g).min())
 
 
-def _pixel(cam, point, height: int, width: int, fovy_deg: float) -> tuple[float, float]:
-    """Where a world point appears in the image of a free camera (pinhole projection)."""
-    az, el = np.deg2rad(cam.azimuth), np.deg2rad(cam.elevation)
-    forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
-    eye = np.asarray(cam.lookat) - cam.distance * forward
-    right = np.cross(forward, (0.0, 0.0, 1.0))
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    d = np.asarray(point, float) - eye
-    f = 0.5 * height / np.tan(np.deg2rad(fovy_deg) / 2)
-    z = d @ forward
-    return 0.5 * width + f * (d @ right) / z, 0.5 * height - f * (d @ up) / z
-
-
 def main(path: str = "docs/bodies_by_age.png") -> None:
     env = MimoParallelEnv(Lineup(len(BODIES)), per_agent=[s for _, s in BODIES],
                           render_mode="rgb_array", render_size=(600, 1200), vestibular=False)
@@ -86,7 +73,7 @@ def main(path: str = "docs/bodies_by_age.png") -> None:
     draw = ImageDraw.Draw(image)
     fovy = float(env.world.model.vis.global_.fovy)
     for (label, _), y in zip(BODIES, SPOTS):
-        u, v = _pixel(cam, (0.0, y, -0.04), frame.shape[0], frame.shape[1], fovy)
+        u, v = free_camera_pixel(cam, (0.0, y, -0.04), frame.shape[0], frame.shape[1], fovy)
         draw.text((u - 3 * len(label), v), label, fill=(20, 20, 20))
     image.save(path)
     print(f"wrote {path}")

@@ -15,8 +15,8 @@ from .body.joint_groups import held_posture
 from .core.world import AgentSetup, Prop
 from .tasks.free_play import FreePlay
 
-__all__ = ["GAZE_TURNS", "HOLD_BALL_ARM", "THREE_SIZES", "eye_turn", "geom_triangles",
-           "hand_ball_scene", "save_expressions_png", "save_hand_ball_png",
+__all__ = ["GAZE_TURNS", "HOLD_BALL_ARM", "THREE_SIZES", "eye_turn", "free_camera_pixel",
+           "geom_triangles", "hand_ball_scene", "save_expressions_png", "save_hand_ball_png",
            "save_partner_gaze_png", "save_three_sizes_png", "FIGURES"]
 
 
@@ -346,7 +346,7 @@ def save_three_sizes_png(path) -> str:
         top = float(w.data.site_xpos[a.head_site, 2] + w.model.geom_size[a.head_geom, 0])
         feet = w.data.xpos[a.root_body] * (1, 1, 0)            # on the floor below the body
         mass = w.model.body_subtreemass[a.root_body]
-        x, y = _free_camera_pixel(cam, feet, h, wd, float(w.model.vis.global_.fovy))
+        x, y = free_camera_pixel(cam, feet, h, wd, float(w.model.vis.global_.fovy))
         ax.annotate(f"{env.agents[i]}: {label}\n{top:.2f} m, {mass:.0f} kg", (x, y),
                     xytext=(0, -8), textcoords="offset points", ha="center", va="top",
                     fontsize=7, bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="0.6",
@@ -359,8 +359,9 @@ def save_three_sizes_png(path) -> str:
     return str(path)
 
 
-def _free_camera_pixel(cam, point, height: int, width: int, fovy_deg: float):
-    """Where a world point appears (x, y pixels) in the image of a free camera."""
+def free_camera_pixel(cam, point, height: int, width: int, fovy_deg: float):
+    """Where a world point appears (x, y pixels) in the image of a free camera (MjvCamera's
+    azimuth, elevation, distance and lookat; a pinhole of vertical field of view ``fovy_deg``)."""
     az, el = np.deg2rad(cam.azimuth), np.deg2rad(cam.elevation)
     forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
     eye = np.asarray(cam.lookat) - cam.distance * forward
