@@ -105,6 +105,7 @@ def build_infant(
     strength: float = 1.0,
     age_months: float | None = None,
     body: str = "infant",
+    motor_age_months: float | None = None,
 ) -> InfantBuild:
     """Build one infant.
 
@@ -123,8 +124,10 @@ def build_infant(
         age_months: the infant's age, 0 to 33 months (segments from growth curves, see
             :mod:`~mimo_social.body.growth`); None: the published 18-month body.
         body: ``"infant"`` or ``"adult"`` (the adult caregiver's tables, ``body/adult.py``).
+        motor_age_months: the motors' age (torques, muscle forces: those of the body grown to
+            it), 0 to 33 months; None: the body's age.
     """
-    tables = load_body(hands, scale, strength, age_months, body)
+    tables = load_body(hands, scale, strength, age_months, body, motor_age_months)
     if base not in ("free", "fixed"):
         raise ValueError(f"base={base!r}; allowed: 'free', 'fixed'")
     by_name = {j.name: j for j in tables.joints}

@@ -132,6 +132,7 @@ class BodyTables:
     scale: float = 1.0      # the size factor these tables were scaled by (see scale_body)
     strength: float = 1.0   # the strength factor on top of the size law
     age_months: float | None = None  # the age grown to (body/growth.py); None: the 18-month body
+    motor_age_months: float | None = None  # the motors' age when not the body's (load_body)
     body: str = "infant"    # "infant" or "adult" (body/adult.py)
 
     @property
@@ -212,13 +213,19 @@ AGE_RANGE = (0.0, 33.0)
 
 
 def load_body(hands: str = "mitten", scale: float = 1.0, strength: float = 1.0,
-              age_months: float | None = None, body: str = "infant") -> BodyTables:
+              age_months: float | None = None, body: str = "infant",
+              motor_age_months: float | None = None) -> BodyTables:
     """The measurement tables of one hand version with the mirrored left side: the infant grown
     to ``age_months`` (0 to 33; None: the published 18-month body; see ``body/growth.py``) or,
     for ``body="adult"``, the adult caregiver (``body/adult.py``); then scaled to a body
     ``scale`` times that size and ``strength`` times its strength (see :func:`scale_body`).
     ``scale=1, strength=1, age_months=None`` gives the published tables unchanged, and so does
     ``age_months=18``, bit for bit.
+
+    ``motor_age_months`` (infants, 0 to 33; None: the body's age): the motors of another age:
+    every joint's motor torque (``gear``) and muscle force (``fmax_neg``, ``fmax_pos``) are
+    those of the body grown to ``motor_age_months`` (its volume-law strength, what a body of
+    that age has); sizes, masses and passive joint parameters stay the body's.
 
     Cached: the same arguments give the same (immutable) object.
     """
@@ -231,8 +238,35 @@ def load_body(hands: str = "mitten", scale: float = 1.0, strength: float = 1.0,
             raise ValueError(f"age_months={age_months!r} is for infant bodies; body={body!r} "
                              "takes age_months=None")
         age_months = _factor("age_months", age_months, AGE_RANGE)
-    return _load(hands, _factor("scale", scale, SCALE_RANGE),
-                 _factor("strength", strength, STRENGTH_RANGE), age_months, body)
+    scale = _factor("scale", scale, SCALE_RANGE)
+    strength = _factor("strength", strength, STRENGTH_RANGE)
+    tables = _load(hands, scale, strength, age_months, body)
+    if motor_age_months is None:
+        return tables
+    if body != "infant":
+        raise ValueError(f"motor_age_months={motor_age_months!r} is for infant bodies; "
+                         f"body={body!r} takes motor_age_months=None")
+    motor = _factor("motor_age_months", motor_age_months, AGE_RANGE)
+    if motor == (REFERENCE_AGE if age_months is None else age_months):
+        return tables
+    return _with_motors(hands, scale, strength, age_months, motor)
+
+
+#: the age (months) of the published body (``age_months=None``)
+REFERENCE_AGE = 18.0
+
+
+@functools.lru_cache(maxsize=None)
+def _with_motors(hands: str, scale: float, strength: float, age_months: float | None,
+                 motor_age_months: float) -> BodyTables:
+    """The infant's tables at ``age_months`` with every joint's motor torque and muscle force
+    from the same body grown to ``motor_age_months``."""
+    tables = _load(hands, scale, strength, age_months, "infant")
+    motors = _load(hands, scale, strength, motor_age_months, "infant")
+    strong = {j.name: j for j in motors.joints}
+    joints = tuple(replace(j, gear=strong[j.name].gear, fmax_neg=strong[j.name].fmax_neg,
+                           fmax_pos=strong[j.name].fmax_pos) for j in tables.joints)
+    return replace(tables, joints=joints, motor_age_months=motors.age_months)
 
 
 #: The makers of the bodies other than the published infant: ``"grow"`` ->
@@ -266,6 +300,7 @@ def _load(hands: str, scale: float, strength: float, age_months: float | None = 
 def _cache_clear() -> None:
     """Forget every loaded table (after the CSV files changed, e.g. a muscle calibration)."""
     _load.cache_clear()
+    _with_motors.cache_clear()
     _published.cache_clear()
     for maker in MAKERS.values():     # the adult's tables are cached by their maker
         getattr(maker, "cache_clear", lambda: None)()

@@ -86,6 +86,12 @@ class AgentConfig:
     # The infant's age in months (0 to 33): every segment from the growth curves; None: the
     # published 18-month-old, unchanged. Only for body="infant".
     age_months: float | None = None
+    # The infant's motor age in months (0 to 33): motor strength (each motor's torque limits,
+    # each muscle's fmax) and the sensorimotor delays of delays="developmental". A joint's
+    # strength at body age B and motor age M is the volume-law strength of the body grown to M
+    # (what a fresh build at age M has): the motor develops as in a typical infant of age M.
+    # None: follows age_months (18 for the published body). Only for body="infant".
+    motor_age_months: float | None = None
     # Sensorimotor delays: None (none), "developmental" (published figures for the agent's age,
     # docs/bodies.md) or a mapping channel -> milliseconds for channels of DELAY_CHANNELS
     # (missing channels: 0); applied in whole control steps.
@@ -119,6 +125,12 @@ class AgentConfig:
                 raise ConfigError(f"age_months={show(self.age_months)} is for infant bodies; "
                                   f"body={self.body!r} takes None")
             put("age_months", check_number("", "age_months", self.age_months, *AGE_RANGE))
+        if self.motor_age_months is not None:
+            if self.body != "infant":
+                raise ConfigError(f"motor_age_months={show(self.motor_age_months)} is for "
+                                  f"infant bodies; body={self.body!r} takes None")
+            put("motor_age_months", check_number("", "motor_age_months",
+                                                  self.motor_age_months, *AGE_RANGE))
         put("delays", _parse_delays(self.delays))
 
     @property
@@ -128,6 +140,14 @@ class AgentConfig:
         if self.body == "adult":
             return None
         return 18.0 if self.age_months is None else self.age_months
+
+    @property
+    def motor_age(self) -> float | None:
+        """The age in months the motors and the developmental delays follow:
+        ``motor_age_months``, else :attr:`age`; None for an adult."""
+        if self.body == "adult":
+            return None
+        return self.age if self.motor_age_months is None else self.motor_age_months
 
 
 def _parse_delays(value):

@@ -48,13 +48,14 @@ MAX_DELAY_STEPS = 1000
 
 def delays_ms(config) -> dict[str, float]:
     """Every channel's delay in milliseconds for an :class:`AgentConfig`: none (0) for
-    ``delays=None``, the published figures at ``config.age`` for ``"developmental"``, else the
-    channels given (others 0)."""
+    ``delays=None``, the published figures at ``config.motor_age`` (the motor age, which is the
+    body age unless ``motor_age_months`` is given) for ``"developmental"``, else the channels
+    given (others 0)."""
     given = config.delays
     if given is None:
         return dict.fromkeys(CHANNELS, 0.0)
     if given == "developmental":
-        return developmental_delays(config.age)
+        return developmental_delays(config.motor_age)
     return {c: float(given.get(c, 0.0)) for c in CHANNELS}
 
 
@@ -74,7 +75,7 @@ def check_delay_steps(agent: str, config, dt: float) -> dict[str, int]:
             and (c == "motor" or getattr(config, c, None))]
     if over:
         c, ms = over[0], delays_ms(config)[over[0]]
-        age = "an adult" if config.age is None else f"{config.age:g} months"
+        age = "an adult" if config.motor_age is None else f"{config.motor_age:g} months"
         given = (f"delays='developmental' ({age}) gives {c} {ms:g} ms"
                  if config.delays == "developmental" else f"delays[{c!r}]={ms:g} ms")
         longest = MAX_DELAY_STEPS * dt * 1000.0

@@ -204,7 +204,8 @@ class World:
             rgba = cfg.clothes_rgba or CLOTHES_PALETTE[i % len(CLOTHES_PALETTE)]
             build = build_infant(cfg.hands, setup.frozen, setup.base, rgba,
                                  scale=cfg.scale, strength=cfg.strength,
-                                 age_months=cfg.age_months, body=cfg.body)
+                                 age_months=cfg.age_months, body=cfg.body,
+                                 motor_age_months=cfg.motor_age_months)
             unknown = sorted(set(setup.actuated or ()) - set(build.actuated))
             if unknown:
                 raise ValueError(f"{self.names[i]}: cannot actuate {unknown}: not motor joints "
