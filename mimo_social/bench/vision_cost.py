@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ctypes
 import json
+import math
 import os
 import subprocess
 import sys
@@ -22,7 +23,7 @@ from ..envs import free_play_v0
 from ..render.eye_renderer import Tile, TileRenderer, shared_gl_context
 
 __all__ = ["BENCH_VARIANTS", "bench_states", "bench_images", "bench_env", "measure",
-           "measure_backend", "format_results"]
+           "measure_backend", "format_results", "FOVEA_CONFIGS", "bench_fovea", "format_fovea"]
 
 #: Per-image variants, each adding one change to the one before (``final`` is what the env uses).
 BENCH_VARIANTS = {
@@ -259,4 +260,36 @@ def format_results(results: dict) -> str:
             lines.append(f"{b} | {r['config']} | vision {r['vision']:.4f} | total "
                          f"{r['total']:.4f} | physics {r['physics']:.4f} | touch "
                          f"{r.get('touch', 0):.4f}")
+    return "\n".join(lines)
+
+
+#: :func:`bench_fovea`'s configurations: one infant, eyes of each size, fovea off and on
+FOVEA_CONFIGS = {f"{size}x{size}, fovea {name}": dict(
+    n_agents=1, vision={"width": size, "height": size, "fovea": fovea})
+    for size in (64, 128) for name, fovea in (("off", None), ("2", 2), ("4", 4))}
+
+
+def bench_fovea(sim_seconds: float = 5.0, seed: int = 0) -> list[dict]:
+    """What a fovea costs: :func:`bench_env` over :data:`FOVEA_CONFIGS` (taking turns), with
+    milliseconds per control step of the vision system and of the whole step."""
+    env = free_play_v0.parallel_env(n_agents=1)
+    dt = env.dt
+    env.close()
+    out = bench_env(FOVEA_CONFIGS, sim_seconds=sim_seconds, seed=seed)
+    for r in out:        # seconds per simulated second -> milliseconds per control step
+        r["vision_ms_per_step"] = 1e3 * r["vision"] * dt
+        r["total_ms_per_step"] = 1e3 * r["total"] * dt
+    return out
+
+
+def format_fovea(results: list[dict]) -> str:
+    """:func:`bench_fovea`'s results as a markdown table."""
+    lines = ["| eyes (1 infant, 2 eyes) | fovea (strength; rendered side) | vision ms / step | "
+             "step ms | real s / simulated s |", "|---|---|---|---|---|"]
+    for r in results:
+        size, fovea = FOVEA_CONFIGS[r["config"]]["vision"]["width"], \
+            FOVEA_CONFIGS[r["config"]]["vision"]["fovea"]
+        what = "off" if fovea is None else f"{fovea:g}; {size * math.ceil(fovea)} px"
+        lines.append(f"| {size}x{size} | {what} | {r['vision_ms_per_step']:.2f} | "
+                     f"{r['total_ms_per_step']:.2f} | {r['total']:.3f} |")
     return "\n".join(lines)

@@ -35,6 +35,9 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
     parser.add_argument("--rounds", type=positive_int, default=5)
     parser.add_argument("--sim-seconds", type=positive_float, default=5.0)
     parser.add_argument("--json", default=None, type=output_file, help="write all results here")
+    parser.add_argument("--fovea", action="store_true",
+                        help="only the cost of foveated eyes: one infant, 64x64 and 128x128 "
+                             "eyes, fovea off, strength 2 and 4, taking turns, in this process")
     parser.add_argument("--worker", action="store_true",
                         help="measure in this process only and print one JSON line")
     parser.set_defaults(func=run)
@@ -42,6 +45,12 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.fovea:
+        results = vision_cost.bench_fovea(args.sim_seconds)
+        print(vision_cost.format_fovea(results))
+        if args.json:
+            write_file(args.json, json.dumps(results, indent=1))
+        return 0
     if args.worker:
         print("JSON" + json.dumps(vision_cost.measure(args.rounds, args.sim_seconds)))
         return 0

@@ -18,6 +18,13 @@ images stay sharp). ``VisionSystem.cutoffs`` holds each agent's cut-off (None: n
 :class:`AcuityBlur` is the identity where the cut-off is at or above the image's Nyquist
 frequency (e.g. 18 months' 12.4 cycles per degree needs eyes 1640 pixels tall to act).
 
+Foveated eyes (``fovea``, :mod:`mimo_social.senses.fovea`): None (the default) leaves the images
+as rendered; a strength ``s`` (or ``{"strength": s, "render_scale": k}``) renders each eye ``k``
+times larger, blurs it there (acuity, in degrees), then warps it to ``height`` x ``width`` with
+the centre magnified ``s`` times and the whole field of view kept; depth images take the same
+warp (nearest pixel). The observation spaces keep their shapes. ``VisionSystem.foveas`` holds
+each agent's :class:`~mimo_social.senses.fovea.FovealWarp` (None: off).
+
 One :class:`VisionSystem` per world renders every agent's eyes once per control step, after the
 physics and before any agent observes, every ``every``-th step (``every=1``: every step; the
 images of the steps between are the last ones rendered), and at once after a reset. All eyes
@@ -50,6 +57,7 @@ from ..util.checks import check_bool, check_int
 from ..util.names import reject_old_names
 from .acuity import acuity_blur, check_acuity, cutoff_for
 from .base import SenseEntry
+from .fovea import FovealWarp, check_fovea
 
 __all__ = ["VisionConfig", "VisionSystem", "VisionSense", "build_vision", "vision_system",
            "eye_images", "render_now", "anaglyph", "save_anaglyph", "write_png", "EYES", "SENSE"]
@@ -66,6 +74,11 @@ class VisionConfig:
     depth: bool = False     # depth images too (metres), `depth_left` / `depth_right`
     every: int = 1          # render every k-th control step, holding the last images between
     acuity: float | str | None = None   # None | "age" | cut-off in cycles per degree
+    # Foveated eyes: None (off), True (strength 4), a strength (the magnification at the
+    # image centre, 1 to 16) or a mapping {"strength": ..., "render_scale": ...}; the eye is
+    # rendered render_scale (1 to 8, default: the strength rounded up) times larger and warped
+    # to width x height, centre magnified, the whole field of view kept (docs/senses.md)
+    fovea: float | dict | None = None
 
     def __post_init__(self):
         for key in ("width", "height"):
@@ -73,6 +86,7 @@ class VisionConfig:
         object.__setattr__(self, "depth", check_bool("vision", "depth", self.depth))
         object.__setattr__(self, "every", check_int("vision", "every", self.every, 1, 1000))
         object.__setattr__(self, "acuity", check_acuity(self.acuity))
+        object.__setattr__(self, "fovea", check_fovea(self.fovea, self.width, self.height))
 
 
 class VisionSystem:
@@ -84,19 +98,22 @@ class VisionSystem:
         self.configs = list(configs)
         self.agents = [i for i, c in enumerate(self.configs) if c]
         tiles, groups, self._tile_of = [], [], {}
-        self.cameras, self.cutoffs, self._blur = {}, {}, {}
+        self.cameras, self.cutoffs, self._blur, self.foveas = {}, {}, {}, {}
         for i in self.agents:
             cfg = self.configs[i]
             right, left = (int(c) for c in world.agents[i].eye_cameras)
             self.cameras[i] = {"left": left, "right": right}
             self.cutoffs[i] = cutoff_for(cfg.acuity, world.agent_setups[i].config.age)
-            self._blur[i] = acuity_blur(self.cutoffs[i], cfg.height, cfg.width,
+            # with a fovea: rendered k times larger, blurred there (in degrees), then warped
+            k = cfg.fovea.render_scale if cfg.fovea else 1
+            self.foveas[i] = FovealWarp(cfg.fovea, cfg.height, cfg.width) if cfg.fovea else None
+            self._blur[i] = acuity_blur(self.cutoffs[i], cfg.height * k, cfg.width * k,
                                         float(world.model.cam_fovy[left]))
             group = []
             for eye in EYES:
                 self._tile_of[i, eye] = len(tiles)
                 group.append(len(tiles))
-                tiles.append(Tile(cfg.width, cfg.height, cfg.depth))
+                tiles.append(Tile(cfg.width * k, cfg.height * k, cfg.depth))
             groups.append(group)
         self._tiles, self._groups = tiles, groups
         self.renderer: TileRenderer | None = None
@@ -130,12 +147,13 @@ class VisionSystem:
         jobs = [(self._tile_of[i, e], self.cameras[i][e]) for i in agents for e in EYES]
         result = self.renderer.render(model, data, jobs)
         for i in agents:
-            imgs, blur = {}, self._blur[i]
+            imgs, blur, fovea = {}, self._blur[i], self.foveas[i]
             for e in EYES:
                 rgb, depth = result[self._tile_of[i, e]]
-                imgs[f"eye_{e}"] = rgb if blur is None else blur(rgb)
+                rgb = rgb if blur is None else blur(rgb)
+                imgs[f"eye_{e}"] = rgb if fovea is None else fovea.rgb(rgb)
                 if depth is not None:
-                    imgs[f"depth_{e}"] = depth
+                    imgs[f"depth_{e}"] = depth if fovea is None else fovea.depth(depth)
             self.images[i] = imgs
             self.fresh[i] = True
             self.renders[i] += 1
