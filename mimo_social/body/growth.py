@@ -12,9 +12,24 @@ Data (``body/data``, sources in ``body/data/README.md``):
 
 A segment's factor at an age is ``measurement(age) / measurement(18)``: the 18-month body is the
 published one (every factor exactly 1, the tables bit for bit) and every other age keeps its
-hand-tuned proportions. :func:`grow_body` applies the factors with
-:func:`~mimo_social.body.resize.resize_body` (masses at constant density, torques and passive
-joint parameters with the volume of the part a joint moves; see there).
+hand-tuned proportions.
+
+Below the survey's youngest group (mean age 1 month, :data:`YOUNGEST_GROUP`) the curves have no
+data, and three of them cannot be extrapolated: the fits of upper-arm and forearm circumference
+stopped at ``b`` = 0.1 to 15 digits (a bound of the fit) and hip breadth's at 0.105, so they
+fall without limit towards -0.1 months. At birth they made the trunk (half the body's mass; hip
+breadth sets it both ways) 0.57 of its 18-month size, volume 0.18, where the other curves keep
+0.63-0.76 of theirs: the newborn came out 2.81 kg, 15 % under the WHO median. Below 1 month
+every measurement is therefore its 1-month value times ``head_circumference(age) /
+head_circumference(1)``: the body keeps the proportions of the youngest measured group and
+grows isometrically, as the WHO medians say infants do in their first month (length x1.095,
+head circumference x1.080, weight x1.316 = 1.095^3.04), at the pace of the one curve whose newborn
+value a standard checks (head circumference at birth 34.44 cm; WHO median 34.17 cm).
+``body/data/README.md`` and ``docs/validation.md`` give the figures.
+
+:func:`grow_body` applies the factors with :func:`~mimo_social.body.resize.resize_body` (masses
+at constant density, torques and passive joint parameters with the volume of the part a joint
+moves; see there).
 """
 
 from __future__ import annotations
@@ -28,11 +43,16 @@ from importlib import resources
 from .resize import resize_body
 from .tables import AGE_RANGE, BodyTables, load_body
 
-__all__ = ["AGE_RANGE", "REFERENCE_AGE", "measurement", "measurements", "segment_factors",
-           "grow_body", "who_medians", "growth_table"]
+__all__ = ["AGE_RANGE", "REFERENCE_AGE", "YOUNGEST_GROUP", "measurement", "measurements",
+           "segment_factors", "grow_body", "who_medians", "who_head_circumference",
+           "newborn_arm", "circumferences", "body_measures", "growth_table"]
 
 #: The age of the published body: every factor is 1 there.
 REFERENCE_AGE = 18.0
+#: The mean age (months) of the survey's youngest group: below it the body grows isometrically.
+YOUNGEST_GROUP = 1.0
+#: The measurement that paces growth below YOUNGEST_GROUP.
+_PACE = "head_circumference"
 
 
 def _rows(filename: str) -> list[dict]:
@@ -65,13 +85,22 @@ def _age(age_months) -> float:
     return age
 
 
+def _curve(name: str, age: float) -> float:
+    a, b, c = _curves()[name]
+    return a * math.log(age + b) + c
+
+
 def measurement(name: str, age_months: float) -> float:
-    """The measurement ``name`` (cm) at ``age_months``: ``a ln(age + b) + c``."""
-    curves = _curves()
-    if name not in curves:
-        raise ValueError(f"unknown growth measurement {name!r}; known: {sorted(curves)}")
-    a, b, c = curves[name]
-    return a * math.log(_age(age_months) + b) + c
+    """The measurement ``name`` (cm) at ``age_months``: ``a ln(age + b) + c`` from the
+    youngest group (1 month) on; below it the 1-month value times the head circumference's
+    ratio to its own 1-month value (isometric growth; see the module docstring)."""
+    if name not in _curves():
+        raise ValueError(f"unknown growth measurement {name!r}; known: {sorted(_curves())}")
+    age = _age(age_months)
+    if age >= YOUNGEST_GROUP:
+        return _curve(name, age)
+    pace = _curve(_PACE, age) / _curve(_PACE, YOUNGEST_GROUP)
+    return _curve(name, YOUNGEST_GROUP) * pace
 
 
 def _factor(expr: str, age: float) -> float:
@@ -129,6 +158,33 @@ def who_medians() -> dict:
     return out
 
 
+@functools.lru_cache(maxsize=None)
+def who_head_circumference() -> dict:
+    """WHO Child Growth Standards head-circumference-for-age medians, boys and girls averaged:
+    age (months) -> cm (``who_head_circumference.csv``; sources in ``body/data/README.md``)."""
+    return {float(r["age_months"]): (float(r["head_boys_cm"]) + float(r["head_girls_cm"])) / 2
+            for r in _rows("who_head_circumference.csv")}
+
+
+@functools.lru_cache(maxsize=None)
+def newborn_arm() -> dict:
+    """Term newborns' mid-upper-arm circumference (cm) and arm-to-head circumference ratio:
+    quantity -> mean, and quantity + ``"_sd"`` -> its SD (``newborn_arm.csv``)."""
+    out = {}
+    for r in _rows("newborn_arm.csv"):
+        out[r["quantity"]] = float(r["value"])
+        out[r["quantity"] + "_sd"] = float(r["sd"])
+    return out
+
+
+def circumferences(tables: BodyTables) -> dict:
+    """The body's head and mid-upper-arm circumferences (cm): ``2 pi r`` of the head sphere
+    and of the right upper arm's capsule."""
+    radius = {g.name: g.size[0] for g in tables.geoms}
+    return {"head": 200 * math.pi * radius["head"],
+            "upper_arm": 200 * math.pi * radius["right_upper_arm"]}
+
+
 def growth_table(hands: str = "mitten") -> list[tuple]:
     """Rows ``(age, height_cm, mass_kg, who_length_cm, who_weight_kg)`` for the ages of
     ``who_medians.csv``: the grown body's standing height (head top to soles, every joint at 0)
@@ -138,3 +194,18 @@ def growth_table(hands: str = "mitten") -> list[tuple]:
         t = load_body(hands, age_months=age)
         rows.append((age, 100 * t.standing_height, t.total_mass, length, weight))
     return rows
+
+
+def body_measures(ages, hands: str = "mitten") -> dict:
+    """The grown body at each of ``ages`` (months): arrays ``age``, ``height_cm`` (standing,
+    head top to soles), ``mass_kg``, ``head_cm`` and ``upper_arm_cm`` (circumferences)."""
+    import numpy as np
+
+    rows = []
+    for age in ages:
+        t = load_body(hands, age_months=float(age))
+        c = circumferences(t)
+        rows.append((float(age), 100 * t.standing_height, t.total_mass, c["head"],
+                     c["upper_arm"]))
+    cols = np.array(rows, float).reshape(-1, 5).T
+    return dict(zip(("age", "height_cm", "mass_kg", "head_cm", "upper_arm_cm"), cols))
