@@ -17,7 +17,8 @@ from .tasks.free_play import FreePlay
 
 __all__ = ["GAZE_TURNS", "HOLD_BALL_ARM", "THREE_SIZES", "eye_turn", "free_camera_pixel",
            "geom_triangles", "hand_ball_scene", "save_expressions_png", "save_hand_ball_png",
-           "save_partner_gaze_png", "save_three_sizes_png", "FIGURES"]
+           "save_partner_gaze_png", "save_three_sizes_png", "save_validation_body_png",
+           "FIGURES"]
 
 
 # the right arm held forward, palm up, the hand tilted 12 degrees towards the fingertips
@@ -374,6 +375,66 @@ def free_camera_pixel(cam, point, height: int, width: int, fovy_deg: float):
     return 0.5 * width + f * (rel @ right) / z, 0.5 * height - f * (rel @ up) / z
 
 
+def save_validation_body_png(path) -> str:
+    """The grown body (every 0.5 months, 0-24) against published infant data
+    (docs/validation.md): standing length and mass against the WHO medians with the tolerance
+    bands of the tests, head circumference against the WHO medians, and the newborn's
+    mid-upper-arm circumference and arm-to-head ratio against term newborns."""
+    from .body import growth
+
+    plt = _pyplot()
+    model = growth.body_measures(np.arange(0.0, 24.01, 0.5))
+    age = model["age"]
+    who = growth.who_medians()
+    head = growth.who_head_circumference()
+    arm = growth.newborn_arm()
+    fig, axes = plt.subplots(1, 4, figsize=(15, 3.8), dpi=110)
+    panels = (
+        ("Length (cm)", model["height_cm"], {a: v[0] for a, v in who.items()}, 0.07,
+         "WHO median"),
+        ("Mass (kg)", model["mass_kg"], {a: v[1] for a, v in who.items()}, 0.10,
+         "WHO median"),
+        ("Head circumference (cm)", model["head_cm"], head, 0.03,
+         "WHO median"))
+    for ax, (label, values, ref, tol, ref_label) in zip(axes, panels):
+        ra = np.array(sorted(ref))
+        rv = np.array([ref[a] for a in ra])
+        ax.fill_between(ra, rv * (1 - tol), rv * (1 + tol), color="0.85",
+                        label=f"tested band, +/- {100 * tol:.0f} %")
+        ax.plot(ra, rv, "o", color="k", ms=5, label=ref_label)
+        ax.plot(age, values, "-", color="tab:blue", lw=2, label="the model")
+        ax.set_xlabel("age (months)")
+        ax.set_title(label, fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="lower right")
+    ax = axes[3]
+    ratio = model["upper_arm_cm"] / model["head_cm"]
+    ax.plot(age, model["upper_arm_cm"], "-", color="tab:blue", lw=2,
+            label="model: mid-upper-arm circumference (cm)")
+    muac = "mid_upper_arm_circumference_cm"
+    ax.errorbar([0], [arm[muac]], yerr=[arm[muac + "_sd"]], fmt="s", color="k",
+                ms=5, capsize=3, label="term newborns (mean, SD)")
+    twin = ax.twinx()
+    twin.plot(age, ratio, "--", color="tab:orange", lw=1.5, label="model: arm / head")
+    ahr = "arm_to_head_circumference_ratio"
+    twin.errorbar([0.4], [arm[ahr]], yerr=[arm[ahr + "_sd"]], fmt="D",
+                  color="tab:red", ms=4, capsize=3, label="term newborns: arm / head")
+    twin.set_ylim(0.2, 0.4)
+    ax.set_ylim(8, 18)
+    ax.set_xlabel("age (months)")
+    ax.set_title("Mid-upper-arm circumference", fontsize=10)
+    ax.grid(alpha=0.3)
+    lines = ax.get_legend_handles_labels()
+    lines2 = twin.get_legend_handles_labels()
+    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], fontsize=7, loc="lower right")
+    fig.suptitle("The grown body (mitten hands) against infant data: WHO medians with boys and "
+                 "girls averaged, term newborns (docs/validation.md)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return str(path)
+
+
 #: the figures ``mimo-social figure NAME OUT.png`` draws: name -> (function(path), what it shows)
 FIGURES = {
     "skin-hand-ball": (save_hand_ball_png, "the skin of a hand holding a ball, coloured by force "
@@ -382,4 +443,6 @@ FIGURES = {
                                                  "eyes, and the learner's eye view of it"),
     "eyes-expressions": (save_expressions_png, "the seven expressions on a head with eyeballs"),
     "bodies-three-sizes": (save_three_sizes_png, "three body sizes in one world, labelled"),
+    "validation-body": (save_validation_body_png, "the grown body's length, mass, head and arm "
+                                                  "circumferences against infant data"),
 }
