@@ -31,6 +31,7 @@ the applied controls; task observations, sense infos and the expression are not 
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import Any, Mapping, Sequence
 
 import mujoco
@@ -46,6 +47,7 @@ from ..util.checks import check_bool, check_choice, check_seed, number_array, sh
 from ..util.names import reject_old_names
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
 from .delays import MotorDelay, SenseDelay, delay_steps, fill_sensor_history
+from .regrow import age_changes, age_options, regrow_senses
 from .infos import InfoEncoder
 from .rendering import SceneRendering
 from .task import Task, agent_user_settings, check_start_poses
@@ -146,6 +148,7 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
         self._bind()
         self._bind_task()
         self._rng = np.random.default_rng()
+        self._pending_ages: dict[int, dict] = {}   # age changes for the next reset (set_age)
         self._was_reset = False   # step() before the first reset() is an error, not a crash
         self._renderer = None
         self.timing = dict.fromkeys(TIMING_KEYS, 0.0)
@@ -200,12 +203,19 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
                                       if self.agent_configs[i].expressions else motors)
         self._expression = np.zeros(len(self.possible_agents), dtype=np.int64)
         self.controls = [np.zeros(act.n_controls) for act in self.actuation]
-        # ring buffers: per agent one per sense (None: undelayed; vestibular is MuJoCo's), motor
-        self._sense_delays = [[SenseDelay(k) if (k := self._delays[i][s.name]) and
-                               s.name != "vestibular" else None for s in self.senses[i]]
-                              for i in range(len(self.possible_agents))]
-        self._motor_delays = [MotorDelay(k, act.n_controls) if (k := self._delays[i]["motor"])
-                              else None for i, act in enumerate(self.actuation)]
+        self._sense_delays, self._motor_delays = [], []
+        for i in range(len(self.possible_agents)):
+            self._sense_delays.append(None)
+            self._motor_delays.append(None)
+            self._delay_rings(i)
+
+    def _delay_rings(self, i: int) -> None:
+        """Agent ``i``'s ring buffers: one per sense (None: undelayed; vestibular is MuJoCo's),
+        one for its motors."""
+        self._sense_delays[i] = [SenseDelay(k) if (k := self._delays[i][s.name]) and
+                                 s.name != "vestibular" else None for s in self.senses[i]]
+        k = self._delays[i]["motor"]
+        self._motor_delays[i] = MotorDelay(k, self.actuation[i].n_controls) if k else None
 
     def advance(self, n: int) -> str | None:
         """``n`` physics steps with the controls in force, through the world's own step (the
@@ -257,9 +267,49 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
             raise KeyError(f"unknown agent {agent!r}; agents of this env: {self.possible_agents}")
         return agent
 
+    # -- another age at reset, without compiling (core/regrow.py) --------------------------------
+    def set_age(self, age_months: float | None = None, motor_age_months: float | None = None,
+                agent: str | None = None) -> None:
+        """The body age and / or the motor age (months, 0 to 33; None: unchanged) of ``agent``
+        (None: every infant) from the next :meth:`reset` on, written into the compiled model
+        without compiling it again (:mod:`mimo_social.core.regrow`); ``reset(options=
+        {"age_months": ..., "motor_age_months": ...})`` does the same at that reset (a number
+        for every infant, or a dict agent -> months). Adults have no age: a ConfigError."""
+        values = {"age_months": age_months, "motor_age_months": motor_age_months}
+        for i, fields in age_changes(self.possible_agents, self.agent_configs, values, agent,
+                                     "set_age").items():
+            self._pending_ages.setdefault(i, {}).update(fields)
+
+    def _grow(self, changes: dict) -> None:
+        """Apply age changes (agent index -> {setting: months}) to the world, the motors, the
+        senses, the delays and the task."""
+        w = self.world
+        size, pos = w.model.geom_size.copy(), w.model.geom_pos.copy()
+        for i, fields in sorted(changes.items()):
+            config = replace(self.agent_configs[i], **fields)
+            if config == self.agent_configs[i]:
+                continue
+            old = w.tables[i]
+            w.regrow(i, config)
+            self.agent_configs[i] = config
+            regrow_senses(self, i, old, size, pos)
+            self._delays[i] = delay_steps(config, self.dt)
+            self._delay_rings(i)
+        self.task.configs = tuple(self.agent_configs)
+        self._bind_task()
+
     def reset(self, seed: int | None = None, options: dict | None = None):
+        ages = age_options(options)   # a bad option or age: an error before anything changes
+        changes = age_changes(self.possible_agents, self.agent_configs, ages, None,
+                              "reset(options)") if ages else {}
         if check_seed(seed, "reset") is not None:   # a seed that is not an integer >= 0: a ConfigError
             self._rng = np.random.default_rng(int(seed))
+        pending = self.__dict__.setdefault("_pending_ages", {})
+        for i, fields in changes.items():
+            pending.setdefault(i, {}).update(fields)
+        if pending:
+            self._pending_ages = {}
+            self._grow(pending)
         w = self.world
         w.reset()
         for act in self.actuation:

@@ -32,6 +32,12 @@ class SingleAgentEnv(gym.Env):
         obs, infos = self.parallel.reset(seed=seed, options=options)
         return obs[self.agent], infos[self.agent]
 
+    def set_age(self, age_months: float | None = None, motor_age_months: float | None = None,
+                agent: str | None = None) -> None:
+        """The infant's ages from the next reset on (:meth:`MimoParallelEnv.set_age`); reset's
+        ``options`` (``age_months``, ``motor_age_months``) go to the ParallelEnv too."""
+        self.parallel.set_age(age_months, motor_age_months, agent)
+
     def step(self, action):
         obs, rew, term, trunc, infos = self.parallel.step({self.agent: action})
         a = self.agent

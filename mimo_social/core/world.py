@@ -15,7 +15,7 @@ own scaled tables (:attr:`World.tables`) and lowered onto the floor from its own
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Sequence
 
 import mujoco
@@ -29,6 +29,7 @@ from ..util.checks import check_choice
 from ..util.names import agent_names
 from .config import AgentConfig, PhysicsConfig
 from .delays import check_delay_steps, delay_sensors, fill_sensor_history
+from .regrow import agent_maps, regrow_agent
 
 __all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE"]
 
@@ -163,13 +164,16 @@ class World:
         # MjData pickles with its model: every model field a task changed (a ball's size and
         # mass, weld and contact settings) and every quantity of the last step (qfrc_bias,
         # contacts, the solver's warm start) travel, so a copy continues exactly.
-        state = {"recipe": self._recipe, "data": self.data, "bad_count": self._bad_count}
+        state = {"recipe": self._recipe, "data": self.data, "bad_count": self._bad_count,
+                 "regrown": dict(self.regrown)}
         if self.model.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP:
             state["awake"] = {k: getattr(self.data, k) for k in self._SLEEP_COUNTERS}
         return state
 
     def __setstate__(self, state):
         self.__init__(*state["recipe"])   # the index tables, faces and spec of the recipe
+        for i, config in state.get("regrown", {}).items():   # ages changed since (regrow)
+            self.regrow(i, config)
         self.data = state["data"]
         for k, v in state.get("awake", {}).items():
             setattr(self.data, k, v)
@@ -229,6 +233,9 @@ class World:
             if self.room is not None and self.ROOM_SLEEP and not p.fixed:
                 body.sleep = mujoco.mjtSleepPolicy.mjSLEEP_NEVER   # tasks move their props
         self.spec = spec
+        self.regrown: dict[int, AgentConfig] = {}   # agent -> its config after an age change
+        self._regrow_maps: dict[int, object] = {}
+        self._scratch = None
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
         self.delayed_sensors = np.flatnonzero(self.model.sensor_delay > 0)
@@ -541,6 +548,37 @@ class World:
         mujoco.mj_forward(m, d)
         fill_sensor_history(m, d, self.delayed_sensors)
         self._bad_count = 0
+
+    # -- another age without compiling (core/regrow.py) -----------------------------------------
+    def regrow(self, i: int, config: AgentConfig) -> None:
+        """Agent ``i``'s body at the ages of ``config`` (same hands, body kind and senses),
+        written into the compiled model in place (:func:`~mimo_social.core.regrow.regrow_agent`);
+        its tables, setup and start height follow. Takes effect at the next :meth:`reset`."""
+        dt = self.physics.timestep * self.physics.frame_skip
+        check_delay_steps(self.names[i], config, dt)
+        self.tables[i] = regrow_agent(self, i, config, dt)
+        setups = list(self.agent_setups)
+        setups[i] = replace(setups[i], config=config)
+        self.agent_setups = tuple(setups)
+        self.regrown[i] = config
+
+    def regrow_maps(self, i: int):
+        """Agent ``i``'s table rows as model ids (:func:`~mimo_social.core.regrow.agent_maps`),
+        resolved once."""
+        if i not in self._regrow_maps:
+            self._regrow_maps[i] = agent_maps(self, i)
+        return self._regrow_maps[i]
+
+    def scratch_data(self) -> mujoco.MjData:
+        """A scratch MjData of this model (kept; its contents are any)."""
+        if self._scratch is None or self._scratch.model is not self.model:
+            self._scratch = mujoco.MjData(self.model)
+        return self._scratch
+
+    def set_initial_height(self, i: int, height: float) -> None:
+        """The start height (m) of agent ``i``'s free root."""
+        a = self.agents[i]
+        self._initial_qpos[a.free_qpos + 2] = height
 
     def set_expression(self, agent: int, expression: int) -> None:
         self.faces.show(self.model, self.agents[agent].head_material, expression)

@@ -60,8 +60,9 @@ import numpy as np
 
 # scipy (k-d trees, Dijkstra) is imported where a skin is computed: a cached skin needs none of it
 
-__all__ = ["Skin", "build_skin", "surface_points", "signed_distance", "cache_dir",
-           "SKIN_ALGORITHM_VERSION", "EDGE_FACTOR", "REACH_FACTOR", "MERGE_FACTOR", "GRID_CELL"]
+__all__ = ["Skin", "build_skin", "regrown_skin", "surface_points", "signed_distance",
+           "cache_dir", "SKIN_ALGORITHM_VERSION", "EDGE_FACTOR", "REACH_FACTOR", "MERGE_FACTOR",
+           "GRID_CELL"]
 
 SKIN_ALGORITHM_VERSION = 2
 EDGE_FACTOR = 1.6        # graph edges join points closer than this many spacings
@@ -566,3 +567,59 @@ def build_skin(model: mujoco.MjModel, body_ids: Sequence[int], prefix: str,
         grid_lo=arrays["grid_lo"], grid_dims=arrays["grid_dims"],
         from_cache=source, build_seconds=time.perf_counter() - t0,
     )
+
+
+def regrown_skin(skin: Skin, model: mujoco.MjModel, old_size: np.ndarray,
+                 old_pos: np.ndarray, spacing_ratio: np.ndarray) -> Skin:
+    """``skin`` carried onto the same body at another age (its geoms resized in ``model``;
+    ``old_size``, ``old_pos``: every geom's size and position before), with the same points:
+    the observation keeps its size.
+
+    Each point moves with its primitive, in the primitive's frame: a sphere's by the ratio of
+    radii; a cylinder's across by the radii's ratio and along by the half-lengths'; a capsule's
+    tube likewise and its caps rigidly with the radius (the caps stay hemispheres on the new
+    tube's ends); a box's and an ellipsoid's axis by axis. Normals follow by the inverse
+    transpose of each point's map, renormalised. Each part's spacing and its neighbourhoods'
+    distances are multiplied by ``spacing_ratio`` (per part); the lookup grids are rebuilt
+    around the moved points. A skin laid out afresh on the new body may have a few points more
+    or fewer (the layout rounds point counts per primitive)."""
+    g = skin.point_geom
+    kind = model.geom_type[g]
+    R = np.stack([_quat_mat(q) for q in model.geom_quat[g]]) if len(g) else np.zeros((0, 3, 3))
+    q = np.einsum("nji,nj->ni", R, skin.points - old_pos[g])
+    a, b = old_size[g], model.geom_size[g]
+    ratio = np.divide(b, a, out=np.ones_like(b), where=a > 0)
+    lin = ratio.copy()                                  # the map's diagonal, per point
+    sph = kind == _G.mjGEOM_SPHERE
+    lin[sph] = ratio[sph, :1]
+    tube = (kind == _G.mjGEOM_CAPSULE) | (kind == _G.mjGEOM_CYLINDER)
+    lin[tube, 1] = ratio[tube, 0]
+    lin[tube, 2] = ratio[tube, 1]
+    new_q = q * lin
+    cap = (kind == _G.mjGEOM_CAPSULE) & (np.abs(q[:, 2]) > a[:, 1])
+    if cap.any():   # the caps keep their shape: their offset beyond the tube's end by radius
+        h0, h1, rr = a[cap, 1], b[cap, 1], ratio[cap, 0]
+        z = q[cap, 2]
+        new_q[cap, 2] = np.sign(z) * (h1 + (np.abs(z) - h0) * rr)
+        lin[cap, 2] = rr
+    points = np.einsum("nij,nj->ni", R, new_q) + model.geom_pos[g]
+    local_n = np.einsum("nji,nj->ni", R, skin.normals) / lin
+    normals = np.einsum("nij,nj->ni", R, local_n)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    spacing = skin.part_spacing * spacing_ratio
+    grids, los, dims = [], [], []
+    for k in range(len(skin.part_names)):
+        a0, a1 = skin.part_start[k], skin.part_start[k + 1]
+        cells, lo, dim = _grid(points[a0:a1], spacing[k])
+        grids.append(cells + a0)
+        los.append(lo)
+        dims.append(dim)
+    nbr_dist = (skin.nbr_dist * spacing_ratio[skin.point_part][:, None]).astype(np.float32)
+    return Skin(
+        part_names=list(skin.part_names), part_bodies=skin.part_bodies, part_spacing=spacing,
+        part_start=skin.part_start, part_geoms=skin.part_geoms, points=points, normals=normals,
+        point_part=skin.point_part, point_geom=skin.point_geom, nbr=skin.nbr, nbr_dist=nbr_dist,
+        grid=np.concatenate(grids).astype(np.int32),
+        grid_start=np.concatenate([[0], np.cumsum([len(c) for c in grids])]).astype(np.intp),
+        grid_lo=np.array(los), grid_dims=np.array(dims, np.int64), from_cache="regrown",
+        build_seconds=0.0)

@@ -185,13 +185,14 @@ class TouchSystem:
                                   "part; use touch=False to turn touch off")
             self.skins.append(build_skin(m, agent.body_ids, prefix, spacing, cfg.density,
                                          cfg.exclude, cfg.cache, world.tables[i].scale))
-        self._concatenate(m)
+        self.concatenate(m)
         self.build_seconds = time.perf_counter() - t0
         self.reset(m, world.data)
 
     # -- building --------------------------------------------------------------------------------
-    def _concatenate(self, m):
-        """All agents' skins as one set of arrays (global point and part numbers)."""
+    def concatenate(self, m):
+        """All agents' skins as one set of arrays (global point and part numbers); again after
+        a skin of :attr:`skins` was replaced by one of as many points (an age change)."""
         pts, nrm, scaled, nbr, parts, grids = [], [], [], [], [], []
         part_body, part_agent, part_s, part_start, part_world, part_nearest = [], [], [], [], [], []
         params = []

@@ -129,6 +129,13 @@ class VisionSystem:
             out.update({f"depth_{e}": np.zeros((c.height, c.width), np.float32) for e in EYES})
         return out
 
+    def set_age(self, model, i: int, age_months: float | None) -> None:
+        """Agent ``i``'s acuity blur for the body age ``age_months`` (an age change at reset)."""
+        cfg = self.configs[i]
+        self.cutoffs[i] = cutoff_for(cfg.acuity, age_months)
+        self._blur[i] = acuity_blur(self.cutoffs[i], cfg.height, cfg.width,
+                                    float(model.cam_fovy[self.cameras[i]["left"]]))
+
     # -- shared-system interface ---------------------------------------------------------------
     def reset(self, model, data) -> None:
         self._step = 0      # the update that follows a reset renders every agent

@@ -49,6 +49,14 @@ class Actuation(ABC):
     def reset(self, model, data) -> None:
         """Clear internal state at episode start."""
 
+    def retune(self, joints: list) -> None:
+        """The same motors with the parameters of ``joints`` (the JointSpec of each motor, in
+        action order: the body at another age); the state is cleared and a model that adapts
+        its motors adapts them again at the next reset."""
+        if [j.name for j in joints] != [j.name for j in self.joints]:
+            raise ValueError("retune: the joints must be those of the motors, in action order")
+        type(self).__init__(self, joints, self.actuator_ids)
+
     @property
     @abstractmethod
     def observation_size(self) -> int: ...

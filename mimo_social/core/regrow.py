@@ -1,0 +1,391 @@
+"""An infant of another age in the compiled world, without compiling: the new values written in
+place into the live ``MjModel`` (the same model and data objects; renderers and index tables
+kept).
+
+:func:`regrow_agent` takes agent ``i``'s new :class:`~mimo_social.core.config.AgentConfig`
+(another ``age_months`` and / or ``motor_age_months``; hands, body kind, actuation and senses
+unchanged, so the body's topology is the same) and writes, for that agent only:
+
+- from the tables of the new body age (:func:`~mimo_social.body.tables.load_body`): segment
+  positions (``body_pos``), geom sizes, positions and contact lengths (torsional and rolling
+  friction), the iris and pupil of each eye, site and eye-camera positions, joint pivots, joint
+  stiffness, damping, armature and friction loss;
+- the mass properties from the new geoms (:mod:`mimo_social.body.inertia`, MuJoCo's formulas):
+  ``body_mass``, ``body_ipos``, ``body_iquat``, ``body_inertia``;
+- the bounds: ``geom_rbound``, ``geom_aabb`` and the bodies' bounding-volume trees
+  (``bvh_aabb``, in each body's inertial frame, rebuilt bottom-up from the leaves);
+- the motors' torque limits (``actuator_ctrlrange``, ``actuator_forcerange``) from the tables of
+  the motor age (the muscle and positional models adapt their motors when next reset);
+- the start height: the body is lowered onto the floor from its new geometry as a fresh build
+  is (its rest pose's lowest point 2 mm above the floor);
+- then ``mujoco.mj_setConst`` for the derived constants (subtree masses, inverse weights,
+  ``actuator_acc0``, the model statistics).
+
+A fresh build at the new ages gives the same values to rounding (the principal axes of a body of
+several geoms may come out in another order or sign: the inertia tensor is the same).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from typing import Mapping, Sequence
+
+import mujoco
+import numpy as np
+
+from ..body.builder import EYE_CAMERA_X, GEOM_FRICTION, IRIS, PUPIL
+from ..body.inertia import (body_inertials, boxes_in_parent, geom_aabb, geom_moments,
+                            geom_rbound, quat_matrices)
+from ..body.tables import BodyTables, load_body
+from ..senses import SENSES
+from ..senses.skin import regrown_skin
+from ..util.checks import show
+from .config import ConfigError
+from .delays import VESTIBULAR_SENSORS, delay_steps
+
+__all__ = ["AgentMaps", "agent_maps", "regrow_agent", "body_tables", "support_below",
+           "REST_CLEARANCE", "AGE_OPTIONS", "age_options", "age_changes", "regrow_senses"]
+
+#: a body starts with its lowest point this high above the floor (m), as the world places it
+REST_CLEARANCE = 0.002
+
+
+def body_tables(config) -> BodyTables:
+    """The (scaled, grown) tables of an agent config: what its body is built from."""
+    return load_body(config.hands, config.scale, config.strength, config.age_months,
+                     config.body, config.motor_age_months)
+
+
+@dataclass
+class AgentMaps:
+    """Model ids of one agent's table rows (resolved once per world, by name)."""
+
+    segment_body: np.ndarray      # (S,) body id of each table segment
+    root: int                     # the root segment's body
+    geom: np.ndarray              # (G,) geom id of each table geom
+    eyes: list                    # (table geom index, iris id, pupil id) per eye
+    joint: np.ndarray             # (J,) joint id of each table joint, -1: folded away
+    site: np.ndarray              # (T,) site id of each table site
+    head_site: int
+    head_geom_row: int            # the table row of the head geom
+    cameras: list                 # (table geom index of the eye, camera id)
+    actuator: np.ndarray          # (J,) actuator id of each table joint, -1: none
+    geoms: np.ndarray             # every geom of the agent (iris and pupil too)
+    bodies: np.ndarray            # every body of the agent
+    bvh: np.ndarray               # the agent's bvh nodes
+    bvh_base: np.ndarray          # the first node of each of those nodes' body
+
+
+def _id(model, kind: str, name: str) -> int:
+    try:
+        return int(getattr(model, kind)(name).id)
+    except KeyError:
+        return -1
+
+
+def agent_maps(world, i: int) -> AgentMaps:
+    """The id maps of agent ``i`` of ``world`` (its tables' names resolved in its model)."""
+    m, t = world.model, world.tables[i]
+    p = f"{world.names[i]}/"
+    geoms = np.array([_id(m, "geom", p + g.name) for g in t.geoms], np.intp)
+    eyes, cams = [], []
+    for k, g in enumerate(t.geoms):
+        if g.body.endswith("_eye"):
+            eyes.append((k, _id(m, "geom", f"{p}{g.name}_iris"),
+                         _id(m, "geom", f"{p}{g.name}_pupil")))
+            cams.append((k, _id(m, "camera", p + g.body)))
+    acts = np.array([_id(m, "actuator", p + j.actuator) if j.actuator else -1
+                     for j in t.joints], np.intp)
+    a = world.agents[i]
+    bodies = np.asarray(a.body_ids, np.intp)
+    has = m.body_bvhnum > 0
+    base = np.repeat(m.body_bvhadr[has], m.body_bvhnum[has])
+    nodes = np.concatenate([np.arange(m.body_bvhadr[b], m.body_bvhadr[b] + m.body_bvhnum[b])
+                            for b in bodies]).astype(np.intp)
+    return AgentMaps(
+        segment_body=np.array([_id(m, "body", p + s.name) for s in t.segments], np.intp),
+        root=int(a.root_body), geom=geoms, eyes=eyes,
+        joint=np.array([_id(m, "joint", p + j.name) for j in t.joints], np.intp),
+        site=np.array([_id(m, "site", p + s.name) for s in t.sites], np.intp),
+        head_site=int(a.head_site),
+        head_geom_row=next(k for k, g in enumerate(t.geoms) if g.name == "head"),
+        cameras=cams, actuator=acts, geoms=np.asarray(a.geom_ids, np.intp), bodies=bodies,
+        bvh=nodes, bvh_base=base[nodes])
+
+
+def support_below(model, data, geom_ids) -> float:
+    """The lowest world z of the geoms ``geom_ids`` (exact for the primitive shapes)."""
+    z = data.geom_xpos[geom_ids, 2]
+    rz = data.geom_xmat[geom_ids].reshape(-1, 3, 3)[:, 2, :]
+    size = model.geom_size[geom_ids]
+    t = model.geom_type[geom_ids]
+    G = mujoco.mjtGeom
+    low = np.where(t == G.mjGEOM_SPHERE, size[:, 0], 0.0)
+    cap = t == G.mjGEOM_CAPSULE
+    low = np.where(cap, np.abs(rz[:, 2]) * size[:, 1] + size[:, 0], low)
+    cyl = t == G.mjGEOM_CYLINDER
+    low = np.where(cyl, np.abs(rz[:, 2]) * size[:, 1]
+                   + size[:, 0] * np.sqrt(np.clip(1 - rz[:, 2] ** 2, 0, 1)), low)
+    low = np.where(t == G.mjGEOM_BOX, np.sum(np.abs(rz) * size, axis=1), low)
+    low = np.where(t == G.mjGEOM_ELLIPSOID, np.sqrt(np.sum((rz * size) ** 2, axis=1)), low)
+    return float(np.min(z - low))
+
+
+def _pad3(v) -> np.ndarray:
+    out = np.zeros(3)
+    out[:len(v)] = v
+    return out
+
+
+def _write_body(m, maps: AgentMaps, t: BodyTables) -> None:
+    """Positions, sizes, frictions, passive joint parameters and motor limits from ``t``."""
+    for k, s in enumerate(t.segments):
+        if s.parent is not None:
+            m.body_pos[maps.segment_body[k]] = s.pos
+    for k, g in enumerate(t.geoms):
+        gid = maps.geom[k]
+        m.geom_size[gid] = _pad3(g.size)
+        m.geom_pos[gid] = g.pos
+        m.geom_friction[gid] = g.friction or GEOM_FRICTION
+    for k, iris, pupil in maps.eyes:
+        g = t.geoms[k]
+        r, centre = float(g.size[0]), np.asarray(g.pos, float)
+        cx, across, depth = IRIS
+        m.geom_size[iris] = (across * r, across * r, depth * r)
+        m.geom_pos[iris] = centre + (cx * r, 0.0, 0.0)
+        cx, radius, half = PUPIL
+        m.geom_size[pupil] = (radius * r, half * r, 0.0)
+        m.geom_pos[pupil] = centre + (cx * r, 0.0, 0.0)
+        m.geom_friction[iris] = m.geom_friction[pupil] = g.friction or GEOM_FRICTION
+    for k, c in maps.cameras:
+        g = t.geoms[k]
+        m.cam_pos[c] = np.asarray(g.pos, float) + (EYE_CAMERA_X * g.size[0], 0.0, 0.0)
+    m.site_pos[maps.head_site] = t.geoms[maps.head_geom_row].pos
+    for k, s in enumerate(t.sites):
+        m.site_pos[maps.site[k]] = s.pos
+    for k, j in enumerate(t.joints):
+        jid = maps.joint[k]
+        if jid < 0:
+            continue
+        dof = m.jnt_dofadr[jid]
+        m.jnt_pos[jid] = j.pos
+        m.jnt_stiffness[jid] = j.stiffness
+        m.dof_damping[dof] = j.damping
+        m.dof_armature[dof] = j.armature
+        m.dof_frictionloss[dof] = j.frictionloss
+        a = maps.actuator[k]
+        if a >= 0:
+            m.actuator_ctrlrange[a] = m.actuator_forcerange[a] = (-j.torque_neg, j.torque_pos)
+
+
+def _write_inertia(m, maps: AgentMaps, t: BodyTables) -> None:
+    """Mass properties of the agent's bodies, bounds of its geoms and its bodies' trees."""
+    gids = maps.geoms
+    mass = np.zeros(m.ngeom)
+    mass[maps.geom] = [g.mass for g in t.geoms]
+    kind, size = m.geom_type[gids], m.geom_size[gids]
+    moments = geom_moments(kind, size, mass[gids])
+    local = np.searchsorted(maps.bodies, m.geom_bodyid[gids])
+    total, com, iquat, inertia, _ = body_inertials(local, len(maps.bodies), mass[gids],
+                                                   m.geom_pos[gids], m.geom_quat[gids], moments)
+    # a body of one massive geom: its principal frame is the geom's (as MuJoCo's compiler has)
+    heavy = mass[gids] > 0
+    one = np.bincount(local[heavy], minlength=len(maps.bodies)) == 1
+    for g in np.flatnonzero(heavy & one[local]):
+        b = local[g]
+        iquat[b], inertia[b] = m.geom_quat[gids[g]], moments[g]
+    b = maps.bodies
+    m.body_mass[b], m.body_ipos[b], m.body_iquat[b], m.body_inertia[b] = total, com, iquat, inertia
+    m.geom_rbound[gids] = geom_rbound(kind, size)
+    m.geom_aabb[gids] = geom_aabb(kind, size)
+    # bounding-volume trees: leaves are geoms' boxes in their body's inertial frame
+    nodes = maps.bvh
+    leaf = m.bvh_nodeid[nodes] >= 0
+    g = m.bvh_nodeid[nodes[leaf]]
+    body = m.geom_bodyid[g]
+    R = quat_matrices(m.body_iquat[body])
+    pos = np.einsum("nji,nj->ni", R, m.geom_pos[g] - m.body_ipos[body])
+    quat = np.empty((len(g), 4))
+    conj = m.body_iquat[body] * (1.0, -1.0, -1.0, -1.0)
+    for k in range(len(g)):
+        mujoco.mju_mulQuat(quat[k], conj[k], m.geom_quat[g[k]])
+    m.bvh_aabb[nodes[leaf]] = boxes_in_parent(m.geom_aabb[g], pos, quat)
+    for n, base in zip(nodes[~leaf][::-1], maps.bvh_base[~leaf][::-1]):   # children first
+        c = m.bvh_child[n] + base
+        box = m.bvh_aabb[c]
+        lo, hi = (box[:, :3] - box[:, 3:]).min(0), (box[:, :3] + box[:, 3:]).max(0)
+        m.bvh_aabb[n, :3], m.bvh_aabb[n, 3:] = (lo + hi) / 2, (hi - lo) / 2
+
+
+def _lower_onto_floor(world, i: int, maps: AgentMaps, scratch) -> None:
+    """The agent's start height from its (new) geometry in its rest pose."""
+    m = world.model
+    a = world.agents[i]
+    q = world.initial_qpos
+    scratch.qpos[:] = q
+    mujoco.mj_kinematics(m, scratch)
+    low = support_below(m, scratch, maps.geoms)
+    if a.free_qpos >= 0:
+        z = a.free_qpos + 2
+        height = q[z] - low + REST_CLEARANCE
+        world.set_initial_height(i, height)
+        m.qpos0[z] = m.qpos_spring[z] = m.body_pos[maps.root, 2] = height
+    else:
+        m.body_pos[maps.root, 2] += REST_CLEARANCE - low
+
+
+def regrow_agent(world, i: int, config, dt: float) -> BodyTables:
+    """Write agent ``i``'s body at ``config``'s ages into ``world``'s compiled model (module
+    docstring); returns the new tables. A ConfigError when the change needs a recompile (the
+    vestibular delay beyond what the model's sensor history holds)."""
+    m = world.model
+    maps = world.regrow_maps(i)
+    t = body_tables(config)
+    if config.vestibular:
+        k = delay_steps(config, dt)["vestibular"]
+        _vestibular_delay(world, i, k, dt, VESTIBULAR_SENSORS)
+    size_before = _mean_box(m)
+    _write_body(m, maps, t)
+    _write_inertia(m, maps, t)
+    scratch = world.scratch_data()
+    _lower_onto_floor(world, i, maps, scratch)
+    mujoco.mj_setConst(m, scratch)
+    _write_statistics(m, size_before)
+    return t
+
+
+def _mean_box(m) -> float:
+    """The mean edge of the bodies' equivalent inertia boxes (a measure of their size)."""
+    mass, inertia = m.body_mass[1:], m.body_inertia[1:]
+    heavy = mass > mujoco.mjMINVAL
+    I, mass = inertia[heavy], mass[heavy, None]
+    sq = 6.0 * (I.sum(axis=1, keepdims=True) - 2.0 * I) / mass
+    return float(np.sqrt(np.maximum(sq, 0.0)).mean()) if len(I) else 0.0
+
+
+def _write_statistics(m, size_before: float) -> None:
+    """The model statistics that depend on the bodies: ``meaninertia`` (the mean diagonal of
+    the joint-space inertia at ``qpos0``, which scales the solver's tolerance), ``meanmass``
+    (as the compiler computes them) and ``meansize`` (for drawing only: scaled with the mean
+    inertia-box edge of the bodies, within a few percent of a fresh build's)."""
+    if m.nv:
+        m.stat.meaninertia = float(m.dof_M0.mean())
+    if m.nbody > 1:
+        m.stat.meanmass = float(m.body_mass[1:].mean())
+    after = _mean_box(m)
+    if size_before > 0 and after > 0:
+        m.stat.meansize = m.stat.meansize * after / size_before
+
+
+def _vestibular_delay(world, i: int, k: int, dt: float, sensors) -> None:
+    m = world.model
+    ts = m.opt.timestep
+    for name in sensors:
+        s = m.sensor(f"{world.names[i]}/{name}").id
+        held = int(m.sensor_history[s, 0])
+        need = k * int(round(dt / ts)) + 2 if k else 0
+        if need > held:
+            raise ConfigError(
+                f"agent {world.names[i]}: a vestibular delay of {k} control steps needs a "
+                f"history of {need} samples; the compiled model holds {held}; allowed: a "
+                f"vestibular delay of at most {max(0, (held - 2) * ts / dt):g} steps without a "
+                "rebuild (build the env with the longer delay)")
+        m.sensor_delay[s] = k * dt - 0.5 * ts if k else 0.0
+
+
+# -- the env's side: which agents change, and their senses and motors --------------------------
+#: the options ``reset(options=...)`` takes: each a number (every infant) or {agent: number}
+AGE_OPTIONS = ("age_months", "motor_age_months")
+
+
+def age_options(options) -> dict:
+    """The age settings of ``reset``'s ``options`` (None or a mapping of :data:`AGE_OPTIONS`);
+    a ConfigError naming an unknown key and the keys allowed."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping):
+        raise ConfigError(f"reset: options={show(options)} not allowed; allowed: None or a dict "
+                          f"with keys {list(AGE_OPTIONS)}")
+    unknown = sorted((k for k in options if k not in AGE_OPTIONS), key=str)
+    if unknown:
+        raise ConfigError(f"reset: unknown option(s) {unknown}; allowed: {list(AGE_OPTIONS)} "
+                          "(each a number of months, 0 to 33, for every infant, or a dict "
+                          "agent -> months)")
+    return {k: options[k] for k in AGE_OPTIONS if k in options}
+
+
+def age_changes(names: Sequence[str], configs: Sequence, values: Mapping, agent=None,
+                where: str = "set_age") -> dict[int, dict]:
+    """Agent index -> {setting: months} of the infants that ``values`` (setting -> None (no
+    change), a number (``agent``, or every infant when ``agent`` is None) or a dict agent ->
+    number) changes, each checked as the agent's config checks it; a ConfigError (an unknown
+    agent: a KeyError) naming the agent, the setting, the value and what is allowed."""
+    infants = [n for n, c in zip(names, configs) if c.body == "infant"]
+
+    def index(name) -> int:
+        if name not in names:
+            raise KeyError(f"{where}: unknown agent {name!r}; agents of this env: {list(names)}")
+        i = list(names).index(name)
+        if configs[i].body != "infant":
+            raise ConfigError(f"{where}: agent {name} is an adult (body='adult'); "
+                              f"{' and '.join(AGE_OPTIONS)} are for infants: {infants}")
+        return i
+
+    if agent is not None:
+        targets = [index(agent)]
+    else:
+        targets = [names.index(n) for n in infants]
+    out: dict[int, dict] = {}
+    for key, value in values.items():
+        if value is None:
+            continue
+        if isinstance(value, Mapping):
+            for name, v in value.items():
+                out.setdefault(index(name), {})[key] = v
+            continue
+        if not targets:
+            raise ConfigError(f"{where}: {key}={show(value)}: this env has no infant (agents "
+                              f"{list(names)}); ages are for infants")
+        for i in targets:
+            out.setdefault(i, {})[key] = value
+    for i, fields in out.items():
+        try:
+            replace(configs[i], **fields)
+        except ConfigError as e:
+            raise ConfigError(f"{where}: agent {names[i]}: {e}") from None
+    return out
+
+
+def regrow_senses(env, i: int, old: BodyTables, old_size: np.ndarray,
+                  old_pos: np.ndarray) -> None:
+    """After :meth:`World.regrow` of agent ``i``: its motors take the new torques, its senses'
+    spaces the new bounds (the same space objects), its skin follows its geoms (as many
+    points: :func:`~mimo_social.senses.skin.regrown_skin`) and its eyes' acuity the body age.
+    ``old``: its tables before; ``old_size``, ``old_pos``: every geom's size and position
+    before."""
+    w, cfg = env.world, env.agent_configs[i]
+    t = w.tables[i]
+    by_name = {j.name: j for j in t.joints}
+    act = env.actuation[i]
+    act.retune([by_name[n] for n in w.agents[i].actuated_names])
+    for sense in env.senses[i]:
+        entry = SENSES[sense.name]
+        if entry.per_agent is None:
+            continue
+        fresh = entry.per_agent(getattr(cfg, sense.name), w, i, act)
+        for key, space in sense.spaces.items():
+            if hasattr(space, "low"):
+                np.copyto(space.low, fresh.spaces[key].low)
+                np.copyto(space.high, fresh.spaces[key].high)
+    touch = env.systems.get("touch")
+    if touch is not None and touch.skins[i] is not None:
+        skin = touch.skins[i]
+        ratio = np.array([t.touch_spacing[n] / old.touch_spacing[n] for n in skin.part_names])
+        touch.skins[i] = regrown_skin(skin, w.model, old_size, old_pos, ratio)
+        touch.concatenate(w.model)
+        for sense in env.senses[i]:
+            if sense.name == "touch":
+                sense.skin = touch.skins[i]
+    vision = env.systems.get("vision")
+    if vision is not None and i in vision.agents:
+        vision.set_age(w.model, i, cfg.age)
