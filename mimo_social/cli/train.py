@@ -9,13 +9,17 @@
     ``--algo recurrent_ppo``: sb3-contrib's RecurrentPPO (an LSTM policy: memory);
     ``--normalize-reward``: SB3's VecNormalize on the rewards, saved as ``vecnormalize.pkl``.
     ``--curriculum selfbody`` (env options by stage) and ``--bc-episodes N`` (a warm start
-    cloned from the scripted controller): docs/training.md.
+    cloned from the scripted controller): docs/training.md. ``--growth forward:1-12`` (the
+    infant's age by training step: forward, inverse or stochastic): docs/training.md, "Growth".
 
 ``mimo-social eval DIR --episodes 10 [--record run.rrd] [--video run.mp4 | --frames DIR]``
     Reloads ``DIR/model.zip`` (``--model best`` or a path for another), runs the episodes with the
     deterministic policy (the mean action) and the stochastic one (sampled actions; only one:
     ``--deterministic`` / ``--stochastic``), prints the mean return, success rate and length of
     each and writes ``DIR/eval_results.json`` (:mod:`mimo_social.train.evaluation`).
+    ``--ages 1,3,6,9,12``: the same episodes at each age, both policies, into a cross-age table
+    and figure (``cross_age.csv`` / ``.md`` / ``.png`` / ``.json`` in DIR or ``--out``;
+    :mod:`mimo_social.train.cross_age`).
 
 ``mimo-social compare --task standup --algos ppo,sac --seeds 3 --steps 50000 --out runs/cmp``
     Trains every algorithm with seeds 0..n-1 (``--jobs`` processes at a time) into
@@ -122,7 +126,8 @@ def _engine_conflicts(args) -> str | None:
                              ("--bc-epochs", "bc_epochs", None),
                              ("--bc-kwargs", "bc_kwargs", None),
                              ("--intrinsic", "intrinsic", None),
-                             ("--intrinsic-kwargs", "intrinsic_kwargs", None))
+                             ("--intrinsic-kwargs", "intrinsic_kwargs", None),
+                             ("--growth", "growth", None))
            if given(k, d) and (k != "algo" or args.algo == "recurrent_ppo")]
     if bad:
         return f"{', '.join(bad)}: for --engine sb3 (the default engine)"
@@ -157,7 +162,7 @@ def _sb3_train_kwargs(args) -> dict:
         kw["frame_stack"] = args.frame_stack
     if getattr(args, "normalize_reward", False):
         kw["normalize_reward"] = True
-    for key in ("curriculum", "bc_episodes", "bc_epochs", "bc_kwargs"):
+    for key in ("curriculum", "bc_episodes", "bc_epochs", "bc_kwargs", "growth"):
         if getattr(args, key, None) is not None:
             kw[key] = getattr(args, key)
     if getattr(args, "intrinsic", None) is not None:
@@ -165,6 +170,16 @@ def _sb3_train_kwargs(args) -> dict:
     elif getattr(args, "intrinsic_kwargs", None) is not None:
         kw["intrinsic"] = dict(args.intrinsic_kwargs)    # (refused: no kind)
     return kw
+
+
+def growth_spec(text: str):
+    """A growth schedule spec (``forward:1-12``, ``inverse:1-12:200000``, ``stochastic:3-9``),
+    checked: a :class:`~mimo_social.train.growth.Growth`."""
+    from ..train.growth import parse_growth
+    try:
+        return parse_growth(text)
+    except TrainInputError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
 
 
 def _success(last: dict, key: str) -> str:
@@ -237,7 +252,39 @@ def _eval_lines(res: dict, head: str, which: str, models: dict | None) -> None:
               f"{r['return_std']:.3g}" + ("" if math.isnan(s) else f", success {s:.0%}"))
 
 
+def _ages_main(args) -> int:
+    """``eval --ages``: the cross-age table (printed) and figure."""
+    from ..train.cross_age import evaluate_ages
+    from ..train.growth import check_ages
+    given = [f for f, v in (("--record", args.record), ("--video", args.video),
+                            ("--frames", args.frames), ("--stochastic", args.stochastic),
+                            ("--deterministic", args.deterministic)) if v]
+    try:
+        ages = check_ages(args.ages, "--ages")
+        if given:
+            raise TrainInputError(f"{', '.join(given)} with --ages; allowed there: --episodes, "
+                                  "--model, --seed, --env-kwargs, --out (both policies are "
+                                  "always run)")
+        if _run_engine(args.dir) != "sb3":
+            raise TrainInputError("--ages: for runs of --engine sb3")
+        res = evaluate_ages(args.dir, ages, args.episodes, model=args.model, seed=args.seed,
+                            out=args.out, env_kwargs=args.env_kwargs,
+                            progress=not args.no_progress)
+    except (FileNotFoundError, TrainInputError) as e:
+        print(f"mimo-social eval: error: {e}", file=sys.stderr)
+        return 2
+    print(res["markdown"])
+    print(f"wrote {res['csv']}, {res['md']}, {res['png']} and {res['json']}")
+    return 0
+
+
 def _eval_main(args) -> int:
+    if args.ages is not None:
+        return _ages_main(args)
+    if args.out is not None:
+        print("mimo-social eval: error: --out is the folder of the cross-age files: give it "
+              "with --ages (without, eval writes DIR/eval_results.json)", file=sys.stderr)
+        return 2
     if args.stochastic and args.deterministic:
         print("mimo-social eval: error: --stochastic and --deterministic: give at most one "
               "(neither: both policies)", file=sys.stderr)
@@ -402,6 +449,11 @@ def add_parser(subparsers) -> None:
     c.add_argument("--intrinsic-kwargs", type=json_object, default=None,
                    help='JSON settings of the bonus: coef (0.01), extrinsic (1.0; 0: a '
                    'reward-free run), lr (1e-3), hidden (64), seed (the run\'s)')
+    c.add_argument("--growth", type=growth_spec, default=None, metavar="KIND:A-B[:STEPS]",
+                   help="the infant's age as training goes (one-agent tasks): forward:1-12 "
+                   "(1 to 12 months linearly over the run; :STEPS over that many env steps, "
+                   "then 12), inverse:1-12 (12 down to 1), stochastic:1-12 (each episode's "
+                   "age drawn uniformly from 1-12 by the env's seeded generator)")
     g = p.add_argument_group("RLlib engine (--engine rllib; needs the rllib extra)")
     g.add_argument("--engine", choices=("sb3", "rllib"), default="sb3",
                    help="sb3 (Stable-Baselines3, the default) or rllib (RLlib on Ray)")
@@ -440,6 +492,12 @@ def add_parser(subparsers) -> None:
     p.add_argument("--frame-every", type=positive_int, default=1, help="keep every k-th frame")
     p.add_argument("--env-kwargs", type=env_kwargs, default={},
                    help="JSON keyword arguments for the env, over those of the training run")
+    p.add_argument("--ages", default=None, metavar="A,B,...",
+                   help="a cross-age evaluation: the same episodes with the infant at each age "
+                   "(months 0-33, e.g. 1,3,6,9,12), both policies; writes cross_age.csv, .md, "
+                   ".png and .json into DIR (or --out) and prints the table")
+    p.add_argument("--out", default=None, type=output_dir,
+                   help="with --ages: the folder of the cross-age files (default: DIR)")
     p.set_defaults(func=_eval_main)
 
     p = subparsers.add_parser("compare", help="train several algorithms and seeds, plot them "

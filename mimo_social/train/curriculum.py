@@ -6,6 +6,7 @@ task that has one; ``--curriculum FILE`` takes any file, ``.toml`` or ``.json``)
 
     task = "selfbody"            # optional: the task the file is for (checked)
     evaluate = "final"           # or "current": the stage the evaluations run under
+    growth = "forward:6-12"      # optional: the infant's age by step (mimo_social.train.growth)
     [[stages]]
     name = "4 targets"
     draw = { target = ["head", "chest_middle", "right_upper_leg", "left_upper_leg"] }
@@ -70,7 +71,7 @@ __all__ = ["Stage", "Curriculum", "CurriculumEnv", "CurriculumController", "DIRE
 DIRECTORY = Path(__file__).parent / "curricula"
 STAGE_KEYS = ("name", "env_kwargs", "options", "draw", "until")
 UNTIL_KEYS = ("steps", "success", "window")
-TOP_KEYS = ("task", "evaluate", "description", "stages")
+TOP_KEYS = ("task", "evaluate", "description", "stages", "growth")
 EVALUATE = ("final", "current")
 #: mixed into a reset seed for the generator of the drawn values
 DRAW_SALT = 30
@@ -115,6 +116,8 @@ class Curriculum:
     source: str
     evaluate: str = "final"
     description: str = ""
+    #: the infant's age by training step (:mod:`~mimo_social.train.growth`; None: none)
+    growth: Any = None
 
     @property
     def final(self) -> int:
@@ -127,9 +130,12 @@ class Curriculum:
 
     def describe(self) -> dict:
         """What config.json records (``history`` is added as the run goes)."""
-        return {"source": self.source, "evaluate": self.evaluate,
-                "description": self.description,
-                "stages": [s.describe() for s in self.stages]}
+        out = {"source": self.source, "evaluate": self.evaluate,
+               "description": self.description,
+               "stages": [s.describe() for s in self.stages]}
+        if self.growth is not None:
+            out["growth"] = self.growth.spec
+        return out
 
 
 def merge_kwargs(base: Mapping[str, Any], extra: Mapping[str, Any]) -> dict:
@@ -260,7 +266,12 @@ def load_curriculum(spec, task: str) -> Curriculum:
     description = data.get("description", "")
     if not isinstance(description, str):
         raise TrainInputError(f"{where}: description={description!r}; allowed: a string")
-    return Curriculum(out, source, evaluate, description)
+    from .growth import parse_growth
+    try:
+        growth = parse_growth(data.get("growth"))
+    except TrainInputError as e:
+        raise TrainInputError(f"{where}: {e}") from None
+    return Curriculum(out, source, evaluate, description, growth)
 
 
 def check_curriculum(cur: Curriculum, task: str, observation: Mapping[str, Any],

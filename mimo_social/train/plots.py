@@ -3,6 +3,9 @@
 ``plot_learning_curve(run)``
     ``learning_curve.png``: evaluation return (mean and std) and training returns against steps,
     and the success rate where the task reports one; one line per agent for multi-agent runs.
+``plot_cross_age(result, path)``
+    ``cross_age.png`` of :func:`~mimo_social.train.cross_age.evaluate_ages`: success rate and mean
+    return (with its spread) against the infant's age, the mean action and sampled actions.
 ``plot_compare(out)``
     ``compare.png`` / ``compare.csv`` of every ``<algo>_seed<k>`` run below ``out`` (the paper's
     Fig. 8: over environment steps and over wall time side by side; each algorithm's mean over
@@ -19,7 +22,8 @@ import numpy as np
 
 from .progress import PROGRESS_FIELDS, progress_agents, read_progress
 
-__all__ = ["COLORS", "plot_learning_curve", "plot_compare", "plot_fig8", "runs_by_group"]
+__all__ = ["COLORS", "plot_learning_curve", "plot_compare", "plot_fig8", "runs_by_group",
+           "plot_cross_age"]
 
 COLORS = {"ppo": "tab:red", "sac": "tab:blue", "ppo recipe": "tab:green",
           "sac recipe": "tab:purple"}
@@ -334,3 +338,61 @@ def plot_fig8(out: str | Path, tasks, png: str | Path | None = None) -> Path:
     fig.savefig(png, dpi=100)
     plt.close(fig)
     return png
+
+
+def _training_mark(ax, trained: dict) -> None:
+    """Shade the ages a run trained over (a growth range) or mark the one it trained at."""
+    if trained.get("range"):
+        low, high = trained["range"]
+        ax.axvspan(low, high, color="tab:orange", alpha=0.12,
+                   label=f"trained over ({trained.get('label') or f'{low:g}-{high:g}'})")
+    else:
+        age = trained.get("age")
+        ax.axvline(18.0 if age is None else float(age), color="tab:orange", ls=":", lw=1.5,
+                   label="trained at" + (" (the published 18-month body)" if age is None
+                                         else f" {float(age):g} months"))
+
+
+def plot_cross_age(result: dict, path: str | Path) -> Path:
+    """Success rate (%) and mean return (+- std) against age (months), the deterministic and
+    the stochastic policy, from :func:`~mimo_social.train.cross_age.evaluate_ages`' result."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = sorted(result["rows"], key=lambda r: r["age_months"])
+    x = np.array([r["age_months"] for r in rows])
+    col = lambda key: np.array([r[key] for r in rows], float)  # noqa: E731
+    fig, (ax_s, ax_r) = plt.subplots(1, 2, figsize=(11, 4))
+    styles = (("", "mean action (deterministic)", "-o", "tab:red"),
+              ("_stochastic", "sampled actions (stochastic)", "--s", "black"))
+    success = False
+    for suffix, label, fmt, color in styles:
+        rate = col("success_rate" + suffix)
+        if np.isfinite(rate).any():
+            success = True
+            ax_s.plot(x, 100 * rate, fmt, ms=5, color=color, label=label)
+        m, s = col("return_mean" + suffix), col("return_std" + suffix)
+        ax_r.plot(x, m, fmt, ms=5, color=color, label=label)
+        ax_r.fill_between(x, m - s, m + s, color=color, alpha=0.12, lw=0)
+    trained = result.get("training_ages") or {}
+    for ax in (ax_s, ax_r):
+        _training_mark(ax, trained)
+        ax.set_xlabel("infant age (months)")
+        ax.set_xticks(x)
+        ax.set_xticklabels([f"{v:g}" for v in x])
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=8)
+    ax_s.set_ylim(-5, 105)
+    ax_s.set_ylabel("success rate (%)")
+    if not success:
+        ax_s.text(0.5, 0.5, f"{result.get('task', 'this task')} reports no success",
+                  transform=ax_s.transAxes, ha="center", va="center", color="0.4")
+    ax_r.set_ylabel(f"episode return (mean +- std, {result.get('episodes', '?')} episodes)")
+    fig.suptitle(f"{result.get('task', '?')} - {str(result.get('algo', '?')).upper()}, "
+                 f"{Path(str(result.get('model', '?'))).name}: across ages", fontsize=11)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -161,6 +161,8 @@ def validate_recipe(recipe: Recipe) -> None:
                  t.get("bc_epochs", 20), t.get("bc_kwargs"))
         if t.get("curriculum") is not None:
             load_curriculum(t["curriculum"], recipe.task)
+        from .growth import parse_growth
+        parse_growth(t.get("growth"))
     except TrainInputError as e:
         raise TrainInputError(f"{where}: {e}") from None
 

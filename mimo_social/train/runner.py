@@ -48,7 +48,36 @@ from .multi import train_multi
 from .single import train_single
 from .tasks import TrainInputError, algo_class, check_mode, check_task, task_module
 
-__all__ = ["train"]
+__all__ = ["train", "run_growth"]
+
+
+def run_growth(spec, cur, task: str, mode: str | None, env_kwargs):
+    """``train``'s ``growth`` (or the curriculum's ``growth`` key) checked before anything
+    is written: a :class:`~mimo_social.train.growth.Growth`, or None. One-agent tasks only;
+    the env must have ``set_age`` (the core env's age change between episodes)."""
+    from .growth import check_set_age, parse_growth
+    growth = parse_growth(spec)
+    from_cur = getattr(cur, "growth", None)
+    if growth is not None and from_cur is not None:
+        raise TrainInputError(f"growth {growth.spec} and the curriculum's growth "
+                              f"{from_cur.spec}: allowed: one of the two")
+    growth = growth if growth is not None else from_cur
+    if growth is None:
+        return None
+    if mode is not None:
+        raise TrainInputError(f"growth {growth.spec} with --mode {mode}; allowed: a one-agent "
+                              "task (its learner is the only infant)")
+    if "age_months" in (env_kwargs or {}):
+        raise TrainInputError(f"growth {growth.spec} with env_kwargs age_months="
+                              f"{env_kwargs['age_months']!r}: the schedule sets the age; allowed:"
+                              " one of the two")
+    from .envs import make_env
+    env = make_env(task, **dict(env_kwargs or {}))
+    try:
+        check_set_age(env, growth)
+    finally:
+        env.close()
+    return growth
 
 
 def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
@@ -60,7 +89,8 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           normalize_obs: bool | None = None, flat_obs: bool = False, frame_stack: int = 1,
           worker_timeout: float = 600.0, normalize_reward: bool = False,
           curriculum=None, bc_episodes: int = 0, bc_epochs: int = 20, intrinsic=None,
-          bc_kwargs: Mapping[str, Any] | None = None, recipe: str | None = None) -> dict:
+          bc_kwargs: Mapping[str, Any] | None = None, recipe: str | None = None,
+          growth=None) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
     time). See the module docstring for what it writes.
 
@@ -88,7 +118,10 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     written. ``intrinsic`` (None, ``"rnd"`` or a settings mapping; not ``independent``): an RND
     novelty bonus added to the learner's rewards (:mod:`mimo_social.train.intrinsic`; with
     ``{"extrinsic": 0}`` a reward-free run). ``recipe``: the name of the shipped recipe the
-    run follows (:mod:`mimo_social.train.recipes`), recorded in ``config.json``."""
+    run follows (:mod:`mimo_social.train.recipes`), recorded in ``config.json``. ``growth``
+    (one-agent tasks): the infant's age as training goes, a spec such as ``"forward:1-12"``
+    or a :class:`~mimo_social.train.growth.Growth` (:mod:`mimo_social.train.growth`; a
+    curriculum file may give it instead)."""
     from .hyperparams import resolve, run_options, to_json, to_sb3
 
     mode = check_mode(task, mode)
@@ -145,6 +178,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     cur = prepare_curriculum(curriculum, task, mode, {
         "flat": bool(flat_obs) or mode in ("shared", "independent"),
         "frame_stack": int(frame_stack)}, dict(env_kwargs or {}))
+    growth = run_growth(growth, cur, task, mode, env_kwargs)
     import torch
 
     eval_every = int(eval_every) if eval_every else None
@@ -172,6 +206,8 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     if intrinsic is not None:
         config["intrinsic"] = intrinsic
     extra = {} if cur is None and bc is None else {"curriculum": cur, "bc": bc}
+    if growth is not None:
+        extra["growth"] = growth
     if mode is not None:
         return train_multi(task, algo, steps, seed, out, mode=mode, eval_every=eval_every,
                            eval_episodes=eval_episodes, checkpoint_every=checkpoint_every,

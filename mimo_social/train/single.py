@@ -25,8 +25,9 @@ import sys
 import time
 from pathlib import Path
 
-from .curriculum import CurriculumController, curriculum_envs
+from .curriculum import CurriculumController, curriculum_env, curriculum_envs
 from .envs import make_env
+from .growth import GrowthController, monitored_growth_env, wrap_growth
 from .interrupt import StopSignals
 from .progress import write_config
 from .rollouts import evaluate_policy, vecnormalize_path
@@ -159,6 +160,41 @@ def curriculum_controller(curriculum, venv, eval_env, config: dict, out: Path):
                                 lambda: write_config(out, config), warn)
 
 
+def growth_envs(growth, task: str, observation: dict, env_kwargs: dict, curriculum, eval_env,
+                steps: int):
+    """``(eval_env, env_fn)`` of a run under a growth schedule: the evaluation env and each
+    training env (the task's env, or its curriculum env, below its episode statistics) in a
+    :class:`~mimo_social.train.growth.GrowthEnv`."""
+    if curriculum is None:
+        make = functools.partial(make_env, task, **observation, **env_kwargs)
+    else:
+        make = functools.partial(curriculum_env, task, dict(observation),
+                                 curriculum.plan(env_kwargs))
+    return (wrap_growth(eval_env, growth, steps),
+            functools.partial(monitored_growth_env, make, growth.describe(), steps))
+
+
+def growth_controller(growth, venv, eval_env, steps: int, config: dict, out: Path):
+    """The :class:`~mimo_social.train.growth.GrowthController` of a run (None without a
+    growth schedule): it rewrites config.json and says so on stderr at each whole month."""
+    if growth is None:
+        return None
+    return GrowthController(growth, venv, eval_env, steps, config,
+                            lambda: write_config(out, config), warn)
+
+
+def step_hooks(*controls):
+    """The callback's ``on_step``: every controller's (None: no controller)."""
+    hooks = [c.on_step for c in controls if c is not None]
+    if not hooks:
+        return None
+
+    def on_step(n, infos) -> None:
+        for hook in hooks:
+            hook(n, infos)
+    return on_step
+
+
 def warm_start_run(model, task: str, env, bc: dict, seed: int, config: dict, out: Path, log,
                    eval_episodes: int, total_steps: int):
     """The behaviour-cloning warm start of a run before any RL step (on ``env``, the learner's
@@ -189,11 +225,12 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
                  eval_episodes: int, checkpoint_every: int, progress: bool, env_kwargs: dict,
                  algo_kwargs: dict, verbose: int, config: dict, n_envs: int = 1,
                  n_cpus: int = 0, worker_timeout: float = 600.0, curriculum=None,
-                 bc: dict | None = None) -> dict:
+                 bc: dict | None = None, growth=None) -> dict:
     """The one-learner part of :func:`mimo_social.train.runner.train` (arguments checked
     there); ``cls`` is the SB3 algorithm class. ``eval_every=None``: the budgeted schedule.
     ``curriculum``: a checked :class:`~mimo_social.train.curriculum.Curriculum`; ``bc``: the
-    warm start's settings (:func:`~mimo_social.train.demonstrations.check_bc`)."""
+    warm start's settings (:func:`~mimo_social.train.demonstrations.check_bc`); ``growth``: a
+    checked :class:`~mimo_social.train.growth.Growth` (the infant's age by training step)."""
     from .hyperparams import to_json     # (torch: not imported by the workers, which import
     from .workers import one_learner_vec_env     # this module for monitored_env)
 
@@ -210,11 +247,15 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         env_fn = functools.partial(monitored_env, task, dict(env_kwargs), observation)
     else:
         eval_env, env_fn = curriculum_envs(curriculum, task, observation, env_kwargs)
+    if growth is not None:
+        eval_env, env_fn = growth_envs(growth, task, observation, env_kwargs, curriculum,
+                                       eval_env, steps)
     venv = one_learner_vec_env(env_fn, int(n_envs), worker_timeout, n_workers=int(n_cpus))
     stop = StopSignals()
     try:
         venv, model, save = build_model(cls, algo, venv, config, algo_kwargs, seed, verbose)
         control = curriculum_controller(curriculum, venv, eval_env, config, out)
+        grow = growth_controller(growth, venv, eval_env, steps, config, out)
         planned, note = rounding_note(model, algo, steps)
         if note:
             warn(note)
@@ -234,6 +275,9 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         if control is not None:
             control.t_start = log.t_start
             log.columns.append(control.columns)
+        if grow is not None:
+            grow.t_start = log.t_start
+            log.columns.append(grow.columns)
         keep = None
         if bc is not None:
             keep = warm_start_run(model, task, eval_env, bc, seed, config, out, log,
@@ -247,7 +291,7 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         try:
             with stop:
                 cb = sb3_callback(log, schedule, None, 1, checkpoint, stop,
-                                  on_step=None if control is None else control.on_step)
+                                  on_step=step_hooks(control, grow))
                 if keep is not None:
                     from stable_baselines3.common.callbacks import CallbackList
                     cb = CallbackList([cb, keep])
