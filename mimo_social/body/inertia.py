@@ -29,8 +29,8 @@ __all__ = ["geom_moments", "geom_volumes", "geom_rbound", "geom_aabb", "quat_mat
            "ELLIPSOID"]
 
 _G = mujoco.mjtGeom
-SPHERE, CAPSULE, CYLINDER = int(_G.mjGEOM_SPHERE), int(_G.mjGEOM_CAPSULE), int(_G.mjGEOM_CYLINDER)
-BOX, ELLIPSOID = int(_G.mjGEOM_BOX), int(_G.mjGEOM_ELLIPSOID)
+SPHERE, CAPSULE = int(_G.mjGEOM_SPHERE), int(_G.mjGEOM_CAPSULE)
+CYLINDER, BOX, ELLIPSOID = int(_G.mjGEOM_CYLINDER), int(_G.mjGEOM_BOX), int(_G.mjGEOM_ELLIPSOID)
 
 
 def _columns(kind, size):

@@ -289,10 +289,10 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
             config = replace(self.agent_configs[i], **fields)
             if config == self.agent_configs[i]:
                 continue
-            old = w.tables[i]
+            old, old_age = w.tables[i], self.agent_configs[i].age
             w.regrow(i, config)
             self.agent_configs[i] = config
-            regrow_senses(self, i, old, size, pos)
+            regrow_senses(self, i, old, size, pos, old_age)
             self._delays[i] = delay_steps(config, self.dt)
             self._delay_rings(i)
         self.task.configs = tuple(self.agent_configs)

@@ -33,9 +33,11 @@ from typing import Mapping, Sequence
 import mujoco
 import numpy as np
 
+from ..body.growth import segment_factors
 from ..body.builder import EYE_CAMERA_X, GEOM_FRICTION, IRIS, PUPIL
-from ..body.inertia import (body_inertials, boxes_in_parent, geom_aabb, geom_moments,
-                            geom_rbound, quat_matrices)
+from ..body.inertia import (BOX, CAPSULE, CYLINDER, ELLIPSOID, SPHERE, body_inertials,
+                            boxes_in_parent, geom_aabb, geom_moments, geom_rbound,
+                            quat_matrices)
 from ..body.tables import BodyTables, load_body
 from ..senses import SENSES
 from ..senses.skin import regrown_skin
@@ -44,7 +46,8 @@ from .config import ConfigError
 from .delays import VESTIBULAR_SENSORS, delay_steps
 
 __all__ = ["AgentMaps", "agent_maps", "regrow_agent", "body_tables", "support_below",
-           "REST_CLEARANCE", "AGE_OPTIONS", "age_options", "age_changes", "regrow_senses"]
+           "REST_CLEARANCE", "AGE_OPTIONS", "age_options", "age_changes", "regrow_senses",
+           "frame_ratios"]
 
 #: a body starts with its lowest point this high above the floor (m), as the world places it
 REST_CLEARANCE = 0.002
@@ -119,15 +122,12 @@ def support_below(model, data, geom_ids) -> float:
     rz = data.geom_xmat[geom_ids].reshape(-1, 3, 3)[:, 2, :]
     size = model.geom_size[geom_ids]
     t = model.geom_type[geom_ids]
-    G = mujoco.mjtGeom
-    low = np.where(t == G.mjGEOM_SPHERE, size[:, 0], 0.0)
-    cap = t == G.mjGEOM_CAPSULE
-    low = np.where(cap, np.abs(rz[:, 2]) * size[:, 1] + size[:, 0], low)
-    cyl = t == G.mjGEOM_CYLINDER
-    low = np.where(cyl, np.abs(rz[:, 2]) * size[:, 1]
+    low = np.where(t == SPHERE, size[:, 0], 0.0)
+    low = np.where(t == CAPSULE, np.abs(rz[:, 2]) * size[:, 1] + size[:, 0], low)
+    low = np.where(t == CYLINDER, np.abs(rz[:, 2]) * size[:, 1]
                    + size[:, 0] * np.sqrt(np.clip(1 - rz[:, 2] ** 2, 0, 1)), low)
-    low = np.where(t == G.mjGEOM_BOX, np.sum(np.abs(rz) * size, axis=1), low)
-    low = np.where(t == G.mjGEOM_ELLIPSOID, np.sqrt(np.sum((rz * size) ** 2, axis=1)), low)
+    low = np.where(t == BOX, np.sum(np.abs(rz) * size, axis=1), low)
+    low = np.where(t == ELLIPSOID, np.sqrt(np.sum((rz * size) ** 2, axis=1)), low)
     return float(np.min(z - low))
 
 
@@ -356,13 +356,28 @@ def age_changes(names: Sequence[str], configs: Sequence, values: Mapping, agent=
     return out
 
 
+def frame_ratios(old_age: float, new_age: float, segments: Sequence[str]) -> np.ndarray:
+    """(n, 3) per segment the ratio of its frame's x, y, z length factors at ``new_age`` to
+    those at ``old_age`` (:func:`~mimo_social.body.growth.segment_factors`; a ``left_``
+    segment takes its right twin's)."""
+    def factors(age):
+        table = segment_factors(age)
+        out = []
+        for name in segments:
+            key = name if name in table or not name.startswith("left_") else "right_" + name[5:]
+            radial, axial, axis = table.get(key, (1.0, 1.0, "z"))
+            out.append([axial if a == axis else radial for a in "xyz"])
+        return np.array(out)
+    return factors(new_age) / factors(old_age)
+
+
 def regrow_senses(env, i: int, old: BodyTables, old_size: np.ndarray,
-                  old_pos: np.ndarray) -> None:
+                  old_pos: np.ndarray, old_age: float) -> None:
     """After :meth:`World.regrow` of agent ``i``: its motors take the new torques, its senses'
     spaces the new bounds (the same space objects), its skin follows its geoms (as many
     points: :func:`~mimo_social.senses.skin.regrown_skin`) and its eyes' acuity the body age.
     ``old``: its tables before; ``old_size``, ``old_pos``: every geom's size and position
-    before."""
+    before; ``old_age``: its body age before."""
     w, cfg = env.world, env.agent_configs[i]
     t = w.tables[i]
     by_name = {j.name: j for j in t.joints}
@@ -381,7 +396,8 @@ def regrow_senses(env, i: int, old: BodyTables, old_size: np.ndarray,
     if touch is not None and touch.skins[i] is not None:
         skin = touch.skins[i]
         ratio = np.array([t.touch_spacing[n] / old.touch_spacing[n] for n in skin.part_names])
-        touch.skins[i] = regrown_skin(skin, w.model, old_size, old_pos, ratio)
+        touch.skins[i] = regrown_skin(skin, w.model, old_size, old_pos, ratio,
+                                      frame_ratios(old_age, cfg.age, skin.part_names))
         touch.concatenate(w.model)
         for sense in env.senses[i]:
             if sense.name == "touch":
