@@ -377,9 +377,9 @@ def free_camera_pixel(cam, point, height: int, width: int, fovy_deg: float):
 
 def save_validation_body_png(path) -> str:
     """The grown body (every 0.5 months, 0-24) against published infant data
-    (docs/validation.md): standing length and mass against the WHO medians with the tolerance
-    bands of the tests, head circumference against the WHO medians, and the newborn's
-    mid-upper-arm circumference and arm-to-head ratio against term newborns."""
+    (docs/validation.md): standing length, mass, head and mid-upper-arm circumferences against
+    the WHO medians with the tolerance bands of the tests, and the newborn's arm circumference
+    and arm-to-head ratio against term newborns."""
     from .body import growth
 
     plt = _pyplot()
@@ -410,19 +410,24 @@ def save_validation_body_png(path) -> str:
     ax = axes[3]
     ratio = model["upper_arm_cm"] / model["head_cm"]
     ax.plot(age, model["upper_arm_cm"], "-", color="tab:blue", lw=2,
-            label="model: mid-upper-arm circumference (cm)")
+            label="the model (cm)")
     muac = "mid_upper_arm_circumference_cm"
+    who_arm = growth.who_arm_circumference()
+    wa = np.array(sorted(who_arm))
+    wv = np.array([who_arm[a] for a in wa])
+    ax.fill_between(wa, wv * 0.95, wv * 1.05, color="0.85", label="tested band, +/- 5 %")
+    ax.plot(wa, wv, "o", color="k", ms=5, label="WHO median (from 3 months)")
     ax.errorbar([0], [arm[muac]], yerr=[arm[muac + "_sd"]], fmt="s", color="k",
                 ms=5, capsize=3, label="term newborns (mean, SD)")
     twin = ax.twinx()
-    twin.plot(age, ratio, "--", color="tab:orange", lw=1.5, label="model: arm / head")
+    twin.plot(age, ratio, "--", color="tab:orange", lw=1.5, label="the model: arm / head")
     ahr = "arm_to_head_circumference_ratio"
     twin.errorbar([0.4], [arm[ahr]], yerr=[arm[ahr + "_sd"]], fmt="D",
                   color="tab:red", ms=4, capsize=3, label="term newborns: arm / head")
-    twin.set_ylim(0.2, 0.4)
-    ax.set_ylim(8, 18)
+    twin.set_ylim(0.1, 0.4)
+    ax.set_ylim(5, 17)
     ax.set_xlabel("age (months)")
-    ax.set_title("Mid-upper-arm circumference", fontsize=10)
+    ax.set_title("Mid-upper-arm circumference (cm); arm / head (right)", fontsize=10)
     ax.grid(alpha=0.3)
     lines = ax.get_legend_handles_labels()
     lines2 = twin.get_legend_handles_labels()

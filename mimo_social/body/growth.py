@@ -45,7 +45,8 @@ from .tables import AGE_RANGE, BodyTables, load_body
 
 __all__ = ["AGE_RANGE", "REFERENCE_AGE", "YOUNGEST_GROUP", "measurement", "measurements",
            "segment_factors", "grow_body", "who_medians", "who_head_circumference",
-           "newborn_arm", "circumferences", "body_measures", "growth_table"]
+           "who_arm_circumference", "newborn_arm", "circumferences", "body_measures",
+           "growth_table"]
 
 #: The age of the published body: every factor is 1 there.
 REFERENCE_AGE = 18.0
@@ -164,6 +165,14 @@ def who_head_circumference() -> dict:
     age (months) -> cm (``who_head_circumference.csv``; sources in ``body/data/README.md``)."""
     return {float(r["age_months"]): (float(r["head_boys_cm"]) + float(r["head_girls_cm"])) / 2
             for r in _rows("who_head_circumference.csv")}
+
+
+@functools.lru_cache(maxsize=None)
+def who_arm_circumference() -> dict:
+    """WHO Child Growth Standards arm-circumference-for-age medians (3 to 24 months), boys and
+    girls averaged: age (months) -> cm (``who_arm_circumference.csv``)."""
+    return {float(r["age_months"]): (float(r["arm_boys_cm"]) + float(r["arm_girls_cm"])) / 2
+            for r in _rows("who_arm_circumference.csv")}
 
 
 @functools.lru_cache(maxsize=None)

@@ -12,17 +12,18 @@ import pytest
 from mimo_social.body.builder import build_infant
 from mimo_social.body.growth import (YOUNGEST_GROUP, body_measures, circumferences, measurement,
                                      measurements, newborn_arm, segment_factors,
-                                     who_head_circumference, who_medians)
+                                     who_arm_circumference, who_head_circumference,
+                                     who_medians)
 from mimo_social.body.tables import load_body
 
 #: docs/validation.md: relative tolerance of each quantity against its WHO median
-LENGTH, WEIGHT, HEAD = 0.07, 0.10, 0.03
+LENGTH, WEIGHT, HEAD, ARM = 0.07, 0.10, 0.03, 0.05
 WHO_AGES = (0, 6, 12, 18, 24)
 
 
 @pytest.fixture(scope="module")
 def model():
-    ages = sorted(set(WHO_AGES) | set(who_head_circumference()))
+    ages = sorted(set(WHO_AGES) | set(who_head_circumference()) | set(who_arm_circumference()))
     m = body_measures(ages)
     return {a: {k: float(v[i]) for k, v in m.items()} for i, a in enumerate(ages)}
 
@@ -48,6 +49,13 @@ def test_head_circumference_follows_the_who_medians(model):
     assert set(heads) == {0.0, 1.0, 6.0, 12.0, 18.0, 24.0}
     for age, ref in heads.items():
         assert abs(model[age]["head_cm"] / ref - 1) <= HEAD, (age, model[age]["head_cm"], ref)
+
+
+def test_arm_circumference_follows_the_who_medians(model):
+    arms = who_arm_circumference()
+    assert set(arms) == {3.0, 6.0, 12.0, 18.0, 24.0}               # the standard starts at 3
+    for age, ref in arms.items():
+        assert abs(model[age]["upper_arm_cm"] / ref - 1) <= ARM, (age, model[age], ref)
 
 
 def test_the_newborn_arm_matches_term_newborns(model):
@@ -81,8 +89,8 @@ def test_below_the_youngest_group_the_body_shrinks_isometrically():
 def test_every_data_file_names_its_source():
     data = resources.files("mimo_social.body").joinpath("data")
     readme = data.joinpath("README.md").read_text()
-    for name in ("who_medians.csv", "who_head_circumference.csv", "newborn_arm.csv",
-                 "growth_curves.csv"):
+    for name in ("who_medians.csv", "who_head_circumference.csv", "who_arm_circumference.csv",
+                 "newborn_arm.csv", "growth_curves.csv"):
         assert f"`{name}`" in readme, name
 
 
