@@ -216,8 +216,9 @@ class GrowthEnv(gym.Wrapper):
     it on to the env below; it takes effect at the next reset. With ``draw`` (``[low, high]``,
     a stochastic schedule) each reset first draws the age uniformly from the range with the
     wrapper's generator, seeded by the reset's seed (``np.random.default_rng([seed,
-    DRAW_SALT])``), and sets it. The age is set again before a reset whenever the env below is
-    another object (a curriculum stage made it anew). Every info carries ``age_months``."""
+    DRAW_SALT])``), and sets it. Each reset also passes the age in force in its ``options``
+    (``{"age_months": x}``, the core env's other way to set it), so that an env below made anew
+    (a curriculum's next stage) takes it too. Every info carries ``age_months``."""
 
     def __init__(self, env: gym.Env, age_months: float | None = None,
                  draw: tuple[float, float] | None = None):
@@ -226,7 +227,6 @@ class GrowthEnv(gym.Wrapper):
         self.rng = np.random.default_rng(DRAW_SALT)
         self.pending = None if age_months is None else float(age_months)
         self.age_months = self.pending
-        self._applied: tuple | None = None
         #: the ages drawn since :meth:`take_drawn` last emptied it (stochastic)
         self.drawn: deque = deque(maxlen=100_000)
 
@@ -240,7 +240,6 @@ class GrowthEnv(gym.Wrapper):
     def _apply(self, motor_age_months=None, agent=None) -> None:
         inner = self.env.get_wrapper_attr("set_age")
         inner(age_months=self.pending, motor_age_months=motor_age_months, agent=agent)
-        self._applied = (self.pending, id(self.env.unwrapped))
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         if seed is not None:
@@ -249,9 +248,12 @@ class GrowthEnv(gym.Wrapper):
             low, high = self.draw
             self.pending = float(self.rng.uniform(low, high)) if high > low else low
             self.drawn.append(self.pending)
-        if self.pending is not None and self._applied != (self.pending, id(self.env.unwrapped)):
             self._apply()
-        self.age_months = self.pending
+        if self.pending is not None:
+            # the age in the reset's options too: an env below made anew since (a curriculum's
+            # next stage) takes it as well; an age given in ``options`` wins
+            options = {"age_months": self.pending, **(options or {})}
+        self.age_months = (options or {}).get("age_months", self.pending)
         obs, info = self.env.reset(seed=seed, options=options)
         if self.age_months is not None:
             info["age_months"] = self.age_months

@@ -106,6 +106,9 @@ class AgedEnv(gym.Env):
 
     def reset(self, *, seed=None, options=None):
         super().reset(seed=seed)
+        self.options = options
+        if options and "age_months" in options:
+            self.pending = options["age_months"]
         self.age, self.t = self.pending, 0
         return np.zeros(1, np.float32), {}
 
@@ -122,11 +125,13 @@ def test_the_wrapper_passes_set_age_on_and_it_applies_at_the_next_reset():
     assert inner.age == 1.0 and info["age_months"] == 1.0
     env.set_age(age_months=4.5)
     assert env.step(env.action_space.sample())[-1]["age_months"] == 1.0   # the running episode
+    assert inner.calls == [4.5]      # passed on at once, for the next reset
     env.reset()
     assert inner.age == 4.5 and env.step(env.action_space.sample())[-1]["age_months"] == 4.5
-    n = len(inner.calls)
-    env.reset()
-    assert len(inner.calls) == n     # unchanged: not set again
+    assert inner.options == {"age_months": 4.5}   # and in every reset's options
+    inner.pending = None             # an env below made anew (a curriculum's next stage) ...
+    env.reset(options={"other": 1})
+    assert inner.age == 4.5 and inner.options == {"age_months": 4.5, "other": 1}   # ... takes it
 
 
 def test_a_stochastic_wrapper_draws_each_episode_from_its_seeded_generator():
@@ -240,3 +245,118 @@ def test_growth_is_refused_where_it_cannot_apply(tmp_path):
 def _rows(path):
     with open(path, newline="") as f:
         return list(csv.DictReader(f))
+
+
+# -- the real env: its set_age, in this process, in worker processes, in a run -------------------
+#: reach with short episodes, its ball placed at least 0.2 m from the shoulder (a 1-month-old's
+#: reach allows it; the task's 0.25 m does not below 6 months)
+REACH = {"max_steps": 5, "task_options": {"min_distance": 0.2}}
+
+
+def _reach():
+    from mimo_social.train.envs import make_env
+    return make_env("reach", flat=True, **REACH)
+
+
+def test_the_body_takes_the_age_at_the_next_reset_in_this_process():
+    from stable_baselines3.common.vec_env import DummyVecEnv
+    venv = DummyVecEnv([lambda: monitored_growth_env(_reach, "forward:1-12", 100)])
+    config = venv.envs[0].unwrapped.parallel.agent_configs
+    try:
+        venv.seed(0)
+        venv.reset()
+        assert config[0].age_months == 1.0
+        venv.env_method("set_age", age_months=9.5)
+        for k in range(REACH["max_steps"]):
+            assert config[0].age_months == 1.0            # the running episode keeps its age
+            *_, dones, infos = venv.step(np.zeros((1, *venv.action_space.shape)))
+        assert dones[0] and infos[0]["age_months"] == 1.0
+        assert config[0].age_months == 9.5                # the next one: auto-reset at 9.5
+    finally:
+        venv.close()
+
+
+def test_envs_in_worker_processes_take_the_age_at_their_next_reset():
+    from mimo_social.train.workers import TimedSubprocVecEnv
+    import functools
+    fn = functools.partial(monitored_growth_env, _reach, "forward:1-12", 100)
+    venv = TimedSubprocVecEnv([fn, fn], n_workers=1)
+    try:
+        venv.seed(0)
+        venv.reset()
+        assert venv.get_attr("age_months") == [1.0, 1.0]
+        venv.env_method("set_age", age_months=6.0)
+        zero = np.zeros((2, *venv.action_space.shape))
+        for _ in range(REACH["max_steps"]):
+            *_, dones, infos = venv.step(zero)
+        assert all(dones) and [i["age_months"] for i in infos] == [1.0, 1.0]
+        assert venv.get_attr("age_months") == [6.0, 6.0]
+        assert [i["age_months"] for i in venv.step(zero)[-1]] == [6.0, 6.0]
+    finally:
+        venv.close()
+
+
+TINY = ["--algo", "ppo", "--no-progress", "--n-envs", "2", "--eval-episodes", "1",
+        "--env-kwargs", json.dumps({**REACH, "max_steps": 15}),
+        "--algo-kwargs", '{"n_steps": 64, "n_epochs": 1, "batch_size": 128}']
+
+
+def test_a_forward_run_grows_the_infant_and_records_it(tmp_path, capfd):
+    from mimo_social.cli import main
+    out = tmp_path / "run"
+    assert main(["train", "--task", "reach", "--steps", "384", "--out", str(out), "--n-cpus",
+                 "1", "--eval-every", "128", "--growth", "forward:1-12", *TINY]) == 0
+    config = json.loads((out / "config.json").read_text())
+    g = config["growth"]
+    assert g["spec"] == "forward:1-12" and g["kind"] == "forward" and g["span"] == 384
+    months = [h["age_months"] for h in g["history"]]
+    assert months[0] == 1 and months == sorted(months) and months[-1] >= 11
+    assert all(m == int(m) for m in months)               # whole months only
+    rows = _rows(out / "progress.csv")
+    ages = [float(r["age_months"]) for r in rows]
+    assert ages[-1] == 12 and ages == sorted(ages) and len(set(ages)) >= 3
+    for r, a in zip(rows, ages):       # the schedule at the row's step, on the 0.1-month grid
+        assert a == pytest.approx(np.floor((1 + 11 * int(r["timesteps"]) / 384) * 10 + 1e-6)
+                                  / 10)
+    assert [r["eval_age_months"] for r in rows] == [r["age_months"] for r in rows]
+    err = capfd.readouterr().err
+    notes = [line for line in err.splitlines() if "growth: the infant is" in line]
+    assert len(notes) == len(months) - 1 and "12 months old" in notes[-1]
+
+
+def test_a_stochastic_run_draws_every_episode_s_age_in_its_range(tmp_path, capfd):
+    from mimo_social.train import train
+    out = tmp_path / "run"
+    train("reach", "ppo", 256, 0, out, progress=False, n_envs=2, n_cpus=0, eval_every=128,
+          eval_episodes=2, growth="stochastic:3-9", env_kwargs={**REACH, "max_steps": 15},
+          algo_kwargs={"n_steps": 64, "n_epochs": 1, "batch_size": 128})
+    config = json.loads((out / "config.json").read_text())
+    assert config["growth"]["spec"] == "stochastic:3-9" and config["growth"]["history"] == []
+    rows = _rows(out / "progress.csv")
+    trained = [float(r["age_months"]) for r in rows if int(r["train_episodes"])]
+    assert trained and all(3 <= a <= 9 for a in trained) and len(set(trained)) > 1
+    evals = {r["eval_age_months"] for r in rows}
+    assert len(evals) == 1 and 3 <= float(evals.pop()) <= 9      # the same seeded draws
+    assert "growth:" not in capfd.readouterr().err                 # no line per episode
+
+
+def test_a_curriculum_s_growth_key_grows_the_infant_across_its_stages(tmp_path):
+    from mimo_social.train import train
+    spec = {"growth": "forward:6-12", "stages": [
+        {"name": "short", "env_kwargs": {"max_steps": 10}, "until": {"steps": 128}},
+        {"name": "task"}]}
+    kw = dict(progress=False, n_envs=2, n_cpus=0, eval_every=128, eval_episodes=1,
+              env_kwargs={**REACH, "max_steps": 15},
+              algo_kwargs={"n_steps": 64, "n_epochs": 1, "batch_size": 128})
+    out = tmp_path / "run"
+    train("reach", "ppo", 256, 0, out, curriculum=spec, **kw)
+    config = json.loads((out / "config.json").read_text())
+    assert config["curriculum"]["growth"] == "forward:6-12"
+    assert config["growth"]["spec"] == "forward:6-12"
+    assert [h["stage"] for h in config["curriculum"]["history"]] == [0, 1]
+    rows = _rows(out / "progress.csv")
+    assert float(rows[-1]["age_months"]) == 12 and rows[-1]["curriculum_stage"] == "1"
+    with pytest.raises(TrainInputError, match="the curriculum's growth forward:6-12: allowed: "
+                                              "one of the two"):
+        train("reach", "ppo", 256, 0, tmp_path / "again", curriculum=spec,
+              growth="inverse:1-3", **kw)
