@@ -7,6 +7,7 @@ import contextlib
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,12 +15,15 @@ import pytest
 from mimo_social import cli
 from mimo_social.experiments import viewer
 
+ROOT = Path(__file__).resolve().parents[2]
+
 
 def run_cli(args, **env_changes):
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     env.update(env_changes)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
     return subprocess.run([sys.executable, "-m", "mimo_social.cli", "view", *args], env=env,
-                          capture_output=True, text=True)
+                          cwd=ROOT, capture_output=True, text=True)
 
 
 def test_without_a_display_one_line_says_why_and_what_to_do_exit_2():
