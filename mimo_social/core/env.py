@@ -285,17 +285,22 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
         senses, the delays and the task."""
         w = self.world
         size, pos = w.model.geom_size.copy(), w.model.geom_pos.copy()
-        for i, fields in sorted(changes.items()):
-            config = replace(self.agent_configs[i], **fields)
-            if config == self.agent_configs[i]:
-                continue
-            old, old_age = w.tables[i], self.agent_configs[i].age
-            w.regrow(i, config)
-            self.agent_configs[i] = config
-            regrow_senses(self, i, old, size, pos, old_age)
-            self._delays[i] = delay_steps(config, self.dt)
-            self._delay_rings(i)
-        self.task.configs = tuple(self.agent_configs)
+        before = list(self.agent_configs)
+        configs = [replace(c, **changes.get(i, {})) for i, c in enumerate(before)]
+        if configs == before:
+            return
+        self.task.configs = tuple(configs)   # a task may place agents by their sizes
+        setups = [self.task.setup(i, c) for i, c in enumerate(configs)]
+        tables = list(w.tables)
+        for i, setup in enumerate(setups):
+            if setup != w.agent_setups[i]:
+                w.regrow(i, setup)
+        for i, config in enumerate(configs):
+            if config != before[i]:
+                self.agent_configs[i] = config
+                regrow_senses(self, i, tables[i], size, pos, before[i].age)
+                self._delays[i] = delay_steps(config, self.dt)
+                self._delay_rings(i)
         self._bind_task()
 
     def reset(self, seed: int | None = None, options: dict | None = None):

@@ -34,7 +34,8 @@ import mujoco
 import numpy as np
 
 from ..body.growth import segment_factors
-from ..body.builder import EYE_CAMERA_X, GEOM_FRICTION, IRIS, PUPIL
+from ..body.builder import (EYE_CAMERA_X, GEOM_FRICTION, IRIS, PUPIL, axis_angle_quat,
+                            quat_mul)
 from ..body.inertia import (BOX, CAPSULE, CYLINDER, ELLIPSOID, SPHERE, body_inertials,
                             boxes_in_parent, geom_aabb, geom_moments, geom_rbound,
                             quat_matrices)
@@ -217,27 +218,71 @@ def _write_inertia(m, maps: AgentMaps, t: BodyTables) -> None:
         m.bvh_aabb[n, :3], m.bvh_aabb[n, 3:] = (lo + hi) / 2, (hi - lo) / 2
 
 
-def _lower_onto_floor(world, i: int, maps: AgentMaps, scratch) -> None:
-    """The agent's start height from its (new) geometry in its rest pose."""
+def _write_frozen(world, i: int, maps: AgentMaps, t: BodyTables, held) -> None:
+    """Held joints at their (new) angles ``held`` (joint -> rad, the same joints as built): a
+    joint folded into its segment's orientation turns the segment (``body_quat``), one held by
+    an equality gets the angle in ``eq_data`` and in the start pose."""
+    m = world.model
+    held = dict(held)
+    for j in t.joints:   # a held driver holds its coupled follower (as the builder does)
+        if j.coupled_to in held and j.name not in held:
+            held[j.name] = held[j.coupled_to] * j.coupling
+    row = {j.name: k for k, j in enumerate(t.joints)}
+    for k, seg in enumerate(t.segments):
+        if seg.parent is None:
+            continue
+        quat = np.array(seg.quat, float)
+        for j in t.joints:
+            if j.body != seg.name:
+                continue
+            if j.name not in held or maps.joint[row[j.name]] >= 0:
+                break
+            quat = quat_mul(quat, axis_angle_quat(j.axis, held[j.name]))
+        m.body_quat[maps.segment_body[k]] = quat / np.linalg.norm(quat)   # as compiled
+    a = world.agents[i]
+    for name, angle in held.items():
+        jid = maps.joint[row[name]]
+        if jid < 0:
+            continue
+        eq = np.flatnonzero((m.eq_type == mujoco.mjtEq.mjEQ_JOINT) & (m.eq_obj1id == jid)
+                            & (m.eq_obj2id == -1))
+        m.eq_data[eq, 0] = angle
+        world.set_initial_qpos(a.qpos_adr[a.joint_names.index(name)], angle)
+
+
+def _place(world, i: int, maps: AgentMaps, setup, quat, scratch) -> None:
+    """The agent's start pose: its root at ``setup.position`` turned by ``quat``, lowered onto
+    the floor from its (new) geometry in its rest pose."""
     m = world.model
     a = world.agents[i]
+    root = maps.root
+    free = a.free_qpos
     q = world.initial_qpos
+    if free >= 0:
+        q[free:free + 2] = setup.position
+        q[free + 3:free + 7] = quat
+    else:
+        m.body_pos[root, :2] = setup.position
+        m.body_quat[root] = quat
     scratch.qpos[:] = q
     mujoco.mj_kinematics(m, scratch)
     low = support_below(m, scratch, maps.geoms)
-    if a.free_qpos >= 0:
-        z = a.free_qpos + 2
-        height = q[z] - low + REST_CLEARANCE
-        world.set_initial_height(i, height)
-        m.qpos0[z] = m.qpos_spring[z] = m.body_pos[maps.root, 2] = height
+    if free >= 0:
+        q[free + 2] += REST_CLEARANCE - low
+        world.set_initial_root(i, q[free:free + 3], quat)
+        for target in (m.qpos0, m.qpos_spring):
+            target[free:free + 7] = q[free:free + 7]
+        m.body_pos[root], m.body_quat[root] = q[free:free + 3], quat
     else:
-        m.body_pos[maps.root, 2] += REST_CLEARANCE - low
+        m.body_pos[root, 2] += REST_CLEARANCE - low
 
 
-def regrow_agent(world, i: int, config, dt: float) -> BodyTables:
-    """Write agent ``i``'s body at ``config``'s ages into ``world``'s compiled model (module
-    docstring); returns the new tables. A ConfigError when the change needs a recompile (the
-    vestibular delay beyond what the model's sensor history holds)."""
+def regrow_agent(world, i: int, setup, quat, dt: float) -> BodyTables:
+    """Write agent ``i``'s body at the ages of ``setup.config``, placed at ``setup.position``
+    with its root turned by ``quat``, into ``world``'s compiled model (module docstring);
+    returns the new tables. A ConfigError when the change needs a recompile (a vestibular delay
+    beyond what the model's sensor history holds)."""
+    config = setup.config
     m = world.model
     maps = world.regrow_maps(i)
     t = body_tables(config)
@@ -246,9 +291,10 @@ def regrow_agent(world, i: int, config, dt: float) -> BodyTables:
         _vestibular_delay(world, i, k, dt, VESTIBULAR_SENSORS)
     size_before = _mean_box(m)
     _write_body(m, maps, t)
+    _write_frozen(world, i, maps, t, setup.frozen)
     _write_inertia(m, maps, t)
     scratch = world.scratch_data()
-    _lower_onto_floor(world, i, maps, scratch)
+    _place(world, i, maps, setup, quat, scratch)
     mujoco.mj_setConst(m, scratch)
     _write_statistics(m, size_before)
     return t

@@ -27,7 +27,7 @@ from ..expressions.switch import FaceTextures
 from ..scenery import SCENES, add_playroom, clear_toys
 from ..util.checks import check_choice
 from ..util.names import agent_names
-from .config import AgentConfig, PhysicsConfig
+from .config import AgentConfig, ConfigError, PhysicsConfig
 from .delays import check_delay_steps, delay_sensors, fill_sensor_history
 from .regrow import agent_maps, regrow_agent
 
@@ -172,8 +172,8 @@ class World:
 
     def __setstate__(self, state):
         self.__init__(*state["recipe"])   # the index tables, faces and spec of the recipe
-        for i, config in state.get("regrown", {}).items():   # ages changed since (regrow)
-            self.regrow(i, config)
+        for i, setup in state.get("regrown", {}).items():   # ages changed since (regrow)
+            self.regrow(i, setup)
         self.data = state["data"]
         for k, v in state.get("awake", {}).items():
             setattr(self.data, k, v)
@@ -233,7 +233,7 @@ class World:
             if self.room is not None and self.ROOM_SLEEP and not p.fixed:
                 body.sleep = mujoco.mjtSleepPolicy.mjSLEEP_NEVER   # tasks move their props
         self.spec = spec
-        self.regrown: dict[int, AgentConfig] = {}   # agent -> its config after an age change
+        self.regrown: dict[int, AgentSetup] = {}   # agent -> its setup after an age change
         self._regrow_maps: dict[int, object] = {}
         self._scratch = None
         self.model = spec.compile()
@@ -550,17 +550,30 @@ class World:
         self._bad_count = 0
 
     # -- another age without compiling (core/regrow.py) -----------------------------------------
-    def regrow(self, i: int, config: AgentConfig) -> None:
-        """Agent ``i``'s body at the ages of ``config`` (same hands, body kind and senses),
-        written into the compiled model in place (:func:`~mimo_social.core.regrow.regrow_agent`);
-        its tables, setup and start height follow. Takes effect at the next :meth:`reset`."""
+    def regrow(self, i: int, setup: AgentSetup) -> None:
+        """Agent ``i`` as ``setup`` says: its body at the ages of ``setup.config`` (the same
+        hands, body kind and senses) and its place, written into the compiled model in place
+        (:func:`~mimo_social.core.regrow.regrow_agent`); its tables, setup and start pose
+        follow. Takes effect at the next :meth:`reset`. A ConfigError when the setup needs
+        another model (other held joints, motors, base or senses)."""
+        old = self.agent_setups[i]
+        same = replace(setup, config=old.config, position=old.position, facing=old.facing,
+                       frozen=old.frozen if set(setup.frozen) == set(old.frozen) else None)
+        kept = ("hands", "body", "actuation", "scale", "strength", "expressions", "posture")
+        if same != old or any(getattr(setup.config, k) != getattr(old.config, k) for k in kept):
+            raise ConfigError(f"agent {self.names[i]}: this change needs another model (held "
+                              "joints, motors, base, hands, body, actuation, size or posture); "
+                              "an age change at reset changes only the ages and the place")
         dt = self.physics.timestep * self.physics.frame_skip
-        check_delay_steps(self.names[i], config, dt)
-        self.tables[i] = regrow_agent(self, i, config, dt)
+        check_delay_steps(self.names[i], setup.config, dt)
+        pitch = posture_pitch(setup.config.posture, setup.config.body)
+        quat = quat_mul(_yaw_quat(setup.position, setup.facing),
+                        axis_angle_quat((0, 1, 0), np.deg2rad(pitch)))
+        self.tables[i] = regrow_agent(self, i, setup, quat, dt)
         setups = list(self.agent_setups)
-        setups[i] = replace(setups[i], config=config)
+        setups[i] = setup
         self.agent_setups = tuple(setups)
-        self.regrown[i] = config
+        self.regrown[i] = setup
 
     def regrow_maps(self, i: int):
         """Agent ``i``'s table rows as model ids (:func:`~mimo_social.core.regrow.agent_maps`),
@@ -575,10 +588,15 @@ class World:
             self._scratch = mujoco.MjData(self.model)
         return self._scratch
 
-    def set_initial_height(self, i: int, height: float) -> None:
-        """The start height (m) of agent ``i``'s free root."""
+    def set_initial_qpos(self, address: int, value: float) -> None:
+        """One value of the start pose (``qpos`` address)."""
+        self._initial_qpos[address] = value
+
+    def set_initial_root(self, i: int, position, quat) -> None:
+        """The start position (m) and orientation of agent ``i``'s free root."""
         a = self.agents[i]
-        self._initial_qpos[a.free_qpos + 2] = height
+        self._initial_qpos[a.free_qpos:a.free_qpos + 3] = position
+        self._initial_qpos[a.free_qpos + 3:a.free_qpos + 7] = quat
 
     def set_expression(self, agent: int, expression: int) -> None:
         self.faces.show(self.model, self.agents[agent].head_material, expression)

@@ -1,0 +1,218 @@
+"""An infant's age changed at reset without compiling (``env.set_age``, ``reset(options=...)``):
+the change writes the body of the new ages into the live model and equals a fresh build at those
+ages (masses, inertia tensors, geoms, bodies, joints, motors, the start pose, and the motion under
+the same actions); no compile happens and it is cheap; a pickled copy continues identically, a
+seeded reset repeats, every delay buffer starts from the reset reading, bad input is named."""
+
+from __future__ import annotations
+
+import pickle
+import statistics
+import time
+
+import mujoco
+import numpy as np
+import pytest
+
+from mimo_social.body.inertia import quat_matrices
+from mimo_social.core.config import ConfigError
+from mimo_social.core.gym_adapter import SingleAgentEnv
+from mimo_social.envs import free_play_v0, high_five_v0, still_face_v0
+
+STEPS = 100
+
+
+def _tensors(m, bodies):
+    R = quat_matrices(m.body_iquat[bodies])
+    return np.einsum("nij,nj,nkj->nik", R, m.body_inertia[bodies], R)
+
+
+def _same_model(a, b, tol=1e-9):
+    """Every age-dependent model value of the agents of ``a`` equal to ``b``'s."""
+    ma, mb = a.world.model, b.world.model
+    for ag_a, ag_b in zip(a.world.agents, b.world.agents):
+        bodies, geoms = ag_a.body_ids, ag_a.geom_ids
+        assert np.array_equal(bodies, ag_b.body_ids) and np.array_equal(geoms, ag_b.geom_ids)
+        for field in ("body_mass", "body_pos", "body_ipos", "body_subtreemass"):
+            np.testing.assert_allclose(getattr(ma, field)[bodies], getattr(mb, field)[bodies],
+                                       rtol=tol, atol=1e-12, err_msg=field)
+        np.testing.assert_allclose(_tensors(ma, bodies), _tensors(mb, bodies), rtol=tol,
+                                   atol=1e-14, err_msg="inertia tensors")
+        for field in ("geom_size", "geom_pos", "geom_rbound", "geom_aabb", "geom_friction"):
+            np.testing.assert_allclose(getattr(ma, field)[geoms], getattr(mb, field)[geoms],
+                                       rtol=tol, atol=1e-12, err_msg=field)
+    for field in ("body_quat", "eq_data", "jnt_pos", "jnt_stiffness", "dof_damping", "dof_armature", "dof_frictionloss",
+                  "actuator_ctrlrange", "actuator_forcerange", "actuator_gainprm",
+                  "actuator_biasprm", "actuator_gear", "site_pos", "cam_pos", "bvh_aabb",
+                  "dof_invweight0", "body_invweight0", "actuator_acc0", "qpos0", "sensor_delay"):
+        np.testing.assert_allclose(getattr(ma, field), getattr(mb, field), rtol=tol, atol=1e-12,
+                                   err_msg=field)
+    assert ma.stat.meaninertia == pytest.approx(mb.stat.meaninertia, rel=1e-12)
+
+
+def _actions(env, n, seed=1):
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(n):
+        step = {}
+        for a in env.possible_agents:
+            sp = env.action_space(a)
+            motors = sp["motors"] if hasattr(sp, "spaces") else sp
+            u = rng.uniform(motors.low, motors.high).astype(np.float32)
+            step[a] = {"motors": u, "expression": 0} if hasattr(sp, "spaces") else u
+        out.append(step)
+    return out
+
+
+def _run(env, actions, seed=3, **reset):
+    obs, _ = env.reset(seed=seed, **reset)
+    start = env.world.data.qpos.copy()
+    for act in actions:
+        env.step(act)
+    return obs, start, env.world.data.qpos.copy()
+
+
+@pytest.mark.parametrize("hands,actuation", [("mitten", "spring_damper"),
+                                             ("five_fingers", "spring_damper"),
+                                             ("mitten", "muscle"), ("mitten", "positional")])
+def test_an_age_change_at_reset_equals_a_fresh_build(hands, actuation):
+    kw = dict(hands=hands, actuation=actuation, delays="developmental", max_steps=10_000)
+    if actuation == "spring_damper":
+        kw["touch"] = True    # the whole body's skin (the task's default: the right hand's)
+    env = high_five_v0.parallel_env(**kw)
+    env.reset(seed=0)
+    model, data = env.world.model, env.world.data
+    spaces_before = {a: env.observation_space(a) for a in env.possible_agents}
+    shapes = {a: {k: s.shape for k, s in sp.spaces.items()} for a, sp in spaces_before.items()}
+    env.set_age(age_months=6, motor_age_months=12)
+    fresh = high_five_v0.parallel_env(age_months=6, motor_age_months=12, **kw)
+    actions = _actions(env, STEPS)
+    obs, start, end = _run(env, actions)
+    obs_f, start_f, end_f = _run(fresh, actions)
+    assert env.world.model is model and env.world.data is data   # nothing rebuilt
+    assert all(c.age_months == 6 and c.motor_age_months == 12 for c in env.agent_configs)
+    _same_model(env, fresh)
+    np.testing.assert_allclose(start, start_f, atol=1e-12)          # the start pose
+    np.testing.assert_allclose(end, end_f, atol=1e-6)               # the motion
+    for a in env.possible_agents:                                   # the same space objects
+        assert env.observation_space(a) is spaces_before[a]
+        assert {k: v.shape for k, v in obs[a].items()} == shapes[a]
+        for k, v in obs[a].items():
+            if k == "touch":   # a fresh skin may have a few points more or fewer
+                continue
+            assert v.shape == obs_f[a][k].shape
+            np.testing.assert_allclose(env.observation_space(a)[k].low,
+                                       fresh.observation_space(a)[k].low)
+        assert env.delay_steps(a) == fresh.delay_steps(a)
+    env.close()
+    fresh.close()
+
+
+def test_no_compile_happens_and_a_change_is_cheap(monkeypatch):
+    env = free_play_v0.parallel_env(n_agents=1, touch=True)
+    env.reset(seed=0)
+    model = env.world.model
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("compiled during an age change")
+
+    monkeypatch.setattr(mujoco.MjSpec, "compile", refuse)
+    cost = []   # CPU seconds of the reset that applies the change (the reset included)
+    for age in (6, 12, 3, 24, 9, 30, 15):
+        env.set_age(age_months=age, motor_age_months=age + 1)
+        t = time.process_time()
+        env.reset(seed=1)
+        cost.append(time.process_time() - t)
+        assert env.world.model is model
+        assert env.agent_configs[0].age == age
+    assert statistics.median(cost) <= 0.050, cost
+
+
+def test_a_pickled_copy_after_an_age_change_continues_identically():
+    env = free_play_v0.parallel_env(n_agents=1, touch=True, delays="developmental",
+                                    max_steps=10_000)
+    env.reset(seed=0, options={"age_months": 4, "motor_age_months": 9})
+    actions = _actions(env, 20)
+    for act in actions[:10]:
+        env.step(act)
+    copy = pickle.loads(pickle.dumps(env))
+    assert copy.agent_configs[0].age_months == 4 and copy.agent_configs[0].motor_age_months == 9
+    assert copy.world.tables[0].age_months == 4
+    for act in actions[10:]:
+        o1 = env.step(act)[0]["infant_0"]
+        o2 = copy.step(act)[0]["infant_0"]
+        for k in o1:
+            np.testing.assert_array_equal(o1[k], o2[k])
+    np.testing.assert_array_equal(env.world.data.qpos, copy.world.data.qpos)
+    # a reset of the copy gives the same episode as the original's (the body stays 4 months)
+    _, s1, e1 = _run(env, actions)
+    _, s2, e2 = _run(copy, actions)
+    np.testing.assert_array_equal(s1, s2)
+    np.testing.assert_array_equal(e1, e2)
+
+
+def test_a_seeded_reset_after_an_age_change_repeats():
+    env = high_five_v0.parallel_env(max_steps=10_000)
+    actions = _actions(env, 30)
+    first = _run(env, actions, seed=5, options={"age_months": {"infant_0": 8}})
+    again = _run(env, actions, seed=5)
+    assert env.agent_configs[0].age_months == 8 and env.agent_configs[1].age_months is None
+    for x, y in zip(first[1:], again[1:]):
+        np.testing.assert_array_equal(x, y)
+
+
+def test_every_delay_buffer_starts_from_the_reset_reading():
+    k = 3
+    delays = {"proprioception": 30.0, "touch": 30.0, "vestibular": 30.0, "motor": 30.0}
+    env = free_play_v0.parallel_env(n_agents=1, touch=True, expressions=False, delays=delays,
+                                    max_steps=10_000)
+    env.reset(seed=0)
+    actions = _actions(env, 12)
+    for act in actions:              # fill every ring with readings of a moving body
+        env.step(act)
+    for options in ({"age_months": 5}, None):
+        obs, _ = env.reset(seed=2, options=options)
+        first = obs["infant_0"]
+        for t in range(k):
+            later = env.step(actions[t])[0]["infant_0"]
+            for key in ("proprioception", "touch", "vestibular"):
+                np.testing.assert_array_equal(later[key], first[key], err_msg=f"{key} step {t}")
+            # the controls applied are those in force at reset until k steps have passed
+            assert not env.controls[0].any()
+        later = env.step(actions[k])[0]["infant_0"]
+        assert env.controls[0].any()
+        assert not np.array_equal(later["proprioception"], first["proprioception"])
+
+
+def test_gym_adapter_forwards_set_age_and_options():
+    env = SingleAgentEnv(free_play_v0.parallel_env(n_agents=1))
+    env.set_age(age_months=7)
+    env.reset(seed=0)
+    assert env.parallel.agent_configs[0].age_months == 7
+    env.reset(seed=0, options={"motor_age_months": 20})
+    cfg = env.parallel.agent_configs[0]
+    assert (cfg.age_months, cfg.motor_age_months) == (7, 20)
+
+
+def test_bad_input_is_named_and_changes_nothing():
+    env = still_face_v0.parallel_env()
+    env.reset(seed=0)
+    infant, adult = env.possible_agents
+    with pytest.raises(ConfigError, match=rf"{adult} is an adult.*infants: \['{infant}'\]"):
+        env.set_age(age_months=6, agent=adult)
+    with pytest.raises(ConfigError, match=r"age_months=40 not allowed; allowed: .*0.*33"):
+        env.set_age(age_months=40)
+    with pytest.raises(ConfigError, match=r"motor_age_months=-1 not allowed"):
+        env.reset(options={"motor_age_months": -1})
+    with pytest.raises(ConfigError, match=r"unknown option\(s\) \['age'\]; allowed: "
+                                          r"\['age_months', 'motor_age_months'\]"):
+        env.reset(options={"age": 6})
+    with pytest.raises(KeyError, match=r"unknown agent 'infant_7'"):
+        env.set_age(age_months=6, agent="infant_7")
+    with pytest.raises(ConfigError, match=rf"{adult} is an adult"):
+        env.reset(options={"age_months": {adult: 6}})
+    env.reset(seed=0)
+    assert env.agent_configs[0].age_months is None    # nothing pending from the refusals
+    env.set_age(age_months=6)    # every infant: the caregiver is left as it is
+    env.reset(seed=0)
+    assert env.agent_configs[0].age_months == 6 and env.agent_configs[1].body == "adult"
