@@ -74,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
         setup.env.close()
         print(f"mimo-social view: error: {e}", file=sys.stderr)
         return 2
+    viewer.frame_agents(handle, setup.env)
     print(f"viewing {args.task} ({args.control}, agents {', '.join(setup.env.possible_agents)}"
           f", seed {args.seed}); close the window to stop")
     try:

@@ -33,7 +33,7 @@ from ..envs.catalog import entry
 from ..partners.base import zero_action
 
 __all__ = ["CONTROLS", "ViewerUnavailable", "ViewSetup", "ViewRun", "display_problem",
-           "view_env", "open_viewer", "run_viewer", "INSTEAD"]
+           "view_env", "open_viewer", "run_viewer", "frame_agents", "INSTEAD"]
 
 #: the controls every agent can be put under
 CONTROLS = ("scripted", "zero", "random")
@@ -174,6 +174,11 @@ class _Window:
     def lock(self):
         return self.handle.lock()
 
+    @property
+    def cam(self):
+        """The viewer's free camera (``mujoco.MjvCamera``)."""
+        return self.handle.cam
+
     def close(self) -> None:
         self.handle.close()
         for thread in self.threads:
@@ -195,6 +200,18 @@ def _glfw_problem() -> str | None:
         return None
     why = "; ".join(" ".join(str(w.message).split()) for w in caught) or "glfw.init() failed"
     return f"no window can be opened on the display ({why})"
+
+
+def frame_agents(handle, env) -> None:
+    """Point the viewer's free camera at the agents (their root bodies' middle), from far
+    enough away to see them all, a little from above."""
+    world = env.unwrapped.world
+    roots = np.array([world.data.xpos[a.root_body] for a in world.agents])
+    with handle.lock():
+        cam = handle.cam
+        cam.lookat[:] = roots.mean(axis=0)
+        cam.distance = 1.5 + 1.5 * float(np.ptp(roots[:, :2], axis=0).max())
+        cam.azimuth, cam.elevation = 150.0, -20.0
 
 
 def _reset(setup: ViewSetup, seed: int) -> dict:

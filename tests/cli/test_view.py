@@ -157,3 +157,17 @@ def test_open_viewer_without_a_display_raises_viewer_unavailable(monkeypatch):
     with pytest.raises(viewer.ViewerUnavailable, match="no display .* 'mimo-social demo'"):
         viewer.open_viewer(None, None)
     assert viewer.display_problem({"WAYLAND_DISPLAY": "wayland-0"}) is None
+
+
+def test_frame_agents_points_the_free_camera_at_the_agents():
+    import mujoco
+
+    setup = viewer.view_env("still_face", "zero")
+    handle = FakeViewer(setup.env)
+    handle.cam = mujoco.MjvCamera()
+    viewer.frame_agents(handle, setup.env)
+    world = setup.env.unwrapped.world
+    roots = np.array([world.data.xpos[a.root_body] for a in world.agents])
+    assert np.allclose(handle.cam.lookat, roots.mean(axis=0)) and handle.locks == 1
+    assert handle.cam.distance > 1.5
+    setup.env.close()
