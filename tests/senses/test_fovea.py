@@ -202,3 +202,20 @@ def test_an_env_with_a_fovea_pickles_and_is_deterministic():
             assert np.array_equal(a[agent][key], c[agent][key]), (agent, key)
     for e in (env, clone, again):
         e.close()
+
+
+def test_bench_vision_fovea_option_and_table():
+    from mimo_social.bench import vision_cost
+    from mimo_social.cli import build_parser
+
+    args = build_parser().parse_args(["bench", "vision", "--fovea", "--sim-seconds", "2"])
+    assert args.fovea and args.sim_seconds == 2.0
+    names = list(vision_cost.FOVEA_CONFIGS)
+    assert names[0] == "64x64, fovea off" and names[-1] == "128x128, fovea 4"
+    rows = [{"config": names[0], "vision_ms_per_step": 0.5, "total_ms_per_step": 0.9,
+             "total": 0.09},
+            {"config": names[-1], "vision_ms_per_step": 8.0, "total_ms_per_step": 9.0,
+             "total": 0.9}]
+    text = vision_cost.format_fovea(rows)
+    assert "| 64x64 | off | 0.50 | 0.90 | 0.090 |" in text
+    assert "| 128x128 | 4; 512 px | 8.00 | 9.00 | 0.900 |" in text
