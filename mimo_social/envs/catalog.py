@@ -16,9 +16,10 @@ from types import ModuleType
 
 from ..core.gym_adapter import SingleAgentEnv
 from ..tasks import (catch, contingency, free_play, handover, high_five, imitation,
-                     joint_attention, mirror, reach, selfbody, social_touch, standup, still_face)
+                     joint_attention, mirror, reach, rollover, selfbody, social_touch, standup,
+                     still_face)
 from . import (catch_v0, contingency_v0, free_play_v0, handover_v0, high_five_v0, imitation_v0,
-               joint_attention_v0, mirror_v0, reach_v0, selfbody_v0, social_touch_v0,
+               joint_attention_v0, mirror_v0, reach_v0, rollover_v0, selfbody_v0, social_touch_v0,
                standup_v0, still_face_v0)
 
 __all__ = ["EnvEntry", "CATALOG", "KINDS", "entry", "names", "make_gym", "register_envs"]
@@ -48,6 +49,27 @@ class EnvEntry:
     #: -> summary, in the scripted env, ``rows(summaries)`` -> table lines, ``UNIT``); None for a task
     #: whose success and return say it all
     measures: ModuleType | None = None
+    #: further Gymnasium ids of the same task, each a variant of its options: ``(gym_id,
+    #: defaults)`` pairs, ``defaults`` keyword pairs as in ``gym_defaults`` (merged over them; a
+    #: variant's ``task_options`` are merged over the entry's, and the user's over both)
+    gym_variants: tuple = ()
+
+    @property
+    def gym_ids(self) -> tuple[str, ...]:
+        """Every Gymnasium id of the task: ``gym_id`` first, then its variants'."""
+        return (self.gym_id, *(v[0] for v in self.gym_variants))
+
+    def gym_kwargs(self, gym_id: str | None = None, **kwargs) -> dict:
+        """The env keywords ``gym.make(gym_id, **kwargs)`` builds the env with: the id's
+        defaults, then ``kwargs`` (``task_options`` merged, not replaced)."""
+        out = dict(self.gym_defaults)
+        if gym_id is not None and gym_id != self.gym_id:
+            variants = dict(self.gym_variants)
+            if gym_id not in variants:
+                raise ValueError(f"task {self.name!r}: gym_id={gym_id!r} not allowed; allowed: "
+                                 f"{list(self.gym_ids)}")
+            out = _merged(out, dict(variants[gym_id]))
+        return _merged(out, kwargs)
 
     @property
     def module_name(self) -> str:
@@ -68,9 +90,19 @@ class EnvEntry:
             return self.module.scripted_env(**kwargs)
         return self.module.parallel_env(**kwargs)
 
-    def gym_env(self, **kwargs) -> SingleAgentEnv:
-        """The one-learner env as a Gymnasium env (what ``gym.make(gym_id)`` returns)."""
-        return SingleAgentEnv(self.scripted_env(**{**dict(self.gym_defaults), **kwargs}))
+    def gym_env(self, gym_id: str | None = None, **kwargs) -> SingleAgentEnv:
+        """The one-learner env as a Gymnasium env (what ``gym.make(gym_id)`` returns; None:
+        the entry's own ``gym_id``, else one of its variants')."""
+        return SingleAgentEnv(self.scripted_env(**self.gym_kwargs(gym_id, **kwargs)))
+
+
+def _merged(defaults: dict, given: dict) -> dict:
+    """``given`` over ``defaults``; two ``task_options`` dicts are merged (``given``'s win)."""
+    out = {**defaults, **given}
+    old, new = defaults.get("task_options"), given.get("task_options")
+    if isinstance(old, dict) and isinstance(new, dict):
+        out["task_options"] = {**old, **new}
+    return out
 
 
 CATALOG: tuple[EnvEntry, ...] = (
@@ -82,6 +114,11 @@ CATALOG: tuple[EnvEntry, ...] = (
     EnvEntry("standup", standup_v0, "mimo_social/Standup-v0", "one-agent",
              "stand up from a crouch holding a crib rail",
              controller=standup.StandupController),
+    EnvEntry("rollover", rollover_v0, "mimo_social/RollOver-v0", "one-agent",
+             "roll over on the floor: from the back to the belly (start='prone': the reverse)",
+             controller=rollover.RollOverController,
+             gym_variants=(("mimo_social/RollOverProne-v0",
+                            (("task_options", {"start": "prone"}),)),)),
     EnvEntry("selfbody", selfbody_v0, "mimo_social/SelfBody-v0", "one-agent",
              "touch a named primitive of one's own body with the right hand",
              controller=selfbody.SelfBodyController),
@@ -118,7 +155,7 @@ CATALOG: tuple[EnvEntry, ...] = (
 )
 
 _BY_NAME = {e.name: e for e in CATALOG}
-_BY_ID = {e.gym_id: e for e in CATALOG}
+_BY_ID = {i: e for e in CATALOG for i in e.gym_ids}
 
 
 def names(kind: str | None = None) -> tuple[str, ...]:
@@ -138,7 +175,7 @@ def entry(name: str) -> EnvEntry:
 
 def make_gym(gym_id: str, **kwargs) -> SingleAgentEnv:
     """Entry point of every Gymnasium id of the package."""
-    return _BY_ID[gym_id].gym_env(**kwargs)
+    return _BY_ID[gym_id].gym_env(gym_id, **kwargs)
 
 
 def register_envs() -> None:
@@ -146,9 +183,10 @@ def register_envs() -> None:
     import gymnasium as gym
 
     for e in CATALOG:
-        if e.gym_id not in gym.registry:
-            gym.register(id=e.gym_id, entry_point="mimo_social.envs.catalog:make_gym",
-                         kwargs={"gym_id": e.gym_id}, disable_env_checker=False)
+        for gym_id in e.gym_ids:
+            if gym_id not in gym.registry:
+                gym.register(id=gym_id, entry_point="mimo_social.envs.catalog:make_gym",
+                             kwargs={"gym_id": gym_id}, disable_env_checker=False)
 
 
 def describe() -> str:

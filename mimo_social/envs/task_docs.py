@@ -272,7 +272,8 @@ def overview_table(docs: tuple[TaskDoc, ...] | None = None) -> str:
     for d in docs if docs is not None else task_docs():
         dt, step = _control_step(d.task_cls)
         n = d.task_cls.default_max_steps
-        gym_id = f"`{d.entry.gym_id}`" + (" (scripted partner)" if d.entry.social else "")
+        gym_id = ", ".join(f"`{i}`" for i in d.entry.gym_ids) \
+            + (" (scripted partner)" if d.entry.social else "")
         lines.append(f"| [{d.entry.name}](#{_anchor(d.heading)}) | `{d.entry.module.__name__}` | "
                      f"{gym_id} | {d.entry.kind} | {_agents(d)} | {step} | "
                      f"{n} steps ({n * dt:g} s) |")
@@ -296,13 +297,22 @@ def _section(d: TaskDoc) -> str:
     cls = d.task_cls
     out = [f"## {d.heading}", "", _wrap(what[:1].upper() + what[1:]), "",
            _wrap(f"Task `{d.entry.name}`: folder `{d.source}` (`{cls.__name__}`); PettingZoo module "
-                 f"`{d.entry.module.__name__}`; Gymnasium id `{d.entry.gym_id}`."), "",
+                 f"`{d.entry.module.__name__}`; {_gym_ids(d.entry)}."), "",
            "| | |", "|---|---|"]
     out += [f"| {k} | {_markdown(v)} |" for k, v in d.rows]
     out.append(f"| replay plots | {_plots(d)} |")
     for note in d.notes:
         out += ["", _wrap(_markdown(note))]
     return "\n".join(out) + "\n"
+
+
+def _gym_ids(e: EnvEntry) -> str:
+    """``Gymnasium id `X``` or, for a task with variants, every id with the options it sets."""
+    if not e.gym_variants:
+        return f"Gymnasium id `{e.gym_id}`"
+    rest = "; ".join(f"`{i}` ({', '.join(f'{k}={v!r}' for k, v in defaults)})"
+                     for i, defaults in e.gym_variants)
+    return f"Gymnasium ids `{e.gym_id}` and, with other defaults, {rest}"
 
 
 def _wrap(text: str) -> str:
