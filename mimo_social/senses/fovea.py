@@ -90,8 +90,10 @@ def check_fovea(value, width: int, height: int, owner: str = "vision") -> FoveaC
     """A :class:`VisionConfig` ``fovea`` value as a :class:`FoveaConfig` (None: off), for eyes
     of ``width`` x ``height`` output pixels; else a ConfigError naming the field, the value
     and what is allowed."""
-    if value is None or value is False or isinstance(value, FoveaConfig):
-        config = value or None
+    if isinstance(value, FoveaConfig):        # checked again (e.g. after replace())
+        value = {"strength": value.strength, "render_scale": value.render_scale}
+    if value is None or value is False:
+        config = None
     elif value is True:
         config = FoveaConfig(DEFAULT_STRENGTH, math.ceil(DEFAULT_STRENGTH))
     elif isinstance(value, Mapping):

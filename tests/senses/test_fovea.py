@@ -219,3 +219,15 @@ def test_bench_vision_fovea_option_and_table():
     text = vision_cost.format_fovea(rows)
     assert "| 64x64 | off | 0.50 | 0.90 | 0.090 |" in text
     assert "| 128x128 | 4; 512 px | 8.00 | 9.00 | 0.900 |" in text
+
+
+def test_a_checked_setting_is_checked_again_where_it_is_reused():
+    import dataclasses
+
+    cfg = VisionConfig(width=64, height=64, fovea=8)
+    assert VisionConfig(fovea=cfg.fovea).fovea == cfg.fovea
+    assert VisionConfig(**dataclasses.asdict(cfg)) == cfg
+    with pytest.raises(ConfigError, match="fovea render_scale=8 renders 512x8192"):
+        dataclasses.replace(cfg, height=1024)
+    with pytest.raises(ConfigError, match="fovea strength=100"):
+        VisionConfig(fovea=FoveaConfig(100.0, 2))
