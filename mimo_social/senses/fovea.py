@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from numbers import Real
 from typing import Mapping
 
@@ -51,7 +52,7 @@ from ..util.checks import ConfigError, show
 
 __all__ = ["STRENGTH_RANGE", "RENDER_SCALE_RANGE", "DEFAULT_STRENGTH", "MAX_RENDER_SIDE",
            "FoveaConfig", "check_fovea", "profile_exponent", "radial_profile",
-           "source_points", "FovealWarp"]
+           "source_points", "FovealWarp", "foveal_warp"]
 
 #: the strengths (magnification at the centre) allowed
 STRENGTH_RANGE = (1.0, 16.0)
@@ -216,6 +217,10 @@ class FovealWarp:
         #: ``(height, width)`` flat index into the render image of each output pixel's centre
         self.nearest = py * rw + px
 
+    def __reduce__(self):
+        # pickled as its recipe (the matrix is megabytes; rebuilt, or shared, on arrival)
+        return foveal_warp, (self.config, self.height, self.width)
+
     @property
     def taps(self) -> int:
         """Render pixels read for one colour channel (non-zero weights of the matrix)."""
@@ -249,3 +254,10 @@ class FovealWarp:
         u = np.abs(cx - self.width / 2.0) / (self.width / 2.0)
         v = np.abs(cy - self.height / 2.0) / (self.height / 2.0)
         return int(np.count_nonzero(np.maximum(u, v) <= float(fraction)))
+
+
+@lru_cache(maxsize=32)
+def foveal_warp(config: FoveaConfig, height: int, width: int) -> FovealWarp:
+    """The :class:`FovealWarp` of one setting and output size, made once per process and
+    shared (agents with the same eyes, unpickled envs): it is only read."""
+    return FovealWarp(config, int(height), int(width))

@@ -57,7 +57,7 @@ from ..util.checks import check_bool, check_int
 from ..util.names import reject_old_names
 from .acuity import acuity_blur, check_acuity, cutoff_for
 from .base import SenseEntry
-from .fovea import FovealWarp, check_fovea
+from .fovea import check_fovea, foveal_warp
 
 __all__ = ["VisionConfig", "VisionSystem", "VisionSense", "build_vision", "vision_system",
            "eye_images", "render_now", "anaglyph", "save_anaglyph", "write_png", "EYES", "SENSE"]
@@ -106,7 +106,7 @@ class VisionSystem:
             self.cutoffs[i] = cutoff_for(cfg.acuity, world.agent_setups[i].config.age)
             # with a fovea: rendered k times larger, blurred there (in degrees), then warped
             k = cfg.fovea.render_scale if cfg.fovea else 1
-            self.foveas[i] = FovealWarp(cfg.fovea, cfg.height, cfg.width) if cfg.fovea else None
+            self.foveas[i] = foveal_warp(cfg.fovea, cfg.height, cfg.width) if cfg.fovea else None
             self._blur[i] = acuity_blur(self.cutoffs[i], cfg.height * k, cfg.width * k,
                                         float(world.model.cam_fovy[left]))
             group = []

@@ -191,6 +191,9 @@ def test_an_env_with_a_fovea_pickles_and_is_deterministic():
     env.step(zero_actions(env))
     clone = pickle.loads(pickle.dumps(env))
     assert vision_system(clone).renderer is None
+    warp = vision_system(env).foveas[0]
+    assert len(pickle.dumps(warp)) < 1000          # its recipe, not its matrix
+    assert vision_system(clone).foveas[0] is warp   # one per setting and size in a process
     a, *_ = env.step(zero_actions(env))
     b, *_ = clone.step(zero_actions(clone))
     again = make_env(depth=True, fovea=3)
