@@ -36,13 +36,16 @@ Spring-damper motors only (the task's actuation); both hand versions (the finger
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+
 import mujoco
 import numpy as np
 
-from ...partners.base import Partner, agent_index, motor_action, pd_gains, torque_controls
-from ...util.checks import check_number
+from ...partners.base import (Partner, agent_index, check_angles, motor_action, pd_gains,
+                              torque_controls)
+from ...util.checks import ConfigError, check_number, check_numbers, show
 
-__all__ = ["RollOverController", "SUPINE_PLAN", "PRONE_PLAN"]
+__all__ = ["RollOverController", "SUPINE_PLAN", "PRONE_PLAN", "PRESSING", "check_plan"]
 
 #: from the back: phases ``(start s, posture {joint: deg}, press {body: (down N, left N)})``
 SUPINE_PLAN = (
@@ -117,14 +120,50 @@ PRONE_PLAN = (
 )
 
 
+#: the bodies a plan may press against the floor
+PRESSING = ("right_foot", "left_foot", "right_hand", "left_hand")
+
+
+def check_plan(name: str, value) -> tuple:
+    """A plan (see :data:`SUPINE_PLAN`) as a tuple of ``(start s, {joint: deg}, {body: (down N,
+    left N)})`` phases, the first starting at 0 s and each later one later; else a ConfigError
+    naming the setting, the value and what is allowed."""
+    allowed = ("a non-empty list of (start s, {joint: degrees}, {body: (down N, left N)}) "
+               f"phases, the first at 0 s, starts rising; bodies from {list(PRESSING)}")
+    who = "RollOverController"
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence) \
+            or not len(value):
+        raise ConfigError(f"{who}: {name}={show(value)} not allowed; allowed: {allowed}")
+    out, last = [], -1.0
+    for k, phase in enumerate(value):
+        if isinstance(phase, (str, bytes, Mapping)) or not isinstance(phase, Sequence) \
+                or len(phase) != 3:
+            raise ConfigError(f"{who}: {name}[{k}]={show(phase)} not allowed; allowed: {allowed}")
+        t = check_number(who, f"{name}[{k}] start", phase[0], 0.0, 3600.0)
+        if (k == 0 and t != 0.0) or (k > 0 and t <= last):
+            raise ConfigError(f"{who}: {name}[{k}] start={t:g} not allowed; allowed: {allowed}")
+        last = t
+        posture = check_angles(who, f"{name}[{k}] posture", phase[1])
+        press = phase[2]
+        if not isinstance(press, Mapping) or any(b not in PRESSING for b in press):
+            raise ConfigError(f"{who}: {name}[{k}] press={show(press)} not allowed; allowed: "
+                              f"{allowed}")
+        press = {b: check_numbers(who, f"{name}[{k}] press[{b!r}]", f, 2, -500.0, 500.0,
+                                  "(down N, left N), each within 500") for b, f in press.items()}
+        out.append((t, posture, press))
+    return tuple(out)
+
+
 class RollOverController(Partner):
     """Roll over through the infant's own motors, by a timed plan of postures and presses (see
     the module table); ``supine`` / ``prone``: the plans (None: the tuned ones); ``frequency``
     (Hz): the PD loop."""
 
     def __init__(self, supine=None, prone=None, frequency: float = 3.0):
-        self.plans = {"supine": SUPINE_PLAN if supine is None else tuple(supine),
-                      "prone": PRONE_PLAN if prone is None else tuple(prone)}
+        self.supine = None if supine is None else check_plan("supine", supine)
+        self.prone = None if prone is None else check_plan("prone", prone)
+        self.plans = {"supine": SUPINE_PLAN if supine is None else self.supine,
+                      "prone": PRONE_PLAN if prone is None else self.prone}
         self.frequency = check_number("RollOverController", "frequency", frequency, 0.1, 20.0)
 
     def __repr__(self):
