@@ -15,7 +15,7 @@ length, so the corners and the edges are kept, nothing of the field of view is l
 at the centre is ``a / (exp(a) - 1) = 1 / strength``: the **strength** is the magnification at
 the centre, output pixels per degree there over those of the plain image of the same size
 (:func:`profile_exponent` solves for ``a``; strength 1 is the identity). At the border the slope
-is ``a exp(a) / (exp(a) - 1)``: 2.4 plain pixels per output pixel at strength 4.
+is ``a exp(a) / (exp(a) - 1)``: 2.6 plain pixels per output pixel at strength 4.
 
 **Real detail at the centre.** The eye is rendered ``render_scale`` times larger than the output
 (default: the strength rounded up), so the magnified centre is made of rendered detail, not
