@@ -25,8 +25,8 @@ interpolated pixels, up to a strength of ``render_scale``.
 ``s x s`` sub-samples spread evenly over its own area (``s = render_scale``), each sub-sample a
 bilinear interpolation of the four render pixels around its source point. The weights of all of
 them form one sparse matrix (rows: output pixels, columns: render pixels; equal taps merged), so
-a colour image is one sparse product per channel (:class:`FovealWarp`). Averaging over the
-pixel's area keeps the compressed periphery from aliasing (a point sample there would skip
+a colour image is one sparse product, all channels at once (:class:`FovealWarp`). Averaging
+over the pixel's area keeps the compressed periphery from aliasing (a point sample there would skip
 render pixels). Depth images use the same warp but take the one render pixel nearest each
 output pixel's centre: averaging distances across an occluding edge would make surfaces that
 are not there (as the acuity blur leaves depth sharp, :mod:`mimo_social.senses.acuity`).
