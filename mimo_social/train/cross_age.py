@@ -135,7 +135,7 @@ def cross_age_markdown(result: Mapping[str, Any]) -> str:
     """The cross-age table (markdown): one row per age, both policies."""
     lines = [f"Cross-age evaluation of `{result['run']}` ({result['task']}, "
              f"{result['algo'].upper()}, {Path(result['model']).name}): {result['episodes']} "
-             f"episodes per age and policy, seeds {result['seed']}..."
+             f"episodes per age and policy, seeds {result['seed']}-"
              f"{result['seed'] + result['episodes'] - 1}.", "",
              "| age (months) | success, mean action | success, sampled | return, mean action | "
              "return, sampled | length, mean action | length, sampled |",

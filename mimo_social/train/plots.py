@@ -376,8 +376,10 @@ def plot_cross_age(result: dict, path: str | Path) -> Path:
         ax_r.plot(x, m, fmt, ms=5, color=color, label=label)
         ax_r.fill_between(x, m - s, m + s, color=color, alpha=0.12, lw=0)
     trained = result.get("training_ages") or {}
+    pad = max(0.5, 0.04 * float(x.max() - x.min()))
     for ax in (ax_s, ax_r):
         _training_mark(ax, trained)
+        ax.set_xlim(float(x.min()) - pad, float(x.max()) + pad)
         ax.set_xlabel("infant age (months)")
         ax.set_xticks(x)
         ax.set_xticklabels([f"{v:g}" for v in x])
@@ -389,8 +391,9 @@ def plot_cross_age(result: dict, path: str | Path) -> Path:
         ax_s.text(0.5, 0.5, f"{result.get('task', 'this task')} reports no success",
                   transform=ax_s.transAxes, ha="center", va="center", color="0.4")
     ax_r.set_ylabel(f"episode return (mean +- std, {result.get('episodes', '?')} episodes)")
+    model = Path(str(result.get("model", "?")))
     fig.suptitle(f"{result.get('task', '?')} - {str(result.get('algo', '?')).upper()}, "
-                 f"{Path(str(result.get('model', '?'))).name}: across ages", fontsize=11)
+                 f"{model.parent.name}/{model.name}: across ages", fontsize=11)
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=110)
