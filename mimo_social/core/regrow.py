@@ -39,16 +39,17 @@ from ..body.builder import (EYE_CAMERA_X, GEOM_FRICTION, IRIS, PUPIL, axis_angle
 from ..body.inertia import (BOX, CAPSULE, CYLINDER, ELLIPSOID, SPHERE, body_inertials,
                             boxes_in_parent, geom_aabb, geom_moments, geom_rbound,
                             quat_matrices)
+from ..body.postures import posture_pitch
 from ..body.tables import BodyTables, load_body
 from ..senses import SENSES
-from ..senses.skin import regrown_skin
+from ..senses.skin_growth import regrown_skin
 from ..util.checks import show
 from .config import ConfigError
-from .delays import VESTIBULAR_SENSORS, delay_steps
+from .delays import VESTIBULAR_SENSORS, check_delay_steps, delay_steps
 
 __all__ = ["AgentMaps", "agent_maps", "regrow_agent", "body_tables", "support_below",
-           "REST_CLEARANCE", "AGE_OPTIONS", "age_options", "age_changes", "regrow_senses",
-           "frame_ratios"]
+           "REST_CLEARANCE", "KEPT", "root_quat", "AGE_OPTIONS", "IGNORED_OPTIONS", "age_options",
+           "age_changes", "regrow_senses", "frame_ratios"]
 
 #: a body starts with its lowest point this high above the floor (m), as the world places it
 REST_CLEARANCE = 0.002
@@ -277,12 +278,37 @@ def _place(world, i: int, maps: AgentMaps, setup, quat, scratch) -> None:
         m.body_pos[root, 2] += REST_CLEARANCE - low
 
 
-def regrow_agent(world, i: int, setup, quat, dt: float) -> BodyTables:
-    """Write agent ``i``'s body at the ages of ``setup.config``, placed at ``setup.position``
-    with its root turned by ``quat``, into ``world``'s compiled model (module docstring);
-    returns the new tables. A ConfigError when the change needs a recompile (a vestibular delay
-    beyond what the model's sensor history holds)."""
+#: what an age change keeps of an agent's config (the model's topology and the body's kind)
+KEPT = ("hands", "body", "actuation", "scale", "strength", "expressions", "posture",
+        "proprioception", "vestibular", "touch", "vision")
+
+
+def root_quat(setup) -> np.ndarray:
+    """The root's orientation of ``setup``: facing its ``facing`` point, pitched as its
+    posture wants (as the world builds it)."""
+    d = np.asarray(setup.facing, float) - np.asarray(setup.position, float)
+    yaw = float(np.arctan2(d[1], d[0])) if np.linalg.norm(d) > 1e-9 else 0.0
+    pitch = posture_pitch(setup.config.posture, setup.config.body)
+    return quat_mul(axis_angle_quat((0, 0, 1), yaw),
+                    axis_angle_quat((0, 1, 0), np.deg2rad(pitch)))
+
+
+def regrow_agent(world, i: int, setup, dt: float) -> BodyTables:
+    """Write agent ``i``'s body at the ages of ``setup.config``, placed as ``setup`` says (its
+    position, facing and held joint angles), into ``world``'s compiled model (module
+    docstring); returns the new tables. A ConfigError when the change needs another model (other
+    held joints, motors, base, senses or body) or a vestibular delay beyond what the model's
+    sensor history holds."""
+    old = world.agent_setups[i]
+    same = replace(setup, config=old.config, position=old.position, facing=old.facing,
+                   frozen=old.frozen if set(setup.frozen) == set(old.frozen) else None)
+    if same != old or any(getattr(setup.config, k) != getattr(old.config, k) for k in KEPT):
+        raise ConfigError(f"agent {world.names[i]}: this change needs another model (held "
+                          f"joints, motors, base or one of {list(KEPT)}); an age change at reset "
+                          "changes only the ages, the place and held angles")
     config = setup.config
+    check_delay_steps(world.names[i], config, dt)
+    quat = root_quat(setup)
     m = world.model
     maps = world.regrow_maps(i)
     t = body_tables(config)
@@ -342,6 +368,9 @@ def _vestibular_delay(world, i: int, k: int, dt: float, sensors) -> None:
 # -- the env's side: which agents change, and their senses and motors --------------------------
 #: the options ``reset(options=...)`` takes: each a number (every infant) or {agent: number}
 AGE_OPTIONS = ("age_months", "motor_age_months")
+#: option keys accepted and ignored: PettingZoo's API test checks that reset takes options with
+#: ``options={"options": 1}``
+IGNORED_OPTIONS = ("options",)
 
 
 def age_options(options) -> dict:
@@ -352,7 +381,7 @@ def age_options(options) -> dict:
     if not isinstance(options, Mapping):
         raise ConfigError(f"reset: options={show(options)} not allowed; allowed: None or a dict "
                           f"with keys {list(AGE_OPTIONS)}")
-    unknown = sorted((k for k in options if k not in AGE_OPTIONS), key=str)
+    unknown = sorted((k for k in options if k not in AGE_OPTIONS + IGNORED_OPTIONS), key=str)
     if unknown:
         raise ConfigError(f"reset: unknown option(s) {unknown}; allowed: {list(AGE_OPTIONS)} "
                           "(each a number of months, 0 to 33, for every infant, or a dict "

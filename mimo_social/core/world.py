@@ -15,7 +15,7 @@ own scaled tables (:attr:`World.tables`) and lowered onto the floor from its own
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Sequence
 
 import mujoco
@@ -27,7 +27,7 @@ from ..expressions.switch import FaceTextures
 from ..scenery import SCENES, add_playroom, clear_toys
 from ..util.checks import check_choice
 from ..util.names import agent_names
-from .config import AgentConfig, ConfigError, PhysicsConfig
+from .config import AgentConfig, PhysicsConfig
 from .delays import check_delay_steps, delay_sensors, fill_sensor_history
 from .regrow import agent_maps, regrow_agent
 
@@ -551,28 +551,13 @@ class World:
 
     # -- another age without compiling (core/regrow.py) -----------------------------------------
     def regrow(self, i: int, setup: AgentSetup) -> None:
-        """Agent ``i`` as ``setup`` says: its body at the ages of ``setup.config`` (the same
-        hands, body kind and senses) and its place, written into the compiled model in place
-        (:func:`~mimo_social.core.regrow.regrow_agent`); its tables, setup and start pose
-        follow. Takes effect at the next :meth:`reset`. A ConfigError when the setup needs
-        another model (other held joints, motors, base or senses)."""
-        old = self.agent_setups[i]
-        same = replace(setup, config=old.config, position=old.position, facing=old.facing,
-                       frozen=old.frozen if set(setup.frozen) == set(old.frozen) else None)
-        kept = ("hands", "body", "actuation", "scale", "strength", "expressions", "posture")
-        if same != old or any(getattr(setup.config, k) != getattr(old.config, k) for k in kept):
-            raise ConfigError(f"agent {self.names[i]}: this change needs another model (held "
-                              "joints, motors, base, hands, body, actuation, size or posture); "
-                              "an age change at reset changes only the ages and the place")
-        dt = self.physics.timestep * self.physics.frame_skip
-        check_delay_steps(self.names[i], setup.config, dt)
-        pitch = posture_pitch(setup.config.posture, setup.config.body)
-        quat = quat_mul(_yaw_quat(setup.position, setup.facing),
-                        axis_angle_quat((0, 1, 0), np.deg2rad(pitch)))
-        self.tables[i] = regrow_agent(self, i, setup, quat, dt)
-        setups = list(self.agent_setups)
-        setups[i] = setup
-        self.agent_setups = tuple(setups)
+        """Agent ``i`` as ``setup`` says: its body at the ages of ``setup.config`` and its place
+        and held angles, written into the compiled model in place
+        (:func:`~mimo_social.core.regrow.regrow_agent`: a ConfigError when the setup needs
+        another model); its tables, setup and start pose follow from the next :meth:`reset`."""
+        self.tables[i] = regrow_agent(self, i, setup,
+                                      self.physics.timestep * self.physics.frame_skip)
+        self.agent_setups = self.agent_setups[:i] + (setup,) + self.agent_setups[i + 1:]
         self.regrown[i] = setup
 
     def regrow_maps(self, i: int):
