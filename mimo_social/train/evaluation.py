@@ -21,7 +21,10 @@ episode and starts each episode afresh (:class:`~mimo_social.train.rollouts.Poli
 trained with ``--normalize-reward`` has ``vecnormalize.pkl`` next to ``model.zip``
 (``best_vecnormalize.pkl``, ``checkpoints/vecnormalize_<n>_steps.pkl``): it is loaded with the
 model (``res["vecnormalize"]``) and applied to the observations where it normalised them; the
-returns reported are the env's own, never normalised.
+returns reported are the env's own, never normalised. A run trained with a growth schedule
+(``--growth``) is evaluated as its last training evaluation was: at the age the schedule ends at
+(``forward``: the oldest, ``inverse``: the youngest; ``res["age_months"]``), or with each
+episode's age drawn from the range (``stochastic``), unless ``env_kwargs`` gives ``age_months``.
 """
 
 from __future__ import annotations
@@ -41,6 +44,7 @@ import numpy as np
 
 from ..core.wrappers import ActionDecoder
 from .envs import make_env, make_parallel_env, make_scripted_env, run_observation
+from .growth import evaluation_ages
 from .rollouts import evaluate_agents, evaluate_policy, load_vecnormalize, vecnormalize_path
 from .tasks import TrainInputError, algo_class
 
@@ -290,9 +294,12 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
     normalize = load_vecnormalize(stats)
     kw = dict(config.get("env_kwargs", {}))
     kw.update(env_kwargs or {})
+    grown, wrap = evaluation_ages(config, env_kwargs or {})   # a growth run: its last age
+    kw.update(grown)
     want_frames = video is not None or frames is not None
     obs = run_observation(config)     # the layout the run was trained on
-    env = make_env(config["task"], render_mode="rgb_array" if want_frames else None, **obs, **kw)
+    env = wrap(make_env(config["task"], render_mode="rgb_array" if want_frames else None, **obs,
+                        **kw))
     penv = env.unwrapped.parallel
     outputs = EvalOutputs(env, penv, record, video, frames, frame_every)
     agent = penv.possible_agents[0]
@@ -311,7 +318,7 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
                               normalize)
         if both:
             res["stochastic"] = _sampled(
-                lambda: make_env(config["task"], **obs, **kw),
+                lambda: wrap(make_env(config["task"], **obs, **kw)),
                 lambda e: evaluate_policy(policy, e, episodes, seed, False, on_episode=bar,
                                           normalize=normalize), seed)
     finally:
@@ -322,6 +329,8 @@ def evaluate(run: str | Path, episodes: int = 10, *, model: str = "final", seed:
                 "vecnormalize": str(stats) if stats.is_file() else None,
                 "episodes": episodes, "deterministic": deterministic, "seed": seed,
                 "wall_time_s": round(time.perf_counter() - t0, 2)})
+    if config.get("growth"):
+        res["age_months"] = kw.get("age_months", config["growth"].get("spec"))
     outputs.report(res, record, video, frames)
     (run / "eval_results.json").write_text(json.dumps(res, indent=2, default=float))
     return res

@@ -48,7 +48,7 @@ from .tasks import TrainInputError
 
 __all__ = ["Growth", "KINDS", "AGE_RANGE", "RESOLUTION", "parse_growth", "age", "check_ages",
            "GrowthEnv", "GrowthController", "growth_env", "monitored_growth_env",
-           "wrap_growth", "check_set_age"]
+           "wrap_growth", "check_set_age", "evaluation_ages"]
 
 KINDS = ("forward", "inverse", "stochastic")
 #: the ages an infant body takes, in months
@@ -57,6 +57,8 @@ AGE_RANGE = (0.0, 33.0)
 RESOLUTION = 0.1
 #: mixed into a reset seed for the generator of the drawn ages
 DRAW_SALT = 32
+#: keys config.json's growth record has besides the schedule's own (read back, ignored)
+RECORDED = ("spec", "resolution_months", "span", "history")
 SPEC_HELP = ("forward:A-B, inverse:A-B (each optionally :STEPS, the env steps the change takes) "
              "or stochastic:A-B, ages in months 0-33 written low-high, e.g. forward:1-12")
 
@@ -137,8 +139,7 @@ def parse_growth(spec: Any) -> Growth | None:
     if spec is None or isinstance(spec, Growth):
         return spec
     if isinstance(spec, Mapping):
-        unknown = sorted(set(spec) - {"kind", "ages", "steps", "spec", "resolution_months",
-                                      "history"})
+        unknown = sorted(set(spec) - {"kind", "ages", "steps", *RECORDED})
         if unknown:
             raise TrainInputError(f"growth {dict(spec)!r}: unknown key(s) {', '.join(unknown)};"
                                   " allowed: kind, ages (a [low, high] pair), steps")
@@ -377,3 +378,18 @@ def check_set_age(env: gym.Env, growth: Growth) -> None:
         raise TrainInputError(f"growth {growth.spec}: this env has no set_age (the core env's "
                               "age change between episodes); allowed: no growth with this "
                               "version of the env") from None
+
+
+def evaluation_ages(config: Mapping[str, Any], env_kwargs: Mapping[str, Any]):
+    """How ``eval`` runs a growth run (``config``: its config.json), as its last training
+    evaluation did: ``(kwargs, wrap)``, the env kwargs to add (``forward`` / ``inverse``: the age
+    the schedule ends at) and a function wrapping each env (``stochastic``: a
+    :class:`GrowthEnv` drawing each episode's age by its seed). No growth, or an ``age_months``
+    in ``env_kwargs`` (the caller's): ``({}, identity)``."""
+    growth = parse_growth(config.get("growth"))
+    if growth is None or "age_months" in (env_kwargs or {}):
+        return {}, (lambda env: env)
+    if growth.kind == "stochastic":
+        return {}, (lambda env: wrap_growth(env, growth, 1))
+    return {"age_months": growth.high if growth.kind == "forward" else growth.low}, \
+        (lambda env: env)

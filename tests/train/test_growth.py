@@ -63,7 +63,7 @@ def test_stochastic_draws_within_the_range_reproducibly_under_a_seed():
     ("forward", "not KIND:A-B[:STEPS]"),
     (12, "allowed: forward:A-B"),
     ({"kind": "forward", "ages": [1]}, "a [low, high] pair"),
-    ({"kind": "forward", "ages": [1, 12], "span": 3}, "unknown key(s) span"),
+    ({"kind": "forward", "ages": [1, 12], "speed": 3}, "unknown key(s) speed"),
 ])
 def test_bad_specs_are_refused_with_what_is_allowed(spec, words):
     with pytest.raises(TrainInputError) as e:
@@ -322,6 +322,9 @@ def test_a_forward_run_grows_the_infant_and_records_it(tmp_path, capfd):
     err = capfd.readouterr().err
     notes = [line for line in err.splitlines() if "growth: the infant is" in line]
     assert len(notes) == len(months) - 1 and "12 months old" in notes[-1]
+    # eval runs it as its last evaluation did: at the age the schedule ends at
+    assert main(["eval", str(out), "--episodes", "1", "--no-progress"]) == 0
+    assert json.loads((out / "eval_results.json").read_text())["age_months"] == 12
 
 
 def test_a_stochastic_run_draws_every_episode_s_age_in_its_range(tmp_path, capfd):
@@ -338,6 +341,9 @@ def test_a_stochastic_run_draws_every_episode_s_age_in_its_range(tmp_path, capfd
     evals = {r["eval_age_months"] for r in rows}
     assert len(evals) == 1 and 3 <= float(evals.pop()) <= 9      # the same seeded draws
     assert "growth:" not in capfd.readouterr().err                 # no line per episode
+    from mimo_social.train import evaluate
+    assert evaluate(out, 1)["age_months"] == "stochastic:3-9"
+    assert evaluate(out, 1, env_kwargs={"age_months": 4})["age_months"] == 4
 
 
 def test_a_curriculum_s_growth_key_grows_the_infant_across_its_stages(tmp_path):
