@@ -8,6 +8,7 @@
     mimo-social bench engines      SB3 vs RLlib training throughput        (cli/bench_engines.py)
     mimo-social bench training     PPO's steps/s against the env alone     (cli/bench_training.py)
     mimo-social bench soak         growth of memory, threads, open files   (cli/bench_soak.py)
+    mimo-social bench ages         age change at reset vs fresh build      (cli/bench_ages.py)
 
 Each module has ``NAME``, ``HELP``, ``add_parser(subparsers, name, **kw)`` and ``run(args)``.
 
@@ -24,8 +25,8 @@ import argparse
 import functools
 import sys
 
-from . import bench_development, bench_engines, bench_floor, bench_recording, bench_sim
-from . import bench_soak, bench_training, bench_vision
+from . import bench_ages, bench_development, bench_engines, bench_floor, bench_recording
+from . import bench_sim, bench_soak, bench_training, bench_vision
 
 __all__ = ["MEASUREMENTS", "OLD_NAMES", "add_parser", "old_form"]
 
@@ -33,7 +34,7 @@ __all__ = ["MEASUREMENTS", "OLD_NAMES", "add_parser", "old_form"]
 MEASUREMENTS = {module.NAME: module for module in (bench_sim, bench_floor, bench_vision,
                                                    bench_recording, bench_development,
                                                    bench_engines, bench_training,
-                                                   bench_soak)}
+                                                   bench_soak, bench_ages)}
 #: old top-level command -> its measurement (kept for one release, not listed in the help)
 OLD_NAMES = {"bench-vision": "vision", "bench-recording": "recording",
              "bench-development": "development", "bench-engines": "engines", "soak": "soak"}

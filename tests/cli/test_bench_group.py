@@ -10,7 +10,8 @@ import pytest
 from mimo_social import cli
 from mimo_social.cli import bench
 
-NEW = ["sim", "floor", "vision", "recording", "development", "engines", "training", "soak"]
+NEW = ["sim", "floor", "vision", "recording", "development", "engines", "training", "soak",
+       "ages"]
 #: old command line -> the same command under its new name (every argument has a default but
 #: engines' --out)
 OLD = {
