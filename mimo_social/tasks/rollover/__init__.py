@@ -49,13 +49,13 @@ privileged cues:
 baselines:
     30 seeded episodes per policy and start (seeds 1000-1029; `python tests/tasks/test_rollover.py
     30 1000`; random: uniform in [-1, 1], seeded per episode). From the back: scripted
-    `RollOverController` (`mimo_social.tasks.rollover.controller`) 100 % (30/30), return 443.1 +-
-    2.3, over (held 1 s) after 271 steps, the chest at 176 degrees at the end; zero action 0 %,
-    return 5.2; random 0 %, 6.9; hacks: bang-bang (every motor at +-1, signs redrawn every 0.25 s)
-    13 % (4/30), return 107.5 +- 84.1; half roll (the controller until the chest has turned 60
-    degrees, then rest: it falls back) 0 %, 165.6 +- 92.4. From the belly: scripted 100 % (30/30),
-    return 398.2 +- 3.8, over after 326 steps, 173 degrees at the end; zero 0 %, 10.2; random 0 %,
-    7.7; bang-bang 10 % (3/30), 147.3 +- 111.4; half roll 0 %, 104.4 +- 7.5. `mimo-social baselines
+    `RollOverController` (`mimo_social.tasks.rollover.controller`) 100 % (30/30), return 443.2 +-
+    2.0, over (and held 1 s) after 271 steps, the chest at 176 degrees at the end; zero action 0 %,
+    return 5.3; random 0 %, 6.8; hacks: bang-bang (every motor at +-1, signs redrawn every 0.25 s)
+    0 %, return 82.5 +- 66.6; half roll (the controller until the chest has turned 60 degrees, then
+    rest: it falls back) 0 %, 187.8 +- 103.7. From the belly: scripted 100 % (30/30), return 398.3
+    +- 5.2, over after 326 steps, 173 degrees at the end; zero 0 %, 10.1; random 0 %, 7.3;
+    bang-bang 13 % (4/30), 167.4 +- 121.7; half roll 0 %, 103.0 +- 9.9. `mimo-social baselines
     rollover --episodes 30 --seed 1000` (from the belly: add `--env-kwargs '{"task_options":
     {"start": "prone"}}'`; docs/baselines.md) gives the same scripted, zero and random figures. No
     learner trained yet (recipe `rollover`: not measured)

@@ -104,7 +104,10 @@ class RollOver(Task):
         self._free = a.free_qpos
         self._geoms = np.array([g for g in a.geom_ids
                                 if m.geom_contype[g] or m.geom_conaffinity[g]], np.intp)
-        self._floor = m.geom("floor").id
+        d = mujoco.MjData(m)   # the world's initial pose: the lying body placed on the floor
+        d.qpos[:] = w.initial_qpos
+        mujoco.mj_kinematics(m, d)
+        self._floor_z = lowest_point(m, d, self._geoms)
 
     def reset(self, env, rng):
         w = env.world
@@ -120,10 +123,7 @@ class RollOver(Task):
         eps = o.perturbation
         d.qpos[self._act_qpos] += rng.uniform(-eps, eps, len(self._act_qpos))
         mujoco.mj_kinematics(m, d)
-        mujoco.mj_collision(m, d)
-        gap = min(mujoco.mj_geomDistance(m, d, self._floor, int(g), 0.5, None)
-                  for g in self._geoms)
-        d.qpos[self._free + 2] += LIFT - gap
+        d.qpos[self._free + 2] += self._floor_z + LIFT - lowest_point(m, d, self._geoms)
         d.ctrl[:] = 0.0
         settle(env, o.settle_steps)
         self.turn_angle = turn_angle(m, d, self.chest_body, o.start)
@@ -154,6 +154,28 @@ class RollOver(Task):
         return np.zeros(1, bool), [{"turn_angle": self.turn_angle,
                                     "is_success": self._turned >= self._hold_steps,
                                     "control_cost": self._cost}]
+
+
+def lowest_point(model, data, geoms: np.ndarray) -> float:
+    """The lowest world z of a set of geoms: exact for spheres, capsules, boxes, ellipsoids
+    and cylinders (from each geom's orientation and half sizes), the bounding sphere for others."""
+    G = mujoco.mjtGeom
+    kind, size = model.geom_type[geoms], model.geom_size[geoms]
+    up = data.geom_xmat[geoms].reshape(-1, 3, 3)[:, 2, :]   # world z in each geom's frame
+    depth = model.geom_rbound[geoms].copy()
+    for k in range(len(geoms)):
+        t, r, u = kind[k], size[k], up[k]
+        if t == G.mjGEOM_SPHERE:
+            depth[k] = r[0]
+        elif t == G.mjGEOM_CAPSULE:
+            depth[k] = r[0] + abs(u[2]) * r[1]
+        elif t == G.mjGEOM_BOX:
+            depth[k] = float(np.abs(u) @ r)
+        elif t == G.mjGEOM_ELLIPSOID:
+            depth[k] = float(np.sqrt(np.sum((u * r) ** 2)))
+        elif t == G.mjGEOM_CYLINDER:
+            depth[k] = abs(u[2]) * r[1] + r[0] * np.sqrt(max(0.0, 1.0 - u[2] ** 2))
+    return float(np.min(data.geom_xpos[geoms, 2] - depth))
 
 
 def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
