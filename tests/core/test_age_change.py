@@ -216,3 +216,17 @@ def test_bad_input_is_named_and_changes_nothing():
     env.set_age(age_months=6)    # every infant: the caregiver is left as it is
     env.reset(seed=0)
     assert env.agent_configs[0].age_months == 6 and env.agent_configs[1].body == "adult"
+
+
+def test_the_acuity_blur_follows_the_new_body_age():
+    vision = {"width": 32, "height": 32, "acuity": "age"}
+    env = free_play_v0.parallel_env(n_agents=1, vision=vision, age_months=18)
+    env.reset(seed=0, options={"age_months": 1, "motor_age_months": 20})
+    fresh = free_play_v0.parallel_env(n_agents=1, vision=vision, age_months=1)
+    eyes, eyes_fresh = env.system("vision"), fresh.system("vision")
+    assert eyes.cutoffs[0] == eyes_fresh.cutoffs[0] is not None
+    obs = env.reset(seed=0)[0]["infant_0"]
+    obs_fresh = fresh.reset(seed=0)[0]["infant_0"]
+    np.testing.assert_array_equal(obs["eye_left"], obs_fresh["eye_left"])
+    env.close()
+    fresh.close()
