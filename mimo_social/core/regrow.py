@@ -81,11 +81,14 @@ class AgentMaps:
     bvh_base: np.ndarray          # the first node of each of those nodes' body
 
 
+_OBJECTS = {"geom": mujoco.mjtObj.mjOBJ_GEOM, "camera": mujoco.mjtObj.mjOBJ_CAMERA,
+            "actuator": mujoco.mjtObj.mjOBJ_ACTUATOR, "body": mujoco.mjtObj.mjOBJ_BODY,
+            "joint": mujoco.mjtObj.mjOBJ_JOINT, "site": mujoco.mjtObj.mjOBJ_SITE}
+
+
 def _id(model, kind: str, name: str) -> int:
-    try:
-        return int(getattr(model, kind)(name).id)
-    except KeyError:
-        return -1
+    """The id of the ``kind`` named ``name``, -1 when there is none."""
+    return int(mujoco.mj_name2id(model, _OBJECTS[kind], name))
 
 
 def agent_maps(world, i: int) -> AgentMaps:
