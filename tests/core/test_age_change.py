@@ -163,9 +163,10 @@ def test_a_seeded_reset_after_an_age_change_repeats():
 
 def test_every_delay_buffer_starts_from_the_reset_reading():
     k = 3
-    delays = {"proprioception": 30.0, "touch": 30.0, "vestibular": 30.0, "motor": 30.0}
+    delays = {"proprioception": 30.0, "touch": 30.0, "vestibular": 30.0, "vision": 30.0,
+              "motor": 30.0}
     env = free_play_v0.parallel_env(n_agents=1, touch=True, expressions=False, delays=delays,
-                                    max_steps=10_000)
+                                    vision={"width": 16, "height": 16}, max_steps=10_000)
     env.reset(seed=0)
     actions = _actions(env, 12)
     for act in actions:              # fill every ring with readings of a moving body
@@ -175,7 +176,7 @@ def test_every_delay_buffer_starts_from_the_reset_reading():
         first = obs["infant_0"]
         for t in range(k):
             later = env.step(actions[t])[0]["infant_0"]
-            for key in ("proprioception", "touch", "vestibular"):
+            for key in ("proprioception", "touch", "vestibular", "eye_left", "eye_right"):
                 np.testing.assert_array_equal(later[key], first[key], err_msg=f"{key} step {t}")
             # the controls applied are those in force at reset until k steps have passed
             assert not env.controls[0].any()
