@@ -109,13 +109,14 @@ def test_constants_equal_the_table():
     env = make("supine")
     assert env.dt == pytest.approx(0.01) and env.max_steps == 600
     o = env.task.options
-    assert (o.start, o.success_angle, o.success_hold, o.cost_weight) \
-        == ("supine", 135.0, 1.0, 0.001)
+    assert (o.start, o.success_angle, o.success_hold, o.over_bonus, o.cost_weight) \
+        == ("supine", 135.0, 1.0, 1.0, 0.001)
     assert (o.perturbation, o.yaw_range, o.settle_steps) == (0.05, 180.0, 100)
     assert env.agent_configs[0].age_months == 6.0 and env.agent_configs[0].posture == "lying"
     doc = " ".join(task.__doc__.split())
-    for text in ("`turn / 180 - 0.001 * sum(u_i^2)`", "135 degrees", "for the last 1 s",
-                 "a fixed 600 steps", "6 months", "U(-0.05, 0.05)", "U(-180, 180)"):
+    for text in ("`turn / 180 + [turn >= 135] - 0.001 * sum(u_i^2)`", "135 degrees",
+                 "for the last 1 s", "a fixed 600 steps", "6 months", "U(-0.05, 0.05)",
+                 "U(-180, 180)"):
         assert text in doc, text
     assert env.action_space(A).shape == (N_MOTORS,)
     assert set(env.observation_space(A).spaces) == {"proprioception", "vestibular"}
@@ -162,7 +163,7 @@ def test_the_start_lies_on_the_back_or_belly_and_differs_across_seeds(start):
 
 
 # -- reward and success ---------------------------------------------------------------------
-def test_reward_is_the_turn_over_180_minus_the_control_cost():
+def test_reward_is_the_turn_over_180_plus_1_when_over_minus_the_control_cost():
     env = make("supine")
     env.reset(seed=0)
     w = env.world
@@ -176,7 +177,16 @@ def test_reward_is_the_turn_over_180_minus_the_control_cost():
     mujoco.mju_mulQuat(q, q, quarter)
     d.qpos[w.agents[0].free_qpos + 3:w.agents[0].free_qpos + 7] = q
     mujoco.mj_kinematics(m, d)
-    assert task.turn_angle(m, d, env.task.chest_body, "supine") == pytest.approx(90.0, abs=15)
+    turn = task.turn_angle(m, d, env.task.chest_body, "supine")
+    assert turn == pytest.approx(90.0, abs=15)
+    assert float(env.task.rewards(env)[0]) == pytest.approx(turn / 180 - 0.03)
+    # another quarter: on the belly, past 135 degrees: 1 more a step
+    mujoco.mju_mulQuat(q, q, quarter)
+    d.qpos[w.agents[0].free_qpos + 3:w.agents[0].free_qpos + 7] = q
+    mujoco.mj_kinematics(m, d)
+    turn = task.turn_angle(m, d, env.task.chest_body, "supine")
+    assert turn > 150
+    assert float(env.task.rewards(env)[0]) == pytest.approx(turn / 180 + 1 - 0.03)
     env.close()
 
 

@@ -27,18 +27,21 @@ observation:
     `proprioception` (208: joint angles, velocities, torques, limit sensors, motor state),
     `vestibular` (6: head gyro, accelerometer); touch on with `touch=True`
 reward:
-    `turn / 180 - 0.001 * sum(u_i^2)` per step: `turn` is how far (degrees, 0 to 180) the chest has
-    turned from its start, the angle between the chest's forward axis (the upper trunk's x axis) and
-    the world's up (from the back) or down (from the belly), minus the control cost over the 30
-    motors (option `cost_weight`: 0.001)
+    `turn / 180 + [turn >= 135] - 0.001 * sum(u_i^2)` per step: `turn` is how far (degrees, 0 to
+    180) the chest has turned from its start, the angle between the chest's forward axis (the upper
+    trunk's x axis) and the world's up (from the back) or down (from the belly); 1 more for every
+    step with the chest turned 135 degrees or more (option `over_bonus`: 1; the angle is
+    `success_angle`); minus the control cost over the 30 motors (option `cost_weight`: 0.001)
 success:
     `is_success`: the chest turned 135 degrees or more (option `success_angle`) for the last 1 s
     without a break (option `success_hold`): on the belly (or back), not on the side, and staying
     there
 return optimum:
-    the reward grows with the turn at every step, so the sooner the infant is over and the longer it
-    stays there, the higher the return: lying on the side earns at most 0.5 a step (300 an
-    episode), below every successful policy measured (398 and more); rolling half way and falling
+    the reward grows with the turn at every step and almost doubles once the chest is past 135
+    degrees, so the sooner the infant is over and the longer it stays there, the higher the return:
+    a policy never past 135 degrees earns less than 0.75 a step (450 an episode, held just short of
+    the angle from the first step), lying on the side at most 0.5 (300), while the scripted
+    controller earns 872 (from the back) and 773 (from the belly); rolling half way and falling
     back, or flailing, scores far less (baselines)
 termination:
     none (a fixed 600 steps, then truncation); a simulation that goes unstable ends the episode
@@ -49,13 +52,13 @@ privileged cues:
 baselines:
     30 seeded episodes per policy and start (seeds 1000-1029; `python tests/tasks/test_rollover.py
     30 1000`; random: uniform in [-1, 1], seeded per episode). From the back: scripted
-    `RollOverController` (`mimo_social.tasks.rollover.controller`) 100 % (30/30), return 443.2 +-
-    2.0, over (and held 1 s) after 271 steps, the chest at 176 degrees at the end; zero action 0 %,
+    `RollOverController` (`mimo_social.tasks.rollover.controller`) 100 % (30/30), return 872.4 +-
+    5.6, over (and held 1 s) after 271 steps, the chest at 176 degrees at the end; zero action 0 %,
     return 5.3; random 0 %, 6.8; hacks: bang-bang (every motor at +-1, signs redrawn every 0.25 s)
-    0 %, return 82.5 +- 66.6; half roll (the controller until the chest has turned 60 degrees, then
-    rest: it falls back) 0 %, 187.8 +- 103.7. From the belly: scripted 100 % (30/30), return 398.3
-    +- 5.2, over after 326 steps, 173 degrees at the end; zero 0 %, 10.1; random 0 %, 7.3;
-    bang-bang 13 % (4/30), 167.4 +- 121.7; half roll 0 %, 103.0 +- 9.9. `mimo-social baselines
+    0 %, return 99.9 +- 137.3; half roll (the controller until the chest has turned 60 degrees, then
+    rest: it falls back) 0 %, 187.8 +- 103.7. From the belly: scripted 100 % (30/30), return 772.5
+    +- 8.5, over after 326 steps, 173 degrees at the end; zero 0 %, 10.1; random 0 %, 7.3;
+    bang-bang 13 % (4/30), 271.6 +- 267.3; half roll 0 %, 103.0 +- 9.9. `mimo-social baselines
     rollover --episodes 30 --seed 1000` (from the belly: add `--env-kwargs '{"task_options":
     {"start": "prone"}}'`; docs/baselines.md) gives the same scripted, zero and random figures. No
     learner trained yet (recipe `rollover`: not measured)

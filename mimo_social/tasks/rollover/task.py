@@ -33,6 +33,7 @@ AGE_MONTHS = 6.0          # infants roll over at about 4 to 6 months (the table'
 SUCCESS_ANGLE = 135.0     # deg: the chest turned this far from its start ...
 SUCCESS_HOLD = 1.0        # s: ... for this long without a break
 COST_WEIGHT = 0.001       # the control cost's weight
+OVER_BONUS = 1.0          # reward per step while the chest is turned success_angle or more
 PERTURBATION = 0.05       # rad, U(-p, p) on every motor joint at reset
 SETTLE_STEPS = 100        # physics steps with zero controls before the first observation
 LIFT = 0.002              # m of air under the lowest geom before settling
@@ -51,13 +52,15 @@ def turn_angle(model, data, body: int, start: str) -> float:
 @dataclass(frozen=True)
 class RollOverOptions(TaskOptions):
     """The start (``supine``: roll onto the belly; ``prone``: onto the back), success (the chest
-    turned ``success_angle`` degrees for ``success_hold`` s), the control cost's weight, the
-    start noise (rad), the start yaw's range (deg, either way) and the settling steps."""
+    turned ``success_angle`` degrees for ``success_hold`` s), the reward per step while turned that
+    far (``over_bonus``), the control cost's weight, the start noise (rad), the start yaw's range
+    (deg, either way) and the settling steps."""
 
     task = "rollover"
     start: str = "supine"
     success_angle: float = SUCCESS_ANGLE
     success_hold: float = SUCCESS_HOLD
+    over_bonus: float = OVER_BONUS
     cost_weight: float = COST_WEIGHT
     perturbation: float = PERTURBATION
     yaw_range: float = 180.0
@@ -67,6 +70,7 @@ class RollOverOptions(TaskOptions):
         self._choice("start", STARTS)
         self._number("success_angle", 90.0, 180.0)
         self._number("success_hold", 0.0, 60.0)
+        self._number("over_bonus", 0.0)
         self._number("cost_weight", 0.0)
         self._number("perturbation", 0.0, 0.5)
         self._number("yaw_range", 0.0, 180.0)
@@ -136,8 +140,10 @@ class RollOver(Task):
         d = env.world.data
         self.turn_angle = turn_angle(env.world.model, d, self.chest_body, self.options.start)
         u = env.controls[0]
-        self._cost = self.options.cost_weight * float(np.dot(u, u))
-        return np.array([self.turn_angle / 180.0 - self._cost])
+        o = self.options
+        self._cost = o.cost_weight * float(np.dot(u, u))
+        over = o.over_bonus if self.turn_angle >= o.success_angle else 0.0
+        return np.array([self.turn_angle / 180.0 + over - self._cost])
 
     def plots(self):
         """Reward, the chest's turn from its start and success (turned and held)."""
