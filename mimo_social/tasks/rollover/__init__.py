@@ -3,7 +3,8 @@
 agents:
     1 (`infant_0`), mitten hands, spring-damper motors; the body of a 6-month-old (`age_months=6`,
     the task's default: infants roll both ways by about 6 months, see sources; `age_months=...`
-    sets another age, but every figure here is for 6 months)
+    sets another age: every figure here is for 6 months, and the controller's docstring gives a
+    few at 4 and 8 months and with five-fingered hands)
 body:
     free base on the bare floor; eyes, fingers, toes and the ankles' inversion and rotation held at
     their rest angles
