@@ -292,11 +292,18 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
         self.task.configs = tuple(configs)   # a task may place agents by their sizes
         setups = [self.task.setup(i, c) for i, c in enumerate(configs)]
         tables = list(w.tables)
-        for i, setup in enumerate(setups):
-            if setup != w.agent_setups[i]:
-                w.regrow(i, setup)
+        moved = [i for i, setup in enumerate(setups) if setup != w.agent_setups[i]]
+        for i in moved:
+            w.regrow(i, setups[i])
+        props = tuple(self.task.props())   # a task may size its props by the agents
+        if props != w.props:
+            w.regrow_props(props)
+        w.reset()                          # the new start state, what the task binds to
+        w.hold_welds()                     # props held to bodies: anchored at the new pose
         for i, config in enumerate(configs):
-            if config != before[i]:
+            if config == before[i] and i in moved:
+                self.actuation[i].retune(self.actuation[i].joints)   # a moved partner: rebind
+            elif config != before[i]:
                 self.agent_configs[i] = config
                 regrow_senses(self, i, tables[i], size, pos, before[i].age)
                 self._delays[i] = delay_steps(config, self.dt)

@@ -49,7 +49,8 @@ from .delays import VESTIBULAR_SENSORS, check_delay_steps, delay_steps
 
 __all__ = ["AgentMaps", "agent_maps", "regrow_agent", "body_tables", "support_below",
            "REST_CLEARANCE", "KEPT", "root_quat", "AGE_OPTIONS", "IGNORED_OPTIONS", "age_options",
-           "age_changes", "regrow_senses", "frame_ratios"]
+           "age_changes", "regrow_senses", "frame_ratios", "regrow_props",
+           "set_constants"]
 
 #: a body starts with its lowest point this high above the floor (m), as the world places it
 REST_CLEARANCE = 0.002
@@ -324,9 +325,67 @@ def regrow_agent(world, i: int, setup, dt: float) -> BodyTables:
     _write_inertia(m, maps, t)
     scratch = world.scratch_data()
     _place(world, i, maps, setup, quat, scratch)
-    mujoco.mj_setConst(m, scratch)
+    set_constants(world, scratch)
     _write_statistics(m, size_before)
     return t
+
+
+def regrow_props(world, props) -> None:
+    """The task's props as ``props`` says (the same props, each of another size, place, mass or
+    colour: a task may size its props by the agents' sizes), written into ``world``'s compiled
+    model in place; a ConfigError for any other change."""
+    m = world.model
+    size_before = _mean_box(m)
+    resized = []
+    for old, new in zip(world.props, props):
+        if new == old:
+            continue
+        if replace(new, size=old.size, pos=old.pos, mass=old.mass, rgba=old.rgba) != old:
+            raise ConfigError(f"prop {new.name}: this change needs another model (its shape, "
+                              "welds or whether it is fixed); an age change at reset changes "
+                              "only a prop's size, place, mass and colour")
+        b = world.prop_bodies[new.name]
+        resized.append(b)
+        g = int(m.body_geomadr[b])
+        size = _pad3(new.size)
+        kind = m.geom_type[g:g + 1]
+        m.geom_size[g], m.geom_rgba[g] = size, new.rgba
+        m.geom_rbound[g] = geom_rbound(kind, size[None])[0]
+        m.geom_aabb[g] = geom_aabb(kind, size[None])[0]
+        # one geom at the body's origin: its frame is the principal frame
+        m.body_mass[b], m.body_inertia[b] = new.mass, geom_moments(kind, size[None], [new.mass])[0]
+        m.body_ipos[b], m.body_iquat[b] = m.geom_pos[g], m.geom_quat[g]
+        m.bvh_aabb[m.body_bvhadr[b]] = m.geom_aabb[g]
+        m.body_pos[b] = new.pos
+        if not new.fixed:
+            q = world.prop_qpos[new.name]
+            m.qpos0[q:q + 3] = m.qpos_spring[q:q + 3] = new.pos
+            for k in range(3):
+                world.set_initial_qpos(q + k, new.pos[k])
+    set_constants(world, world.scratch_data(), resized)
+    _write_statistics(m, size_before)
+
+
+#: the per-body and per-dof constants of ``mj_setConst`` kept for bodies no age change wrote
+_KEPT_BODY = ("body_invweight0",)
+_KEPT_DOF = ("dof_invweight0", "dof_M0", "dof_length")
+
+
+def set_constants(world, scratch, also=()) -> None:
+    """``mujoco.mj_setConst`` for the bodies written (every agent's, and the bodies ``also``:
+    props just resized); the other bodies and their dofs keep their constants as they were: a
+    task that changes a prop at reset (a ball's size and mass) leaves them as a fresh build
+    has them."""
+    m = world.model
+    written = world.body_agent >= 0
+    written[np.asarray(also, np.intp)] = True
+    other = np.flatnonzero(~written)
+    dofs = np.flatnonzero(~written[m.dof_bodyid])
+    kept = [(k, other, getattr(m, k)[other].copy()) for k in _KEPT_BODY] + [
+        (k, dofs, getattr(m, k)[dofs].copy()) for k in _KEPT_DOF]
+    mujoco.mj_setConst(m, scratch)
+    for k, rows, values in kept:
+        getattr(m, k)[rows] = values
 
 
 def _mean_box(m) -> float:

@@ -29,7 +29,7 @@ from ..util.checks import check_choice
 from ..util.names import agent_names
 from .config import AgentConfig, PhysicsConfig
 from .delays import check_delay_steps, delay_sensors, fill_sensor_history
-from .regrow import agent_maps, regrow_agent
+from .regrow import agent_maps, regrow_agent, regrow_props
 
 __all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE"]
 
@@ -165,7 +165,7 @@ class World:
         # mass, weld and contact settings) and every quantity of the last step (qfrc_bias,
         # contacts, the solver's warm start) travel, so a copy continues exactly.
         state = {"recipe": self._recipe, "data": self.data, "bad_count": self._bad_count,
-                 "regrown": dict(self.regrown)}
+                 "regrown": dict(self.regrown), "props": self.regrown_props}
         if self.model.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP:
             state["awake"] = {k: getattr(self.data, k) for k in self._SLEEP_COUNTERS}
         return state
@@ -174,6 +174,8 @@ class World:
         self.__init__(*state["recipe"])   # the index tables, faces and spec of the recipe
         for i, setup in state.get("regrown", {}).items():   # ages changed since (regrow)
             self.regrow(i, setup)
+        if state.get("props") is not None:
+            self.regrow_props(state["props"])
         self.data = state["data"]
         for k, v in state.get("awake", {}).items():
             setattr(self.data, k, v)
@@ -234,6 +236,7 @@ class World:
                 body.sleep = mujoco.mjtSleepPolicy.mjSLEEP_NEVER   # tasks move their props
         self.spec = spec
         self.regrown: dict[int, AgentSetup] = {}   # agent -> its setup after an age change
+        self.regrown_props = None                   # the props after an age change
         self._regrow_maps: dict[int, object] = {}
         self._scratch = None
         self.model = spec.compile()
@@ -559,6 +562,12 @@ class World:
                                       self.physics.timestep * self.physics.frame_skip)
         self.agent_setups = self.agent_setups[:i] + (setup,) + self.agent_setups[i + 1:]
         self.regrown[i] = setup
+
+    def regrow_props(self, props) -> None:
+        """The props of another size, place, mass or colour (a task sizing them by the agents),
+        written into the compiled model in place (:func:`~mimo_social.core.regrow.regrow_props`)."""
+        regrow_props(self, props)
+        self.props = self.regrown_props = tuple(props)
 
     def regrow_maps(self, i: int):
         """Agent ``i``'s table rows as model ids (:func:`~mimo_social.core.regrow.agent_maps`),

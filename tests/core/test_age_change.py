@@ -18,6 +18,7 @@ from mimo_social.body.inertia import quat_matrices
 from mimo_social.core.config import ConfigError
 from mimo_social.core.gym_adapter import SingleAgentEnv
 from mimo_social.envs import free_play_v0, high_five_v0, still_face_v0
+from mimo_social.envs.catalog import CATALOG, entry
 
 STEPS = 100
 
@@ -229,5 +230,22 @@ def test_the_acuity_blur_follows_the_new_body_age():
     obs = env.reset(seed=0)[0]["infant_0"]
     obs_fresh = fresh.reset(seed=0)[0]["infant_0"]
     np.testing.assert_array_equal(obs["eye_left"], obs_fresh["eye_left"])
+    env.close()
+    fresh.close()
+
+
+@pytest.mark.parametrize("name", [e.name for e in CATALOG])
+def test_every_catalogue_env_changes_age_as_a_fresh_build(name):
+    """Tasks place agents, hold joints, size props and bind to the start state by the agents'
+    sizes: after the change every one starts and moves as a fresh build at that age."""
+    module = entry(name).module
+    env = module.parallel_env(max_steps=10_000)
+    env.reset(seed=0)
+    env.set_age(age_months=7)
+    per = [{"age_months": 7} if c.body == "infant" else {} for c in env.agent_configs]
+    fresh = module.parallel_env(max_steps=10_000, per_agent=per)
+    actions = _actions(env, 20)
+    for x, y in zip(_run(env, actions, seed=4)[1:], _run(fresh, actions, seed=4)[1:]):
+        np.testing.assert_allclose(x, y, atol=1e-6)
     env.close()
     fresh.close()
