@@ -138,9 +138,11 @@ def test_both_starts_have_gymnasium_ids():
         e.gym_env("mimo_social/Nothing-v0")
 
 
-def test_a_bad_start_is_refused_naming_what_is_allowed():
+def test_a_bad_start_or_posture_is_refused_naming_what_is_allowed():
     with pytest.raises(ValueError, match=r"start.*'sideways'.*supine.*prone"):
         rollover_v0.parallel_env(task_options={"start": "sideways"})
+    with pytest.raises(ValueError, match=r"infant_0.*posture='sitting'.*allowed: 'lying'"):
+        rollover_v0.parallel_env(posture="sitting")
 
 
 # -- the start ------------------------------------------------------------------------------

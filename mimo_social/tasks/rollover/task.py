@@ -12,6 +12,7 @@ from ...body.joint_groups import held_posture
 from ...body.tables import load_body
 from ...core.task import Plot, Task, TaskOptions
 from ...core.world import AgentSetup
+from ...util.checks import ConfigError
 from ..common import settle
 from ...core.factory import make_aec, make_parallel
 
@@ -90,6 +91,10 @@ class RollOver(Task):
                 "expressions": False}
 
     def setup(self, i, config):
+        if config.posture != "lying":
+            raise ConfigError(f"rollover: agent {self.agent_name(i)}: posture={config.posture!r} "
+                              "not allowed; allowed: 'lying' (the task turns the lying body onto "
+                              "its back or belly: task option start)")
         tables = load_body(config.hands, age_months=config.age_months, body=config.body)
         known = {j.name for j in tables.joints}
         actuated = tuple(j for j in ROLL_JOINTS if j in known)
@@ -131,7 +136,6 @@ class RollOver(Task):
         d.ctrl[:] = 0.0
         settle(env, o.settle_steps)
         self.turn_angle = turn_angle(m, d, self.chest_body, o.start)
-        self._start_angle = self.turn_angle
         self._cost = 0.0
         self._turned = 0   # control steps in a row with the chest turned success_angle or more
         self._hold_steps = max(1, round(o.success_hold / env.dt))
