@@ -31,7 +31,6 @@ the applied controls; task observations, sense infos and the expression are not 
 from __future__ import annotations
 
 import time
-from dataclasses import replace
 from typing import Any, Mapping, Sequence
 
 import mujoco
@@ -47,7 +46,7 @@ from ..util.checks import check_bool, check_choice, check_seed, number_array, sh
 from ..util.names import reject_old_names
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
 from .delays import MotorDelay, SenseDelay, delay_steps, fill_sensor_history
-from .regrow import age_changes, age_options, regrow_senses
+from .ages import age_changes, age_options, grow
 from .infos import InfoEncoder
 from .rendering import SceneRendering
 from .task import Task, agent_user_settings, check_start_poses
@@ -203,15 +202,13 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
                                       if self.agent_configs[i].expressions else motors)
         self._expression = np.zeros(len(self.possible_agents), dtype=np.int64)
         self.controls = [np.zeros(act.n_controls) for act in self.actuation]
-        self._sense_delays, self._motor_delays = [], []
-        for i in range(len(self.possible_agents)):
-            self._sense_delays.append(None)
-            self._motor_delays.append(None)
+        n = len(self.possible_agents)
+        self._sense_delays, self._motor_delays = [None] * n, [None] * n
+        for i in range(n):
             self._delay_rings(i)
 
     def _delay_rings(self, i: int) -> None:
-        """Agent ``i``'s ring buffers: one per sense (None: undelayed; vestibular is MuJoCo's),
-        one for its motors."""
+        """Agent ``i``'s rings: per sense (None: undelayed; vestibular: MuJoCo's), motors."""
         self._sense_delays[i] = [SenseDelay(k) if (k := self._delays[i][s.name]) and
                                  s.name != "vestibular" else None for s in self.senses[i]]
         k = self._delays[i]["motor"]
@@ -281,33 +278,14 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
             self._pending_ages.setdefault(i, {}).update(fields)
 
     def _grow(self, changes: dict) -> None:
-        """Apply age changes (agent index -> {setting: months}) to the world, the motors, the
-        senses, the delays and the task."""
-        w = self.world
-        size, pos = w.model.geom_size.copy(), w.model.geom_pos.copy()
-        before = list(self.agent_configs)
-        configs = [replace(c, **changes.get(i, {})) for i, c in enumerate(before)]
-        if configs == before:
+        """Apply age changes (agent index -> {setting: months}): the world, motors, senses and
+        props (:func:`~mimo_social.core.ages.grow`), then the delays and the task."""
+        changed = grow(self, changes)
+        if changed is None:        # the ages as they were: nothing to do
             return
-        self.task.configs = tuple(configs)   # a task may place agents by their sizes
-        setups = [self.task.setup(i, c) for i, c in enumerate(configs)]
-        tables = list(w.tables)
-        moved = [i for i, setup in enumerate(setups) if setup != w.agent_setups[i]]
-        for i in moved:
-            w.regrow(i, setups[i])
-        props = tuple(self.task.props())   # a task may size its props by the agents
-        if props != w.props:
-            w.regrow_props(props)
-        w.reset()                          # the new start state, what the task binds to
-        w.hold_welds()                     # props held to bodies: anchored at the new pose
-        for i, config in enumerate(configs):
-            if config == before[i] and i in moved:
-                self.actuation[i].retune(self.actuation[i].joints)   # a moved partner: rebind
-            elif config != before[i]:
-                self.agent_configs[i] = config
-                regrow_senses(self, i, tables[i], size, pos, before[i].age)
-                self._delays[i] = delay_steps(config, self.dt)
-                self._delay_rings(i)
+        for i in changed:
+            self._delays[i] = delay_steps(self.agent_configs[i], self.dt)
+            self._delay_rings(i)
         self._bind_task()
 
     def reset(self, seed: int | None = None, options: dict | None = None):

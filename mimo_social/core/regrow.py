@@ -28,12 +28,10 @@ several geoms may come out in another order or sign: the inertia tensor is the s
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Mapping, Sequence
 
 import mujoco
 import numpy as np
 
-from ..body.growth import segment_factors
 from ..body.builder import (EYE_CAMERA_X, GEOM_FRICTION, IRIS, PUPIL, axis_angle_quat,
                             quat_mul)
 from ..body.inertia import (BOX, CAPSULE, CYLINDER, ELLIPSOID, SPHERE, body_inertials,
@@ -41,16 +39,12 @@ from ..body.inertia import (BOX, CAPSULE, CYLINDER, ELLIPSOID, SPHERE, body_iner
                             quat_matrices)
 from ..body.postures import posture_pitch
 from ..body.tables import BodyTables, load_body
-from ..senses import SENSES
-from ..senses.skin_growth import regrown_skin
-from ..util.checks import show
 from .config import ConfigError
 from .delays import VESTIBULAR_SENSORS, check_delay_steps, delay_steps
 
 __all__ = ["AgentMaps", "agent_maps", "regrow_agent", "body_tables", "support_below",
-           "REST_CLEARANCE", "KEPT", "root_quat", "AGE_OPTIONS", "IGNORED_OPTIONS", "age_options",
-           "age_changes", "regrow_senses", "frame_ratios", "regrow_props",
-           "set_constants"]
+           "REST_CLEARANCE", "KEPT", "root_quat", "regrow_props", "set_constants",
+           "check_same_model"]
 
 #: a body starts with its lowest point this high above the floor (m), as the world places it
 REST_CLEARANCE = 0.002
@@ -297,12 +291,10 @@ def root_quat(setup) -> np.ndarray:
                     axis_angle_quat((0, 1, 0), np.deg2rad(pitch)))
 
 
-def regrow_agent(world, i: int, setup, dt: float) -> BodyTables:
-    """Write agent ``i``'s body at the ages of ``setup.config``, placed as ``setup`` says (its
-    position, facing and held joint angles), into ``world``'s compiled model (module
-    docstring); returns the new tables. A ConfigError when the change needs another model (other
-    held joints, motors, base, senses or body) or a vestibular delay beyond what the model's
-    sensor history holds."""
+def check_same_model(world, i: int, setup, dt: float) -> None:
+    """A ConfigError unless agent ``i`` of ``world`` can take ``setup`` in place: the same held
+    joints, motors, base and :data:`KEPT` settings (other ages, place and held angles), its
+    delays within the limits."""
     old = world.agent_setups[i]
     same = replace(setup, config=old.config, position=old.position, facing=old.facing,
                    frozen=old.frozen if set(setup.frozen) == set(old.frozen) else None)
@@ -310,8 +302,17 @@ def regrow_agent(world, i: int, setup, dt: float) -> BodyTables:
         raise ConfigError(f"agent {world.names[i]}: this change needs another model (held "
                           f"joints, motors, base or one of {list(KEPT)}); an age change at reset "
                           "changes only the ages, the place and held angles")
+    check_delay_steps(world.names[i], setup.config, dt)
+
+
+def regrow_agent(world, i: int, setup, dt: float) -> BodyTables:
+    """Write agent ``i``'s body at the ages of ``setup.config``, placed as ``setup`` says (its
+    position, facing and held joint angles), into ``world``'s compiled model (module
+    docstring); returns the new tables. A ConfigError when the change needs another model (other
+    held joints, motors, base, senses or body) or a vestibular delay beyond what the model's
+    sensor history holds."""
+    check_same_model(world, i, setup, dt)
     config = setup.config
-    check_delay_steps(world.names[i], config, dt)
     quat = root_quat(setup)
     m = world.model
     maps = world.regrow_maps(i)
@@ -425,120 +426,3 @@ def _vestibular_delay(world, i: int, k: int, dt: float, sensors) -> None:
                 f"vestibular delay of at most {max(0, (held - 2) * ts / dt):g} steps without a "
                 "rebuild (build the env with the longer delay)")
         m.sensor_delay[s] = k * dt - 0.5 * ts if k else 0.0
-
-
-# -- the env's side: which agents change, and their senses and motors --------------------------
-#: the options ``reset(options=...)`` takes: each a number (every infant) or {agent: number}
-AGE_OPTIONS = ("age_months", "motor_age_months")
-#: option keys accepted and ignored: PettingZoo's API test checks that reset takes options with
-#: ``options={"options": 1}``
-IGNORED_OPTIONS = ("options",)
-
-
-def age_options(options) -> dict:
-    """The age settings of ``reset``'s ``options`` (None or a mapping of :data:`AGE_OPTIONS`);
-    a ConfigError naming an unknown key and the keys allowed."""
-    if options is None:
-        return {}
-    if not isinstance(options, Mapping):
-        raise ConfigError(f"reset: options={show(options)} not allowed; allowed: None or a dict "
-                          f"with keys {list(AGE_OPTIONS)}")
-    unknown = sorted((k for k in options if k not in AGE_OPTIONS + IGNORED_OPTIONS), key=str)
-    if unknown:
-        raise ConfigError(f"reset: unknown option(s) {unknown}; allowed: {list(AGE_OPTIONS)} "
-                          "(each a number of months, 0 to 33, for every infant, or a dict "
-                          "agent -> months)")
-    return {k: options[k] for k in AGE_OPTIONS if k in options}
-
-
-def age_changes(names: Sequence[str], configs: Sequence, values: Mapping, agent=None,
-                where: str = "set_age") -> dict[int, dict]:
-    """Agent index -> {setting: months} of the infants that ``values`` (setting -> None (no
-    change), a number (``agent``, or every infant when ``agent`` is None) or a dict agent ->
-    number) changes, each checked as the agent's config checks it; a ConfigError (an unknown
-    agent: a KeyError) naming the agent, the setting, the value and what is allowed."""
-    infants = [n for n, c in zip(names, configs) if c.body == "infant"]
-
-    def index(name) -> int:
-        if name not in names:
-            raise KeyError(f"{where}: unknown agent {name!r}; agents of this env: {list(names)}")
-        i = list(names).index(name)
-        if configs[i].body != "infant":
-            raise ConfigError(f"{where}: agent {name} is an adult (body='adult'); "
-                              f"{' and '.join(AGE_OPTIONS)} are for infants: {infants}")
-        return i
-
-    if agent is not None:
-        targets = [index(agent)]
-    else:
-        targets = [names.index(n) for n in infants]
-    out: dict[int, dict] = {}
-    for key, value in values.items():
-        if value is None:
-            continue
-        if isinstance(value, Mapping):
-            for name, v in value.items():
-                out.setdefault(index(name), {})[key] = v
-            continue
-        if not targets:
-            raise ConfigError(f"{where}: {key}={show(value)}: this env has no infant (agents "
-                              f"{list(names)}); ages are for infants")
-        for i in targets:
-            out.setdefault(i, {})[key] = value
-    for i, fields in out.items():
-        try:
-            replace(configs[i], **fields)
-        except ConfigError as e:
-            raise ConfigError(f"{where}: agent {names[i]}: {e}") from None
-    return out
-
-
-def frame_ratios(old_age: float, new_age: float, segments: Sequence[str]) -> np.ndarray:
-    """(n, 3) per segment the ratio of its frame's x, y, z length factors at ``new_age`` to
-    those at ``old_age`` (:func:`~mimo_social.body.growth.segment_factors`; a ``left_``
-    segment takes its right twin's)."""
-    def factors(age):
-        table = segment_factors(age)
-        out = []
-        for name in segments:
-            key = name if name in table or not name.startswith("left_") else "right_" + name[5:]
-            radial, axial, axis = table.get(key, (1.0, 1.0, "z"))
-            out.append([axial if a == axis else radial for a in "xyz"])
-        return np.array(out)
-    return factors(new_age) / factors(old_age)
-
-
-def regrow_senses(env, i: int, old: BodyTables, old_size: np.ndarray,
-                  old_pos: np.ndarray, old_age: float) -> None:
-    """After :meth:`World.regrow` of agent ``i``: its motors take the new torques, its senses'
-    spaces the new bounds (the same space objects), its skin follows its geoms (as many
-    points: :func:`~mimo_social.senses.skin.regrown_skin`) and its eyes' acuity the body age.
-    ``old``: its tables before; ``old_size``, ``old_pos``: every geom's size and position
-    before; ``old_age``: its body age before."""
-    w, cfg = env.world, env.agent_configs[i]
-    t = w.tables[i]
-    by_name = {j.name: j for j in t.joints}
-    act = env.actuation[i]
-    act.retune([by_name[n] for n in w.agents[i].actuated_names])
-    for sense in env.senses[i]:
-        entry = SENSES[sense.name]
-        if entry.per_agent is None:
-            continue
-        fresh = entry.per_agent(getattr(cfg, sense.name), w, i, act)
-        for key, space in sense.spaces.items():
-            if hasattr(space, "low"):
-                np.copyto(space.low, fresh.spaces[key].low)
-                np.copyto(space.high, fresh.spaces[key].high)
-    touch = env.systems.get("touch")
-    if touch is not None and touch.skins[i] is not None:
-        skin = touch.skins[i]
-        ratio = np.array([t.touch_spacing[n] / old.touch_spacing[n] for n in skin.part_names])
-        touch.skins[i] = regrown_skin(skin, w.model, old_size, old_pos, ratio,
-                                      frame_ratios(old_age, cfg.age, skin.part_names))
-        touch.concatenate(w.model)
-        for sense in env.senses[i]:
-            if sense.name == "touch":
-                sense.skin = touch.skins[i]
-    vision = env.systems.get("vision")
-    if vision is not None and i in vision.agents:
-        vision.set_age(w.model, i, cfg.age)
