@@ -1,28 +1,31 @@
 """An infant of another age in the compiled world, without compiling: the new values written in
 place into the live ``MjModel`` (the same model and data objects; renderers and index tables
-kept).
+kept). The env's side (which agents change, their motors, senses and skins): core/ages.py.
 
-:func:`regrow_agent` takes agent ``i``'s new :class:`~mimo_social.core.config.AgentConfig`
-(another ``age_months`` and / or ``motor_age_months``; hands, body kind, actuation and senses
-unchanged, so the body's topology is the same) and writes, for that agent only:
+:func:`regrow_agent` takes agent ``i``'s new :class:`~mimo_social.core.world.AgentSetup` (its
+config of other ``age_months`` and / or ``motor_age_months``, and the place and held angles the
+task gives it at those ages; hands, body kind, actuation, size, posture, senses, held joints
+and motors unchanged: :func:`check_same_model`) and writes, for that agent only:
 
 - from the tables of the new body age (:func:`~mimo_social.body.tables.load_body`): segment
   positions (``body_pos``), geom sizes, positions and contact lengths (torsional and rolling
   friction), the iris and pupil of each eye, site and eye-camera positions, joint pivots, joint
   stiffness, damping, armature and friction loss;
+- the held angles: segments a held joint was folded into turned (``body_quat``), joints held
+  by an equality at their angle (``eq_data``, the start pose);
 - the mass properties from the new geoms (:mod:`mimo_social.body.inertia`, MuJoCo's formulas):
   ``body_mass``, ``body_ipos``, ``body_iquat``, ``body_inertia``;
 - the bounds: ``geom_rbound``, ``geom_aabb`` and the bodies' bounding-volume trees
   (``bvh_aabb``, in each body's inertial frame, rebuilt bottom-up from the leaves);
 - the motors' torque limits (``actuator_ctrlrange``, ``actuator_forcerange``) from the tables of
   the motor age (the muscle and positional models adapt their motors when next reset);
-- the start height: the body is lowered onto the floor from its new geometry as a fresh build
-  is (its rest pose's lowest point 2 mm above the floor);
+- the start pose: the root at its place, turned to face its partner, lowered onto the floor
+  from its new geometry as a fresh build is (its rest pose's lowest point 2 mm above it);
 - then ``mujoco.mj_setConst`` for the derived constants (subtree masses, inverse weights,
-  ``actuator_acc0``, the model statistics).
+  ``actuator_acc0``) and the model statistics (:func:`set_constants`).
 
-A fresh build at the new ages gives the same values to rounding (the principal axes of a body of
-several geoms may come out in another order or sign: the inertia tensor is the same).
+:func:`regrow_props` does the same for props a task sizes by its agents. A fresh build at the
+new ages gives the same values to rounding (tests/core/test_age_change.py).
 """
 
 from __future__ import annotations
