@@ -66,14 +66,14 @@ baselines:
 sources:
     rolling emerges at about 3 to 6 months, from the belly to the back first (about 3-5 months)
     and from the back to the belly a month or two later (about 5-7 months): the Alberta Infant Motor
-    Scale's items "rolling prone to supine" and "rolling supine to prone with rotation" (Piper &
-    Darrah; its norms re-checked by Darrah et al. 2014, Dev. Med. Child Neurol. 56(9):877-881, doi
-    10.1111/dmcn.12452), a pediatric neurological examination's 3-month prone item ("rolling front
-    to back usually occurs at 3 to 5 months of age") and parents' guides (front to back at 4 to 6
-    months, back to front at 5 to 7 months). 6 months is the youngest age at which both directions
-    are usual, hence the default body. The task is named after the published MIMo v3 suite's
-    `MIMoRollOver-v0`; its constants were not taken from there: every number here is this task's
-    own and measured
+    Scale (Piper & Darrah), whose prone and supine items include rolling prone to supine and supine
+    to prone (its age norms re-checked by Darrah et al. 2014, Dev. Med. Child Neurol.
+    56(9):877-881, doi 10.1111/dmcn.12452); a pediatric neurological examination's 3-month prone
+    item ("rolling front to back usually occurs at 3 to 5 months of age"; a video at kaltura.com,
+    entry 0_795q4f4q); parents' guides (front to back at 4 to 6 months, back to front at 5 to 7).
+    6 months is the youngest age at which both directions are usual, hence the default body. The
+    task is named after the published MIMo v3 suite's `MIMoRollOver-v0`; nothing was taken from
+    it: every constant here is this task's own and every figure is measured here
 version history:
     v0, issue 32: first version, both starts (`mimo_social/RollOver-v0`: from the back,
     `mimo_social/RollOverProne-v0`: from the belly), scripted controller
