@@ -249,3 +249,20 @@ def test_every_catalogue_env_changes_age_as_a_fresh_build(name):
         np.testing.assert_allclose(x, y, atol=1e-6)
     env.close()
     fresh.close()
+
+
+def test_a_pickled_copy_keeps_the_props_and_places_a_task_gave_the_new_ages():
+    env = entry("imitation").module.parallel_env(max_steps=10_000)
+    env.reset(seed=1, options={"age_months": 5})
+    actions = _actions(env, 16)
+    for act in actions[:8]:
+        env.step(act)
+    copy = pickle.loads(pickle.dumps(env))
+    assert copy.world.props == env.world.props
+    assert copy.world.agent_setups == env.world.agent_setups
+    for act in actions[8:]:
+        env.step(act)
+        copy.step(act)
+    np.testing.assert_array_equal(env.world.data.qpos, copy.world.data.qpos)
+    for x, y in zip(_run(env, actions)[1:], _run(copy, actions)[1:]):
+        np.testing.assert_array_equal(x, y)
