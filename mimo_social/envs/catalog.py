@@ -50,8 +50,9 @@ class EnvEntry:
     #: whose success and return say it all
     measures: ModuleType | None = None
     #: further Gymnasium ids of the same task, each a variant of its options: ``(gym_id,
-    #: defaults)`` pairs, ``defaults`` keyword pairs as in ``gym_defaults`` (merged over them; a
-    #: variant's ``task_options`` are merged over the entry's, and the user's over both)
+    #: defaults)`` pairs, ``defaults`` keyword pairs as in ``gym_defaults`` (merged over them),
+    #: ``task_options`` as pairs too (the entry stays hashable); the user's ``task_options`` are
+    #: merged over the variant's
     gym_variants: tuple = ()
 
     @property
@@ -59,16 +60,24 @@ class EnvEntry:
         """Every Gymnasium id of the task: ``gym_id`` first, then its variants'."""
         return (self.gym_id, *(v[0] for v in self.gym_variants))
 
+    def variant_defaults(self, gym_id: str) -> dict:
+        """What the variant ``gym_id`` sets over the entry's ``gym_defaults`` (``task_options``
+        as a dict); a ValueError naming the allowed ids for an id that is not a variant."""
+        variants = dict(self.gym_variants)
+        if gym_id not in variants:
+            raise ValueError(f"task {self.name!r}: gym_id={gym_id!r} not allowed; allowed: "
+                             f"{list(self.gym_ids)}")
+        out = dict(variants[gym_id])
+        if "task_options" in out:
+            out["task_options"] = dict(out["task_options"])
+        return out
+
     def gym_kwargs(self, gym_id: str | None = None, **kwargs) -> dict:
         """The env keywords ``gym.make(gym_id, **kwargs)`` builds the env with: the id's
         defaults, then ``kwargs`` (``task_options`` merged, not replaced)."""
         out = dict(self.gym_defaults)
         if gym_id is not None and gym_id != self.gym_id:
-            variants = dict(self.gym_variants)
-            if gym_id not in variants:
-                raise ValueError(f"task {self.name!r}: gym_id={gym_id!r} not allowed; allowed: "
-                                 f"{list(self.gym_ids)}")
-            out = _merged(out, dict(variants[gym_id]))
+            out = _merged(out, self.variant_defaults(gym_id))
         return _merged(out, kwargs)
 
     @property
@@ -118,7 +127,7 @@ CATALOG: tuple[EnvEntry, ...] = (
              "roll over on the floor: from the back to the belly (start='prone': the reverse)",
              controller=rollover.RollOverController,
              gym_variants=(("mimo_social/RollOverProne-v0",
-                            (("task_options", {"start": "prone"}),)),)),
+                            (("task_options", (("start", "prone"),)),)),)),
     EnvEntry("selfbody", selfbody_v0, "mimo_social/SelfBody-v0", "one-agent",
              "touch a named primitive of one's own body with the right hand",
              controller=selfbody.SelfBodyController),

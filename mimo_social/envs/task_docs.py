@@ -310,8 +310,9 @@ def _gym_ids(e: EnvEntry) -> str:
     """``Gymnasium id `X``` or, for a task with variants, every id with the options it sets."""
     if not e.gym_variants:
         return f"Gymnasium id `{e.gym_id}`"
-    rest = "; ".join(f"`{i}` ({', '.join(f'{k}={v!r}' for k, v in defaults)})"
-                     for i, defaults in e.gym_variants)
+    rest = "; ".join(
+        f"`{i}` ({', '.join(f'{k}={v!r}' for k, v in e.variant_defaults(i).items())})"
+        for i in e.gym_ids[1:])
     return f"Gymnasium ids `{e.gym_id}` and, with other defaults, {rest}"
 
 

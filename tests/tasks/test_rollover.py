@@ -127,6 +127,8 @@ def test_both_starts_have_gymnasium_ids():
     import gymnasium as gym
     e = entry("rollover")
     assert e.gym_ids == ("mimo_social/RollOver-v0", "mimo_social/RollOverProne-v0")
+    hash(e)   # an entry stays hashable with its variants
+    assert e.variant_defaults("mimo_social/RollOverProne-v0") == {"task_options": {"start": "prone"}}
     for gym_id, start in zip(e.gym_ids, ("supine", "prone")):
         env = gym.make(gym_id, task_options={"success_hold": 0.5})
         par = env.unwrapped.parallel
