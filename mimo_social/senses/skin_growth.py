@@ -28,9 +28,11 @@ def regrown_skin(skin: Skin, model: mujoco.MjModel, old_size: np.ndarray,
     distances are multiplied by ``spacing_ratio`` (per part). Each part's lookup grid is laid
     out around the moved points and takes, per cell, the point of the old grid's cell at the
     place the part's own map (``part_factors``: per part the x, y, z length ratios of its
-    segment frame) brings it back to (no nearest-neighbour search: a few milliseconds). A skin
-    laid out afresh on the new body may have a few points more or fewer (the layout rounds
-    point counts per primitive)."""
+    segment frame) brings it back to (no nearest-neighbour search: a few milliseconds); probed
+    at each point half a spacing outward, as a contact is, it gives the point itself or one
+    within about a spacing of it (tests/core/test_age_change.py). A skin laid out afresh on
+    the new body may have a few points more or fewer (the layout rounds point counts per
+    primitive)."""
     g = skin.point_geom
     kind = model.geom_type[g]
     R = quat_matrices(model.geom_quat)[g]

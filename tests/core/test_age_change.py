@@ -19,6 +19,7 @@ from mimo_social.core.config import ConfigError
 from mimo_social.core.gym_adapter import SingleAgentEnv
 from mimo_social.envs import free_play_v0, high_five_v0, still_face_v0
 from mimo_social.envs.catalog import CATALOG, entry
+from mimo_social.senses.skin import GRID_CELL, SHAPES, signed_distance
 
 STEPS = 100
 
@@ -266,3 +267,46 @@ def test_a_pickled_copy_keeps_the_props_and_places_a_task_gave_the_new_ages():
     np.testing.assert_array_equal(env.world.data.qpos, copy.world.data.qpos)
     for x, y in zip(_run(env, actions)[1:], _run(copy, actions)[1:]):
         np.testing.assert_array_equal(x, y)
+
+
+def _lookup_error(skin):
+    """Per point, probed half a spacing outward (as a contact is): the distance, in spacings,
+    from the point to the one the lookup grid gives."""
+    out = []
+    for k in range(len(skin.part_names)):
+        a, b = skin.part_start[k], skin.part_start[k + 1]
+        s = skin.part_spacing[k]
+        probe = skin.points[a:b] + 0.5 * s * skin.normals[a:b]
+        dims = skin.grid_dims[k]
+        cell = np.clip(np.floor((probe / s - skin.grid_lo[k]) / GRID_CELL).astype(int), 0,
+                       dims - 1)
+        flat = (cell[:, 0] * dims[1] + cell[:, 1]) * dims[2] + cell[:, 2]
+        found = skin.grid[skin.grid_start[k] + flat]
+        out.append(np.linalg.norm(skin.points[found] - skin.points[a:b], axis=1) / s)
+    return np.concatenate(out)
+
+
+@pytest.mark.parametrize("age", [0, 6, 30])
+def test_the_carried_skin_finds_the_touched_point(age):
+    env = free_play_v0.parallel_env(n_agents=1, touch=True)
+    env.reset(seed=0, options={"age_months": age})
+    skin = env.system("touch").skins[0]
+    fresh = free_play_v0.parallel_env(n_agents=1, touch=True, age_months=age)
+    error = _lookup_error(skin)
+    assert np.median(error) == 0.0 and np.percentile(error, 99) <= 0.5 and error.max() <= 1.1
+    # every point on its primitive's new surface, and the part as large as a fresh skin's
+    m = env.world.model
+    for g in np.unique(skin.point_geom):
+        on = skin.point_geom == g
+        R = quat_matrices(m.geom_quat[g])[0]
+        local = (skin.points[on] - m.geom_pos[g]) @ R
+        shape = SHAPES[int(m.geom_type[g])]
+        np.testing.assert_allclose(signed_distance(shape, m.geom_size[g], local), 0.0,
+                                   atol=1e-9, err_msg=m.geom(int(g)).name)
+    for k, name in enumerate(skin.part_names):
+        g = fresh.system("touch").skins[0]
+        j = g.part_names.index(name)
+        mine = skin.points[skin.part_start[k]:skin.part_start[k + 1]]
+        theirs = g.points[g.part_start[j]:g.part_start[j + 1]]
+        np.testing.assert_allclose(np.ptp(mine, axis=0), np.ptp(theirs, axis=0),
+                                   rtol=0.15, atol=0.004, err_msg=name)
