@@ -347,8 +347,8 @@ class GrowthController:
             wall = round(time.perf_counter() - self.t_start, 1)
             self.config["growth"]["history"].append(
                 {"step": int(n), "age_months": new, "wall_time_s": wall})
-            self.note(f"growth: the infant is {new:g} months old from step {n} "
-                      f"({self.growth.spec})")
+            self.note(f"growth: the infant is {new:g} month{'' if new == 1 else 's'} old "
+                      f"from step {n} ({self.growth.spec})")
             self.write()
 
     def columns(self) -> dict:

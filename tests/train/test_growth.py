@@ -366,3 +366,16 @@ def test_a_curriculum_s_growth_key_grows_the_infant_across_its_stages(tmp_path):
                                               "one of the two"):
         train("reach", "ppo", 256, 0, tmp_path / "again", curriculum=spec,
               growth="inverse:1-3", **kw)
+
+
+def test_an_inverse_controller_goes_down_and_notes_each_whole_month_reached():
+    notes, venv, config = [], _Venv(), {}
+    ctl = GrowthController(parse_growth("inverse:1-4"), venv, None, 300, config, lambda: None,
+                           notes.append)
+    for n in range(0, 301):
+        ctl.on_step(n, [])
+    ages = [kw["age_months"] for _, kw in venv.calls]
+    assert ages[0] == 3.9 and ages[-1] == 1 and np.all(np.diff(ages) < 0) and len(ages) == 30
+    assert [h["age_months"] for h in config["growth"]["history"]] == [4, 3, 2, 1]
+    assert [h["step"] for h in config["growth"]["history"]] == [0, 100, 200, 300]
+    assert "1 month old from step 300 (inverse:1-4)" in notes[-1] and len(notes) == 3
