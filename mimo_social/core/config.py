@@ -71,6 +71,10 @@ class AgentConfig:
     touch: TouchConfig | None = None     # the full-body skin: a force vector per point
     vision: VisionConfig | None = None   # two eye cameras: RGB, optionally depth
     expressions: bool = True   # the face is part of the action: 7 expressions
+    # The voice is part of the action: "voice" (a kind of expressions.voice.SOUNDS: silence,
+    # coo, babble, cry, laugh, speech) and "loudness" in [0, 1] (the kind's quietest to
+    # loudest level, docs/senses.md "Hearing and voice"); a sound lasts its control step.
+    voice: bool = False
     posture: str = "standing"   # the start posture
     position: tuple[float, float] | None = None   # (x, y) on the floor; None: the task decides
     facing: tuple[float, float] | None = None     # a point (x, y) to face; None: the task decides
@@ -103,6 +107,7 @@ class AgentConfig:
         check_choice("", "actuation", self.actuation, ACTUATION_MODELS)
         check_choice("", "posture", self.posture, POSTURES)
         put("expressions", check_bool("", "expressions", self.expressions))
+        put("voice", check_bool("", "voice", self.voice))
         for sense in SENSES:   # each sense: None (off) or its config (True / a mapping: parsed)
             put(sense, _parse_sense(sense, getattr(self, sense)))
         if self.position is not None:

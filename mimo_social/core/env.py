@@ -1,11 +1,13 @@
 """The PettingZoo ParallelEnv: N infants in one world, built from a task object.
 
 Actions per agent: a ``Box`` of the agent's motor controls (spring-damper: one value in [-1, 1]
-per motor; muscles: two values in [0, 1] per motor), or, when expressions are on, a
-``Dict({"motors": Box, "expression": Discrete(7)})``. Motor values outside the Box are
-**clipped** (learners' Gaussian policies overshoot); NaN/inf, a wrong shape, an unknown agent or
-an expression id out of range raise ``ValueError`` naming the agent, the field and what is
-allowed. A simulation that goes unstable ends the episode for every agent with the reason in
+per motor; muscles: two values in [0, 1] per motor), or, when expressions or the voice are on, a
+``Dict`` of ``"motors"``, ``"expression"`` (``Discrete(7)``) and ``"voice"`` (``Discrete(6)``)
+with ``"loudness"`` (``Box(0, 1, (1,))``): :mod:`mimo_social.core.actions`. Motor values outside
+the Box are **clipped** (learners' Gaussian policies overshoot); NaN/inf, a wrong shape, an
+unknown agent, an id out of range or a loudness outside [0, 1] raise ``ValueError`` naming the
+agent, the field and what is allowed. ``env.sounds``: every agent's sound of the last step.
+A simulation that goes unstable ends the episode for every agent with the reason in
 ``infos[agent]["instability"]`` (a 1 in the numeric infos).
 
 Infos are numbers by default: each agent's the same keys at reset and at every step
@@ -42,8 +44,10 @@ from ..body.actuation import MODELS as ACTUATION_MODELS
 from ..expressions.faces import EXPRESSIONS
 from ..scenery import SCENES, check_scene_clear
 from ..senses import SENSES
-from ..util.checks import check_bool, check_choice, check_seed, number_array, show
+from ..util.checks import check_bool, check_choice, check_seed
 from ..util.names import reject_old_names
+from ..expressions.voice import SOUNDS, level_db
+from .actions import action_space, check_action_keys, checked_action
 from .config import ConfigError, env_settings, parse_physics, resolve_agents
 from .delays import MotorDelay, SenseDelay, delay_steps, fill_sensor_history
 from .ages import age_changes, age_options, grow
@@ -55,42 +59,10 @@ from .world import World
 __all__ = ["MimoParallelEnv", "TIMING_KEYS"]
 
 TIMING_KEYS = ("actuation", "physics", *SENSES, "task", "other")
-#: the action dtypes read as they are (the common case: no conversion)
-_PLAIN_FLOATS = (np.dtype(np.float32), np.dtype(np.float64))
-#: the keys of an action when expressions are on
-_ACTION_KEYS = frozenset(("motors", "expression"))
-
-
-def _expression_id(agent: str, given) -> int:
-    """The expression id of an action: an integer 0..len(EXPRESSIONS) - 1, also as a numpy or
-    tensor scalar or a 1-element array; else a ValueError naming the agent, the value and what
-    is allowed."""
-    if type(given) is int or type(given) in _INT_SCALARS:      # the common cases, quickly
-        if 0 <= given < len(EXPRESSIONS):
-            return int(given)
-        ok = False
-    else:
-        try:
-            e = np.asarray(given)
-            ok = e.shape in ((), (1,)) and e.dtype.kind in "iu" \
-                and 0 <= int(e.reshape(())) < len(EXPRESSIONS)
-        except Exception:  # noqa: BLE001  (ragged lists, tensors that need grad ...)
-            ok = False
-        if ok:
-            return int(e.reshape(()))
-    raise ValueError(f"{agent}: expression={show(given, 120)} not allowed; allowed: an integer "
-                     f"0..{len(EXPRESSIONS) - 1}: "
-                     + ", ".join(f"{k}={n}" for k, n in enumerate(EXPRESSIONS)))
-
-
 def _empty(space) -> bool:
     """Whether an observation space holds no value (a Box with a 0 in its shape)."""
     shape = getattr(space, "shape", None)
     return shape is not None and 0 in shape
-
-
-_INT_SCALARS = frozenset((np.int64, np.int32, np.int16, np.int8, np.uint64, np.uint32,
-                          np.uint16, np.uint8))
 
 
 class MimoParallelEnv(SceneRendering, ParallelEnv):
@@ -195,12 +167,14 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
                 raise ConfigError(f"{name}: every sense is off; turn on at least one of "
                                   f"{', '.join(SENSES)}")
             self._obs_spaces[name] = spaces.Dict(obs)
-            act = self.actuation[i]
-            motors = spaces.Box(act.control_low, act.control_high, dtype=np.float32)
-            self._act_spaces[name] = (spaces.Dict({"motors": motors,
-                                                   "expression": spaces.Discrete(len(EXPRESSIONS))})
-                                      if self.agent_configs[i].expressions else motors)
+            self._act_spaces[name] = action_space(self.agent_configs[i], self.actuation[i])
         self._expression = np.zeros(len(self.possible_agents), dtype=np.int64)
+        # every agent's sound this step: (kind id of SOUNDS, level in dB SPL at 1 m)
+        self._sounds = np.zeros((len(self.possible_agents), 2))
+        self._voice_adult = np.array([c.body == "adult" for c in self.agent_configs])
+        if "audition" in self.systems:
+            self.systems["audition"].connect(self._sounds, [
+                k for k, c in enumerate(self.agent_configs) if c.voice])
         self.controls = [np.zeros(act.n_controls) for act in self.actuation]
         n = len(self.possible_agents)
         self._sense_delays, self._motor_delays = [None] * n, [None] * n
@@ -305,6 +279,7 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
         for act in self.actuation:
             act.reset(w.model, w.data)
         self._expression[:] = 0
+        self._sounds[:] = 0.0
         for c in self.controls:
             c[:] = 0.0
         if self.task.bound_world is not w:   # the task object was used by another env since
@@ -377,10 +352,12 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
             i = index[a]
             checked.append((i, actuation[i], *check(i, a, actions[a])))
         w = self.world
-        for i, act, expression, u in checked:
+        for i, act, expression, sound, u in checked:
             if expression is not None:
                 self._expression[i] = expression
                 w.set_expression(i, expression)
+            if sound is not None:   # the sound of this control step
+                self._sounds[i] = sound[0], level_db(*sound, self._voice_adult[i])
             # the env's own buffer: the caller's array is never written to nor kept
             c = self.controls[i]
             ring = self._motor_delays[i]
@@ -394,71 +371,31 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
             act.apply(w.model, w.data, c)
 
     def check_action(self, agent: str, action) -> tuple[int | None, np.ndarray]:
-        """``agent``'s action checked as :meth:`step` checks it, nothing applied: its expression
-        id (None with expressions off) and its motor commands (a float array of the motor Box's
-        shape, finite, not clipped). A ValueError names the agent, the field (``motors``,
-        ``expression``), the value and what is allowed; an unknown agent is a KeyError naming
-        the agents. The recorder checks the actions it is given with it."""
-        return self._checked_action(self._index[self._check_agent(agent)], agent, action)
+        """``agent``'s action checked as :meth:`step` checks it (its voice too), nothing
+        applied: its expression id (None with expressions off) and its motor commands (a float
+        array of the motor Box's shape, finite, not clipped). A ValueError names the agent, the
+        field (``motors``, ``expression``, ``voice``, ``loudness``), the value and what is
+        allowed (:mod:`mimo_social.core.actions`); an unknown agent is a KeyError naming the
+        agents. The recorder checks the actions it is given with it."""
+        expression, _, motors = self._checked_action(self._index[self._check_agent(agent)],
+                                                     agent, action)
+        return expression, motors
 
-    def _checked_action(self, i: int, agent: str, action) -> tuple[int | None, np.ndarray]:
-        act = self.actuation[i]
-        expression = None
-        if self.agent_configs[i].expressions:
-            if not (type(action) is dict and action.keys() == _ACTION_KEYS) and (
-                    not isinstance(action, Mapping) or set(action) != _ACTION_KEYS):
-                raise ValueError(f"{agent}: action must be a dict with keys 'motors' and "
-                                 f"'expression' (expressions are on), got {show(action, 120)}")
-            motors, given = action["motors"], action["expression"]
-            expression = _expression_id(agent, given)
-        else:
-            motors = action
-        return expression, self._motor_values(agent, act, motors)
+    def _checked_action(self, i: int, agent: str, action):
+        return checked_action(agent, self.agent_configs[i], self.actuation[i], action)
 
     def _check_action_keys(self, actions) -> None:
-        """A ValueError unless ``actions`` is a mapping with an action for every live agent
-        (actions for agents that ended are allowed and ignored)."""
-        if not isinstance(actions, Mapping):
-            raise ValueError(f"actions must be a dict agent -> action, got {type(actions).__name__}")
-        unknown = [a for a in actions if a not in self._index]
-        if unknown:
-            reject_old_names(unknown, self.possible_agents)
-            raise ValueError(f"actions for unknown agent(s) {unknown}; agents: {self.possible_agents}")
-        missing = [a for a in self.agents if a not in actions]
-        if missing:
-            raise ValueError(f"no action for live agent(s) {missing}; every live agent of "
-                             f"{self.agents} needs one")
+        check_action_keys(actions, self.agents, self._index, self.possible_agents)
 
-    @staticmethod
-    def _motor_values(agent: str, act, motors) -> np.ndarray:
-        """The motor commands as a float array of the right shape, finite; else a ValueError
-        naming the agent, the field, the value and what is allowed.
-
-        Accepted: anything numpy reads as an array of shape ``(n_controls,)`` of integers or
-        floats of any width (Python numbers too, ints beyond 64 bits included) whose values are
-        finite in float64. Refused: bools, complex numbers, strings, bytes, dates, masked
-        entries, tensors that need a gradient, NaN/inf and values beyond float64.
-
-        What learners send, a float32 or float64 numpy array of the right shape, is checked for
-        finite values only (and read, never copied: the caller's array is not written to); the
-        rest, and every message, takes the general path."""
-        if (type(motors) is np.ndarray and motors.dtype in _PLAIN_FLOATS
-                and motors.shape == act.control_low.shape and np.isfinite(motors).all()):
-            return motors
-        lo = f"{act.control_low.min():g}" if act.n_controls else "-1"
-        hi = f"{act.control_high.max():g}" if act.n_controls else "1"
-        allowed = (f"allowed: {act.n_controls} finite numbers in [{lo}, {hi}] (motors "
-                   f"{list(act.control_names)[:4]}{' ...' if act.n_controls > 4 else ''})")
-        field = f"{agent}: action field 'motors'"
-        u = number_array(motors, field, allowed[len("allowed: "):])
-        if u.shape != (act.n_controls,):
-            raise ValueError(f"{field} has shape {u.shape}; expected ({act.n_controls},) "
-                             f"for motors {act.control_names}")
-        if not np.isfinite(u).all():
-            bad = [act.control_names[k] for k in np.flatnonzero(~np.isfinite(u))]
-            raise ValueError(f"{field} has NaN/inf (or values beyond float64) for {bad}; "
-                             f"values must be finite, in [{lo}, {hi}]")
-        return u
+    @property
+    def sounds(self) -> np.ndarray:
+        """Every agent's sound at the last step, ``(n_agents, 2)`` float64, read-only: per agent
+        (index order) the kind id of :data:`~mimo_social.expressions.voice.SOUNDS` and its level
+        in dB SPL at 1 m (silence, and agents with voice off: 0, 0). A sound lasts the control
+        step it was given in; reset makes every agent silent."""
+        view = self._sounds.view()
+        view.flags.writeable = False
+        return view
 
     def _observe(self, i: int, reset: bool = False) -> dict:
         m, d = self.world.model, self.world.data
@@ -492,6 +429,8 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
         cost, weighted = act.costs(u)
         info = {"expression": EXPRESSIONS[self._expression[i]], "step": self.steps,
                 "time": float(self.world.data.time), "cost": cost, "weighted_cost": weighted}
+        if self.agent_configs[i].voice:
+            info["voice"] = SOUNDS[int(self._sounds[i, 0])]
         for sense in self.senses[i]:
             if hasattr(sense, "info"):
                 info.update(sense.info())
@@ -507,6 +446,8 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
         i = self._index[self._check_agent(agent)]
         spec = {"expression": tuple(EXPRESSIONS), "step": "number", "time": "number",
                 "cost": "number", "weighted_cost": "number", "instability": "flag"}
+        if self.agent_configs[i].voice:
+            spec["voice"] = tuple(SOUNDS)
         for sense in self.senses[i]:
             if hasattr(sense, "info_spec"):
                 spec.update(sense.info_spec())
