@@ -1,0 +1,1 @@
+"""Vocal turn-taking (being assembled: the scheduling, the measures and the infant rule)."""
