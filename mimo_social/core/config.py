@@ -18,6 +18,7 @@ import numpy as np
 
 from ..body.tables import AGE_RANGE, BODY_KINDS, HAND_VERSIONS, SCALE_RANGE, STRENGTH_RANGE
 from ..senses import SENSES
+from ..senses.audition import AuditionConfig
 from ..senses.delays import CHANNELS
 from ..senses.proprioception import ProprioceptionConfig
 from ..senses.touch import TouchConfig
@@ -29,6 +30,7 @@ from ..util.names import agent_names
 
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig", "AgentConfig",
+    "AuditionConfig",
     "PhysicsConfig", "ConfigError", "resolve_agents", "parse_physics", "ACTUATION_MODELS",
     "POSTURES", "BODIES", "AGE_RANGE", "DELAY_CHANNELS", "DELAY_LIMIT_MS", "env_settings",
     "RENDER_SIZE_RANGE", "MAX_STEPS_LIMIT",
@@ -70,6 +72,9 @@ class AgentConfig:
     vestibular: VestibularConfig | None = VestibularConfig()   # the head's gyro and accel
     touch: TouchConfig | None = None     # the full-body skin: a force vector per point
     vision: VisionConfig | None = None   # two eye cameras: RGB, optionally depth
+    # Two ears on the head hearing every agent with voice on: per source its kind, the level
+    # at each ear, ILD and ITD (docs/senses.md, "Hearing and voice")
+    audition: AuditionConfig | None = None
     expressions: bool = True   # the face is part of the action: 7 expressions
     # The voice is part of the action: "voice" (a kind of expressions.voice.SOUNDS: silence,
     # coo, babble, cry, laugh, speech) and "loudness" in [0, 1] (the kind's quietest to

@@ -173,8 +173,7 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
         self._sounds = np.zeros((len(self.possible_agents), 2))
         self._voice_adult = np.array([c.body == "adult" for c in self.agent_configs])
         if "audition" in self.systems:
-            self.systems["audition"].connect(self._sounds, [
-                k for k, c in enumerate(self.agent_configs) if c.voice])
+            self.systems["audition"].connect(self._sounds)
         self.controls = [np.zeros(act.n_controls) for act in self.actuation]
         n = len(self.possible_agents)
         self._sense_delays, self._motor_delays = [None] * n, [None] * n

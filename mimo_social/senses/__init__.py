@@ -6,7 +6,8 @@ sense and a shared system are). A new sense is its file (the sense, its config d
 :class:`mimo_social.core.config.AgentConfig`.
 """
 
-from . import proprioception, touch, vestibular, vision
+from . import audition, proprioception, touch, vestibular, vision
+from .audition import AuditionConfig
 from .base import Sense, SenseEntry, SharedSystem
 from .proprioception import Proprioception, ProprioceptionConfig
 from .touch import TouchConfig
@@ -19,7 +20,9 @@ SENSES: dict[str, SenseEntry] = {entry.name: entry for entry in (
     vestibular.SENSE,
     touch.SENSE,
     vision.SENSE,
+    audition.SENSE,
 )}
 
 __all__ = ["SENSES", "Sense", "SenseEntry", "SharedSystem", "Proprioception", "Vestibular",
-           "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig"]
+           "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig",
+           "AuditionConfig"]

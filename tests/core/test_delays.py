@@ -126,12 +126,16 @@ def test_developmental_delays_follow_the_table_and_shorten_with_age():
     assert six["vision"] == adult["vision"] and six["touch"] == adult["touch"]
     # in control steps of 10 ms: the newborn's eyes lag 26 steps, the 18-month-old's 10
     steps = delay_steps(AgentConfig(age_months=0, delays="developmental"), 0.01)
-    assert steps == {"proprioception": 4, "vestibular": 1, "touch": 4, "vision": 26, "motor": 2}
-    assert delay_steps(AgentConfig(body="adult", delays="developmental"), 0.01) == \
-        delay_steps(AgentConfig(delays="developmental"), 0.01)          # 18 months = adult rows
+    assert steps == {"proprioception": 4, "vestibular": 1, "touch": 4, "vision": 26,
+                     "audition": 30, "motor": 2}
+    adult = delay_steps(AgentConfig(body="adult", delays="developmental"), 0.01)
+    toddler = delay_steps(AgentConfig(delays="developmental"), 0.01)
+    # 18 months = adult rows, but for hearing: the auditory P1 matures into the teens
+    assert (adult.pop("audition"), toddler.pop("audition")) == (5, 25)
+    assert adult == toddler
     env = _env("developmental", touch=False)                            # the published infant
     assert env.delay_steps("infant_0") == {"proprioception": 2, "vestibular": 1, "touch": 2,
-                                           "vision": 10, "motor": 2}
+                                           "vision": 10, "audition": 25, "motor": 2}
 
 
 def test_milliseconds_round_to_whole_steps():

@@ -1,0 +1,162 @@
+"""Hearing: who hears what, where from (ILD, ITD), how loud (distance), delays, pickling."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+from mimo_social.core.config import ConfigError
+from mimo_social.envs import free_play_v0
+from mimo_social.expressions.voice import SOUNDS, level_db
+from mimo_social.senses.audition import FEATURES, SPEED_OF_SOUND, woodworth_itd
+
+K = len(SOUNDS)
+LEFT, RIGHT, ILD, ITD = (K + FEATURES.index(f) for f in FEATURES)
+CRY, SILENCE = SOUNDS.index("cry"), 0
+
+
+def pair(speaker_at, listener=None, speaker=None, **settings):
+    """infant_0 at the origin facing +x (the listener), infant_1 at ``speaker_at`` facing it."""
+    listener = dict(listener or {}, position=(0.0, 0.0), facing=(1.0, 0.0))
+    speaker = dict(speaker or {}, position=tuple(speaker_at), facing=(0.0, 0.0))
+    settings.setdefault("voice", True)
+    settings.setdefault("audition", True)
+    e = free_play_v0.parallel_env(n_agents=2, per_agent=[listener, speaker], max_steps=100,
+                                  **settings)
+    e.reset(seed=0)
+    return e
+
+
+def say(env, kinds=(SILENCE, CRY), loudness=1.0):
+    action = {}
+    for a, kind in zip(env.possible_agents, kinds):
+        space = env.action_space(a)
+        action[a] = {"motors": np.zeros(space["motors"].shape, np.float32), "expression": 0,
+                     "voice": kind, "loudness": [loudness]}
+    obs, *_ = env.step(action)
+    return obs
+
+
+def heard(env, at, kinds=(SILENCE, CRY)):
+    """The listener's (agent 0) row for the speaker (agent 1, source 1)."""
+    return say(env, kinds)[env.possible_agents[0]]["audition"][1]
+
+
+@pytest.mark.parametrize("where, sign", [((0.0, 1.5), 1), ((0.0, -1.5), -1), ((1.5, 0.0), 0)])
+def test_ild_and_itd_point_to_the_source(where, sign):
+    env = pair(where)
+    row = heard(env, where)
+    r = float(env.world.model.geom_size[env.world.agents[0].head_geom, 0])
+    assert row[CRY] == 1.0 and row[:K].sum() == 1.0
+    if sign == 0:    # in front: both ears alike
+        assert abs(row[ILD]) < 0.5 and abs(row[ITD]) < 0.02
+    else:            # at the side: about the full head shadow (8 dB) and Woodworth's 90 degrees
+        assert sign * row[ILD] == pytest.approx(8.0, abs=1.0)
+        full = 1000.0 * r / SPEED_OF_SOUND * (np.pi / 2 + 1)
+        assert sign * row[ITD] == pytest.approx(full, rel=0.1)
+        assert sign * (row[LEFT] - row[RIGHT]) > 6.0
+
+
+def test_woodworth_itd_of_an_adult_head_at_90_degrees():
+    assert 1000 * woodworth_itd(0.0875, np.pi / 2) == pytest.approx(0.655, abs=0.005)
+    assert woodworth_itd(0.0875, 0.0) == 0.0
+    assert woodworth_itd(0.0875, -0.3) == -woodworth_itd(0.0875, 0.3)
+
+
+def test_level_falls_by_6_db_per_doubling_of_distance():
+    levels = []
+    for d in (1.0, 2.0, 4.0):
+        levels.append(heard(pair((d, 0.0)), d)[LEFT])
+    assert levels[0] - levels[1] == pytest.approx(6.02, abs=0.5)
+    assert levels[1] - levels[2] == pytest.approx(6.02, abs=0.2)
+    # the level at 2 m: the cry's loudest less 20 log10(2), within the head's size
+    assert levels[1] == pytest.approx(level_db(CRY, 1.0) - 6.02, abs=0.6)
+
+
+def test_a_vocalisation_is_heard_by_the_partner_and_by_the_speaker():
+    env = pair((1.0, 0.0))
+    obs = say(env)
+    partner, own = obs["infant_0"]["audition"][1], obs["infant_1"]["audition"][1]
+    assert partner[CRY] == 1.0 and own[CRY] == 1.0
+    assert own[LEFT] > partner[LEFT] + 15.0        # the own mouth is ~10 cm from the ears
+    assert abs(own[ILD]) < 1e-3 and abs(own[ITD]) < 1e-4
+    assert obs["infant_0"]["audition"].shape == (2, K + 4)
+    assert env.observation_space("infant_0")["audition"].contains(obs["infant_0"]["audition"])
+
+
+def test_silence_is_heard_as_nothing():
+    env = pair((1.0, 0.0))
+    a = say(env, (SILENCE, SILENCE))["infant_0"]["audition"]
+    assert np.array_equal(a, np.tile(np.eye(1, K + 4, 0, dtype=np.float32), (2, 1)))
+
+
+def test_a_sound_below_the_threshold_is_not_heard():
+    env = pair((4.0, 0.0), audition={"threshold_db": 95.0})
+    row = heard(env, None)
+    assert row[SILENCE] == 1.0 and not row[K:].any()
+
+
+def test_a_caregiver_has_bigger_ears_and_hears_too():
+    env = pair((0.0, 1.5), listener={"body": "adult"})
+    row = heard(env, None)
+    r = float(env.world.model.geom_size[env.world.agents[0].head_geom, 0])
+    assert r > 0.08 and row[CRY] == 1.0
+    # the infant's mouth ~0.85 m below the adult's ears, 1.43 m to the left: about 60 degrees
+    lateral = np.arcsin(1.43 / np.hypot(1.43, 0.85))
+    assert row[ITD] == pytest.approx(1000.0 * woodworth_itd(r, lateral), rel=0.1)
+    assert row[ITD] > 1000.0 * woodworth_itd(0.0735, lateral)    # more than an infant's
+
+
+def test_delays_delay_hearing():
+    env = pair((1.0, 0.0), delays={"audition": 30.0})
+    assert env.delay_steps("infant_0")["audition"] == 3
+    rows = [heard(env, None, kinds=(SILENCE, CRY if t == 0 else SILENCE)) for t in range(5)]
+    assert [int(np.argmax(r[:K])) for r in rows] == [SILENCE, SILENCE, SILENCE, CRY, SILENCE]
+
+
+def test_pickled_env_continues_identically_and_seeds_repeat():
+    env = pair((1.0, 0.5))
+    say(env)
+    copy = pickle.loads(pickle.dumps(env))
+    for kinds in [(1, 3), (5, 0), (2, 4)]:
+        a, b = say(env, kinds), say(copy, kinds)
+        for agent in a:
+            assert np.array_equal(a[agent]["audition"], b[agent]["audition"])
+    other = pair((1.0, 0.5))
+    again = pair((1.0, 0.5))
+    assert np.array_equal(say(other)["infant_0"]["audition"],
+                          say(again)["infant_0"]["audition"])
+
+
+def test_bad_audition_config_is_refused():
+    with pytest.raises(ConfigError, match=r"audition: unknown setting\(s\) \['ears'\]"):
+        free_play_v0.parallel_env(n_agents=1, audition={"ears": 3})
+    with pytest.raises(ConfigError, match="threshold_db"):
+        free_play_v0.parallel_env(n_agents=1, audition={"threshold_db": "loud"})
+    with pytest.raises(ConfigError, match="head_shadow_db"):
+        free_play_v0.parallel_env(n_agents=1, audition={"head_shadow_db": -1.0})
+
+
+def test_without_voices_there_is_nothing_to_hear():
+    env = free_play_v0.parallel_env(n_agents=2, audition=True)
+    obs, _ = env.reset(seed=0)
+    assert "audition" not in obs["infant_0"]
+
+
+def test_hearing_and_voice_leave_the_world_unchanged():
+    """Voice and audition change no physics: the bodies move bit for bit as without them."""
+    plain = free_play_v0.parallel_env(n_agents=2, max_steps=100)
+    heard_env = free_play_v0.parallel_env(n_agents=2, max_steps=100, voice=True, audition=True)
+    o1, _ = plain.reset(seed=3)
+    o2, _ = heard_env.reset(seed=3)
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        motors = {a: rng.uniform(-1, 1, 44).astype(np.float32) for a in plain.agents}
+        o1, *_ = plain.step({a: {"motors": m, "expression": 1} for a, m in motors.items()})
+        o2, *_ = heard_env.step({a: {"motors": m, "expression": 1, "voice": 2, "loudness": [1]}
+                                 for a, m in motors.items()})
+    assert np.array_equal(plain.world.data.qpos, heard_env.world.data.qpos)
+    for a in o1:
+        assert set(o2[a]) - set(o1[a]) == {"audition"}
+        for key in o1[a]:
+            assert np.array_equal(o1[a][key], o2[a][key])
