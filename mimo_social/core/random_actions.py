@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["smooth_random_actions", "agent_seeds", "to_bounds", "random_action_block"]
+__all__ = ["smooth_random_actions", "agent_seeds", "to_bounds", "random_action_block",
+           "random_voice"]
 
 
 def smooth_random_actions(n_steps: int, n_motors: int, seed, dt: float = 0.01,
@@ -43,6 +44,20 @@ def smooth_random_actions(n_steps: int, n_motors: int, seed, dt: float = 0.01,
     return motors, expressions.astype(np.int64)
 
 
+def random_voice(n_steps: int, seed, dt: float = 0.01, n_sounds: int = 6,
+                 period: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """A sound kind that switches on average every ``period`` seconds and a loudness drawn
+    uniformly in [0, 1] at each switch: ``(kinds (n_steps,) int64, loudness (n_steps, 1)
+    float32)``; the same ``seed`` gives the same sounds."""
+    rng = np.random.default_rng(seed)
+    switch = rng.random(n_steps) < dt / period
+    switch[:1] = True
+    held = np.maximum.accumulate(np.where(switch, np.arange(n_steps), 0))
+    kinds = rng.integers(0, n_sounds, n_steps)[held]
+    loudness = rng.random(n_steps)[held].astype(np.float32)
+    return kinds.astype(np.int64), loudness.reshape(n_steps, 1)
+
+
 def agent_seeds(seed: int, n_agents: int):
     return np.random.SeedSequence(seed).spawn(n_agents)
 
@@ -66,16 +81,27 @@ def random_action_block(env, n_steps: int, seed: int, **options) -> list[dict]:
     per_agent = []
     for name, s in zip(env.possible_agents, agent_seeds(seed, len(env.possible_agents))):
         space = env.action_space(name)
-        with_expr = isinstance(space, spaces.Dict)
-        box = space["motors"] if with_expr else space
-        n_expr = space["expression"].n if with_expr else 7
+        keys = set(space.spaces) if isinstance(space, spaces.Dict) else set()
+        box = space["motors"] if keys else space
+        n_expr = space["expression"].n if "expression" in keys else 7
         motors, expr = smooth_random_actions(n_steps, box.shape[0], s, env.dt,
                                              n_expressions=n_expr, **options)
         motors = to_bounds(motors, box.low, box.high)
-        per_agent.append((name, with_expr, motors, expr))
+        # the voice from a stream of its own: the motors and faces stay those without a voice
+        voice = (random_voice(n_steps, s.spawn(1)[0], env.dt, space["voice"].n)
+                 if "voice" in keys else None)
+        per_agent.append((name, keys, motors, expr, voice))
     block = []
     for k in range(n_steps):
-        block.append({name: ({"motors": motors[k], "expression": int(expr[k])} if with_expr
-                             else motors[k])
-                      for name, with_expr, motors, expr in per_agent})
+        step = {}
+        for name, keys, motors, expr, voice in per_agent:
+            if not keys:
+                step[name] = motors[k]
+                continue
+            step[name] = action = {"motors": motors[k]}
+            if "expression" in keys:
+                action["expression"] = int(expr[k])
+            if voice is not None:
+                action["voice"], action["loudness"] = int(voice[0][k]), voice[1][k]
+        block.append(step)
     return block

@@ -11,7 +11,9 @@
       expression id;
     * with expressions: ``n`` motor values followed by 7 expression *logits* in ``[-1, 1]``; the
       expression played is ``argmax(logits)`` (ties go to the lowest id, so "neutral" wins when
-      all logits are equal, e.g. all clipped to the same bound).
+      all logits are equal, e.g. all clipped to the same bound);
+    * with the voice on: then 6 voice logits in ``[-1, 1]`` (``argmax``: the sound, ties to
+      "silence") and the loudness in ``[0, 1]`` (clipped to it).
 
     Motor values beyond the Box are clipped to it in float64 (a finite 1e39 is 1, not inf);
     an action that is not numbers (a string, a ragged list, a dict, None, bools), NaN/inf
@@ -241,6 +243,7 @@ class ActionDecoder:
 
     def __init__(self, space: spaces.Space):
         self.source = space
+        self.n_voices = self.voice_start = 0
         self.discrete = is_expression_only(space)
         if self.discrete:  # a face-only agent: its action is the expression id itself
             expression = space["expression"]
@@ -254,21 +257,25 @@ class ActionDecoder:
             self.n_expressions = 0
             self.motor_shape = space.shape
             low, high = space.low.ravel(), space.high.ravel()
-        elif (isinstance(space, spaces.Dict) and set(space.spaces) == {"motors", "expression"}
-              and isinstance(space["motors"], spaces.Box)
-              and isinstance(space["expression"], spaces.Discrete)):
-            motors, expression = space["motors"], space["expression"]
+        elif _is_dict_action(space):
+            motors = space["motors"]
+            expression = space.spaces.get("expression")
             self.n_motors = int(np.prod(motors.shape))
-            self.n_expressions = int(expression.n)
-            self.expression_start = int(expression.start)
+            self.n_expressions = int(expression.n) if expression is not None else 0
+            self.expression_start = int(expression.start) if expression is not None else 0
             self.motor_shape = motors.shape
-            low = np.concatenate([motors.low.ravel(),
-                                  np.full(self.n_expressions, LOGIT_LOW)])
-            high = np.concatenate([motors.high.ravel(),
-                                   np.full(self.n_expressions, LOGIT_HIGH)])
+            voice = space.spaces.get("voice")
+            self.n_voices = int(voice.n) if voice is not None else 0
+            self.voice_start = int(voice.start) if voice is not None else 0
+            n_logits = self.n_expressions + self.n_voices
+            low = np.concatenate([motors.low.ravel(), np.full(n_logits, LOGIT_LOW)]
+                                 + ([space["loudness"].low.ravel()] if voice is not None else []))
+            high = np.concatenate([motors.high.ravel(), np.full(n_logits, LOGIT_HIGH)]
+                                  + ([space["loudness"].high.ravel()] if voice is not None else []))
         else:
             raise TypeError(f"cannot flatten action space {space}; supported: a Box of motors, or "
-                            "Dict(motors=Box, expression=Discrete)")
+                            "Dict(motors=Box, expression=Discrete) (with voice=Discrete and "
+                            "loudness=Box((1,)) when the voice is on)")
         self.space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32),
                                 dtype=np.float32)
 
@@ -281,8 +288,9 @@ class ActionDecoder:
                 raise ValueError(f"{who}: action field 'expression' = {action!r:.120} not "
                                  f"allowed (a face-only agent); {allowed}")
             return {"motors": self._motors, "expression": np.int64(int(e.ravel()[0]))}
-        layout = (f"{self.n_motors} motors + {self.n_expressions} expression logits"
-                  if self.n_expressions else f"{self.n_motors} motors")
+        layout = f"{self.n_motors} motors" + (
+            f" + {self.n_expressions} expression logits" if self.n_expressions else "") + (
+            f" + {self.n_voices} voice logits + loudness" if self.n_voices else "")
         a = _numbers(action, who, "action", f"{self.space.shape[0]} numbers ({layout})")
         if a.shape != self.space.shape:
             raise ValueError(f"{who}: action field 'action' (the flat action) has shape "
@@ -293,25 +301,44 @@ class ActionDecoder:
         motors = np.clip(a[:self.n_motors], self.space.low[:self.n_motors],
                          self.space.high[:self.n_motors])
         motors = motors.astype(np.float32).reshape(self.motor_shape)
-        if not self.n_expressions:
+        if not self.n_expressions and not self.n_voices:
             return motors
-        logits = a[self.n_motors:]
-        if not np.isfinite(logits).all():
-            raise ValueError(f"{who}: action field 'expression logits' = {logits} not allowed; "
-                             f"allowed: {self.n_expressions} finite numbers (the largest picks "
-                             "the expression)")
-        return {"motors": motors,
-                "expression": np.int64(self.expression_start + int(np.argmax(logits)))}
+        out = {"motors": motors}
+        end = self.n_motors + self.n_expressions
+        if self.n_expressions:
+            logits = a[self.n_motors:end]
+            if not np.isfinite(logits).all():
+                raise ValueError(f"{who}: action field 'expression logits' = {logits} not "
+                                 f"allowed; allowed: {self.n_expressions} finite numbers (the "
+                                 "largest picks the expression)")
+            out["expression"] = np.int64(self.expression_start + int(np.argmax(logits)))
+        if self.n_voices:
+            logits, loud = a[end:end + self.n_voices], a[end + self.n_voices:]
+            if not np.isfinite(a[end:]).all():
+                raise ValueError(f"{who}: action field 'voice logits and loudness' = {a[end:]} "
+                                 f"not allowed; allowed: {self.n_voices + 1} finite numbers (the "
+                                 "largest logit picks the sound; the loudness is clipped to "
+                                 "[0, 1])")
+            out["voice"] = np.int64(self.voice_start + int(np.argmax(logits)))
+            out["loudness"] = np.clip(loud, 0.0, 1.0).astype(np.float32)
+        return out
 
     def encode(self, action):
         """The inverse: the flat action for ``action`` (logits HIGH/LOW; face-only: its id)."""
         if self.discrete:
             return int(action["expression"])
-        if not self.n_expressions:
+        if not self.n_expressions and not self.n_voices:
             return np.asarray(action, np.float32).ravel()
-        logits = np.full(self.n_expressions, LOGIT_LOW, np.float32)
-        logits[int(action["expression"]) - self.expression_start] = LOGIT_HIGH
-        return np.concatenate([np.asarray(action["motors"], np.float32).ravel(), logits])
+        parts = [np.asarray(action["motors"], np.float32).ravel()]
+        for n, start, key in ((self.n_expressions, self.expression_start, "expression"),
+                              (self.n_voices, self.voice_start, "voice")):
+            if n:
+                logits = np.full(n, LOGIT_LOW, np.float32)
+                logits[int(action[key]) - start] = LOGIT_HIGH
+                parts.append(logits)
+        if self.n_voices:
+            parts.append(np.asarray(action["loudness"], np.float32).ravel())
+        return np.concatenate(parts)
 
 
 def _numbers(action, who: str, field: str, allowed: str) -> np.ndarray:
@@ -522,6 +549,23 @@ class ExpressionActionWrapper(gym.ActionWrapper):
 
     def action(self, action):
         return {"motors": self._motors, "expression": int(action)}
+
+
+def _is_dict_action(space: spaces.Space) -> bool:
+    """A Dict action of this package: motors (a Box), an expression (Discrete) and / or a voice
+    (Discrete) with its loudness (a Box of one value)."""
+    if not isinstance(space, spaces.Dict) or not isinstance(space.spaces.get("motors"),
+                                                            spaces.Box):
+        return False
+    keys = set(space.spaces)
+    voice = {"voice", "loudness"} <= keys
+    if keys - {"motors", "expression", "voice", "loudness"} or keys == {"motors"} or (
+            ("voice" in keys or "loudness" in keys) and not voice):
+        return False
+    return (("expression" not in keys or isinstance(space["expression"], spaces.Discrete))
+            and (not voice or (isinstance(space["voice"], spaces.Discrete)
+                               and isinstance(space["loudness"], spaces.Box)
+                               and space["loudness"].shape == (1,))))
 
 
 def is_expression_only(space: spaces.Space) -> bool:

@@ -61,7 +61,9 @@ def _actions(env, n, seed=1):
             sp = env.action_space(a)
             motors = sp["motors"] if hasattr(sp, "spaces") else sp
             u = rng.uniform(motors.low, motors.high).astype(np.float32)
-            step[a] = {"motors": u, "expression": 0} if hasattr(sp, "spaces") else u
+            extra = {"expression": 0, "voice": 1, "loudness": [0.5]}   # those the space has
+            step[a] = ({"motors": u, **{k: v for k, v in extra.items() if k in sp.spaces}}
+                       if hasattr(sp, "spaces") else u)
         out.append(step)
     return out
 

@@ -112,3 +112,34 @@ def test_pickled_env_keeps_its_sounds(env):
     assert np.array_equal(copy.sounds, env.sounds)
     copy.step(act(copy, voice=(5, 0)))
     assert copy.sounds[0, 0] == 5.0 and env.sounds[0, 0] == 2.0
+
+
+def test_random_actions_and_the_flat_action_carry_the_voice(env):
+    from mimo_social.core.random_actions import random_action_block
+    from mimo_social.core.wrappers import ActionDecoder, FlattenParallel
+
+    block = random_action_block(env, 200, seed=1)
+    space = env.action_space("infant_0")
+    assert all(space.contains({k: np.asarray(v) if k != "voice" and k != "expression" else v
+                               for k, v in a["infant_0"].items()}) for a in block[:5])
+    assert len({a["infant_0"]["voice"] for a in block}) > 1
+    plain = free_play_v0.parallel_env(n_agents=2)
+    same = random_action_block(plain, 200, seed=1)      # the voice leaves motors and faces as
+    assert all(np.array_equal(a["infant_1"]["motors"], b["infant_1"]["motors"])
+               and a["infant_1"]["expression"] == b["infant_1"]["expression"]
+               for a, b in zip(block, same))
+    decode = ActionDecoder(space)
+    assert decode.space.shape == (44 + 7 + len(SOUNDS) + 1,)
+    flat = decode.encode(block[7]["infant_0"])
+    back = decode(flat)
+    assert (back["voice"], back["expression"]) == (block[7]["infant_0"]["voice"],
+                                                   block[7]["infant_0"]["expression"])
+    assert back["loudness"] == pytest.approx(block[7]["infant_0"]["loudness"])
+    flat[-1] = 3.0                                      # loudness clipped into [0, 1]
+    assert decode(flat)["loudness"][0] == 1.0
+    flat[-2] = np.nan
+    with pytest.raises(ValueError, match="infant_0: action field 'voice logits and loudness'"):
+        decode(flat, "infant_0")
+    wrapped = FlattenParallel(free_play_v0.parallel_env(n_agents=2, voice=True, audition=True))
+    wrapped.reset(seed=0)
+    wrapped.step({a: wrapped.action_space(a).sample() for a in wrapped.agents})

@@ -260,6 +260,10 @@ def agent_actions(env, agent):
     if not isinstance(env.action_space(agent), spaces.Dict):
         return motor_values(n)
     good_motors = views(numeric_arrays(st.just((n,))))
+    keys = set(env.action_space(agent).spaces)
+    if keys != {"motors", "expression"}:    # the voice on: the keys of the space
+        return st.one_of(voice_actions(keys, st.one_of(good_motors, motor_values(n))),
+                         st.builds(lambda m: {"motors": m}, good_motors), not_numbers())
     well_formed = st.builds(lambda m, e: {"motors": m, "expression": e},
                             st.one_of(good_motors, motor_values(n)),
                             st.one_of(st.integers(0, 6), expressions()))
@@ -276,11 +280,45 @@ def agent_actions(env, agent):
     return st.one_of(well_formed, well_formed, odd_dicts, motor_values(n), not_numbers())
 
 
+LOUDNESS = [0.0, 1.0, 0.5, np.float32(0.3), [0.2], np.array([0.7], np.float32), 1.5, -0.1,
+            math.nan, math.inf, "loud", [0.1, 0.2], None, True]
+
+
+def voice_actions(keys, motors):
+    """Dict actions of a space with the voice on: well-formed keys, any expression, voice id
+    and loudness (some bad)."""
+    def build(m, e, v, loud):
+        return {k: x for k, x in (("motors", m), ("expression", e), ("voice", v),
+                                  ("loudness", loud)) if k in keys}
+    return st.builds(build, motors, st.one_of(st.integers(0, 6), expressions()),
+                     st.one_of(st.integers(0, 5), expressions()), st.sampled_from(LOUDNESS))
+
+
+def loudness_rule(value):
+    """The loudness the env must accept, or None."""
+    if value is None or isinstance(value, (str, bool)):
+        return None
+    v = np.asarray(value, dtype=float)
+    return float(v.ravel()[0]) if v.size == 1 and np.isfinite(v).all() \
+        and 0.0 <= v.ravel()[0] <= 1.0 else None
+
+
 def action_rule(env, agent, action):
     """(expression or None, float64 motors) the env must accept, or (fields, None): the fields
     that are wrong (its error must name one of them)."""
     n = motor_box(env, agent).shape[0]
     space = env.action_space(agent)
+    if isinstance(space, spaces.Dict) and set(space.spaces) != {"motors", "expression"}:
+        keys = set(space.spaces)
+        if not isinstance(action, dict) or set(action) != keys:
+            return ("'loudness'",), None
+        e = expression_rule(action["expression"], 7) if "expression" in keys else None
+        m = motor_rule(action["motors"], n)
+        fields = (("'motors'",) if m is None else ()) + (
+            ("expression",) if "expression" in keys and e is None else ()) + (
+            ("voice",) if expression_rule(action["voice"], 6) is None else ()) + (
+            ("loudness",) if loudness_rule(action["loudness"]) is None else ())
+        return (e, m) if not fields else (fields, None)
     if isinstance(space, spaces.Dict):
         if not isinstance(action, (dict, OrderedDict, types.MappingProxyType)) \
                 or set(action) != {"motors", "expression"}:
