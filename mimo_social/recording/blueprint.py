@@ -31,11 +31,13 @@ __all__ = ["CEILING_PATH", "EYE_AZIMUTHS", "EYE_ELEVATIONS", "blueprint", "face_
 CEILING_PATH = entity("world", "scene", "playroom/ceiling")
 
 
-def _text_log(origin: str, name: str, entity_column: bool) -> rrb.TextLogView:
+def _text_log(origin: str, name: str, entity_column: bool,
+              contents: list[str] | None = None) -> rrb.TextLogView:
     """A text log showing the simulated time and the text (the log level, always "INFO", and
-    the step are hidden; the entity path only where it tells who)."""
+    the step are hidden; the entity path only where it tells who); ``contents``: the entity
+    paths shown (None: everything under ``origin``)."""
     return rrb.TextLogView(
-        origin=origin, name=name,
+        origin=origin, name=name, contents=contents,
         columns=rrb.TextLogColumns(
             timeline_columns=[TimelineColumn(SIM_TIME, visible=True),
                               TimelineColumn(STEP, visible=False)],
@@ -90,6 +92,9 @@ def blueprint(agents: list[str], face_paths: list[str],
     logs = [expressions,
             rrb.TimeSeriesView(origin="/", name="action norms",
                                contents=[entity("agents", a, "action_norm") for a in agents])]
+    # text views among the plots (the agents' sounds): a tab beside the expressions
+    logs[1:1] = [_text_log("/", p.title, True, list(p.paths)) for p in plots or ()
+                 if getattr(p, "text", False)]
     bottom = rrb.Tabs(*logs)
     if contacts:
         bottom = rrb.Horizontal(_text_log(CONTACTS_PATH, "contacts between agents", False),
@@ -111,7 +116,7 @@ def blueprint(agents: list[str], face_paths: list[str],
         from .plots import PlotView
         plots = [PlotView("reward", tuple(entity("agents", a, "reward") for a in agents))]
     series = [rrb.TimeSeriesView(origin="/", name=p.title, contents=list(p.paths))
-              for p in plots]
+              for p in plots if not getattr(p, "text", False)]
     if touch_agents:
         series.append(rrb.TimeSeriesView(
             origin="/", name="touch totals (N)",

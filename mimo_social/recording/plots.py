@@ -20,13 +20,17 @@ import rerun as rr
 
 from ..core.task import REWARD, Plot
 from ..core.world import CLOTHES_PALETTE
-from .columns import SCALARS, component_field, entity, optional_scalars
+from ..expressions.voice import SOUNDS
+from .columns import SCALARS, TEXTS, component_field, entity, optional_scalars, sparse_column
 
-__all__ = ["ONE_SERIES_RGB", "PlotLog", "PlotView", "agent_colors"]
+__all__ = ["ONE_SERIES_RGB", "PlotLog", "PlotView", "agent_colors", "SOUND_PLOT"]
 
 #: the colour of a series that is no agent's (one value for the pair, a shared reward): a mid
 #: grey, seen on the viewer's light and dark themes alike, and no infant's clothes
 ONE_SERIES_RGB = (105, 105, 110)
+#: the plot of the agents' sound levels (agents with a voice; a task's own plot of this name
+#: replaces it)
+SOUND_PLOT = "sound_level"
 _WIDTH = 2.0               # px: a line's width (the last agent's)
 _WIDEST = 3.0              # px more for the first agent's line
 
@@ -46,6 +50,7 @@ class PlotView:
 
     title: str
     paths: tuple[str, ...]
+    text: bool = False     # a text log (the sounds' events), not a time series
 
 
 class PlotLog:
@@ -64,6 +69,12 @@ class PlotLog:
         self.colors = agent_colors(env.world)
         n = len(self.agents)
         task_name = getattr(task, "name", type(task).__name__)
+        # the agents with a voice: their sound level as a series and their sounds as events
+        self.voiced = [i for i, c in enumerate(getattr(env, "agent_configs", ()))
+                       if getattr(c, "voice", False)]
+        if self.voiced and SOUND_PLOT not in {getattr(p, "name", None) for p in plots}:
+            plots.append(Plot(SOUND_PLOT, "dB SPL at 1 m", _sound_levels, True,
+                              tuple(self.voiced)))
         seen = set()
         self.plots: list[Plot] = []
         self.views: list[PlotView] = []
@@ -108,12 +119,19 @@ class PlotLog:
             self._calls.append((plot, index, first, first + len(paths)))
             self.views.append(PlotView(plot.title, tuple(paths)))
         self.values = np.full((max(1, int(capacity)), len(self.paths)), np.nan)
+        self.sound_paths = [entity("agents", self.agents[i], "voice") for i in self.voiced]
+        if self.voiced:
+            self.views.append(PlotView("sounds", tuple(self.sound_paths), text=True))
+        self._said = [None] * len(self.voiced)     # per voiced agent its last (kind, dB)
+        self.sound_texts = [[None] * len(self.values) for _ in self.voiced]
 
     # -- set-up ---------------------------------------------------------------------------------
     def fields(self) -> list[pa.Field]:
         """One Scalars field per logged series."""
         desc = rr.Scalars.descriptor_scalars()
-        return [component_field(f"{p}:scalars", p, desc, SCALARS) for p in self.paths]
+        text = rr.TextLog.descriptor_text()
+        return ([component_field(f"{p}:scalars", p, desc, SCALARS) for p in self.paths]
+                + [component_field(f"{p}:text", p, text, TEXTS) for p in self.sound_paths])
 
     def log_static(self, rec: rr.RecordingStream, touch_agents=()) -> None:
         """Every series' name and colour (the agent's clothes colour): the task's plots, and the
@@ -143,6 +161,8 @@ class PlotLog:
         """Row ``n``: every plot's value(s) now (``stepped``: after an env step; at reset the
         row holds no values)."""
         row = self.values[n]
+        if self.voiced:
+            self._note_sounds(n, stepped)
         if not stepped:
             row.fill(np.nan)
             return
@@ -158,10 +178,32 @@ class PlotLog:
                 raise RuntimeError(f"{getattr(env.task, 'name', 'task')} plot {plot.name!r}: "
                                    f"{plot.fn!r} failed: {type(e).__name__}: {e}") from e
 
+    def _note_sounds(self, n: int, stepped: bool) -> None:
+        """Row ``n``'s sound events: a line per voiced agent whose sound (kind or level)
+        changed since the last row ("cry 95 dB", "silence"); at reset every agent is silent."""
+        sounds = self.env.sounds
+        for k, i in enumerate(self.voiced):
+            now = (int(sounds[i, 0]), round(float(sounds[i, 1]), 1)) if stepped else (0, 0.0)
+            text = None
+            if now != self._said[k] and (stepped or self._said[k] is not None):
+                text = "silence" if now[0] == 0 else f"{SOUNDS[now[0]]} {now[1]:.0f} dB"
+            self._said[k] = now
+            self.sound_texts[k][n] = text
+
     def columns(self, n: int) -> list[pa.Array]:
-        """The Scalars columns of the first ``n`` rows (no data where NaN)."""
+        """The Scalars columns of the first ``n`` rows (no data where NaN), then the sound
+        events' TextLog columns (no data where no event)."""
         out = []
         for k in range(len(self.paths)):
             value = self.values[:n, k].copy()          # fresh memory: Arrow wraps it
             out.append(optional_scalars(value, ~np.isnan(value)))
+        for texts in self.sound_texts:
+            rows = texts[:n]
+            out.append(sparse_column(rows, pa.array([t for t in rows if t is not None],
+                                                    pa.utf8()), TEXTS))
         return out
+
+
+def _sound_levels(env) -> np.ndarray:
+    """Every agent's sound level this step (dB SPL at 1 m; silence: 0)."""
+    return env.sounds[:, 1]

@@ -77,7 +77,7 @@ class AuditionConfig:
     def __post_init__(self):
         put = partial(object.__setattr__, self)
         put("threshold_db", check_number("audition", "threshold_db", self.threshold_db,
-                                         -20.0, 120.0))
+                                         0.0, 120.0))
         put("head_shadow_db", check_number("audition", "head_shadow_db", self.head_shadow_db,
                                            0.0, 30.0))
 
@@ -105,6 +105,16 @@ class AuditionSystem:
         self.shadow = np.array([c.head_shadow_db for c in cfgs])
         self.width = len(SOUNDS) + len(FEATURES)
         self.features = np.zeros((n, len(self.sources), self.width), np.float32)
+        self._silence = np.zeros((len(self.listeners), len(self.sources), self.width),
+                                 np.float32)
+        self._silence[..., 0] = 1.0            # every source heard as silence
+        everyone = np.arange(n)
+        self._s_index = (slice(None) if np.array_equal(self.sources, everyone)
+                         else self.sources)
+        self._l_index = (slice(None) if np.array_equal(self.listeners, everyone)
+                         else self.listeners)
+        self._shade = 0.5 * self.shadow[self.listeners]
+        self._thr = self.threshold[self.listeners][None, :, None]
         self.sounds = np.zeros((n, 2))   # the env's (kind, dB at 1 m) per agent: connect()
         radius = max(MAX_HEAD_RADIUS, float(world.model.geom_size[self.heads, 0].max()))
         level = MAX_LEVEL_DB - 20.0 * np.log10(MIN_DISTANCE) + max(self.shadow) / 2.0
@@ -129,40 +139,44 @@ class AuditionSystem:
     def update(self, model, data) -> None:
         L, S = self.listeners, self.sources
         out = self.features
-        out[:] = 0.0
         if not len(L) or not len(S):
             return
+        sounds = self.sounds
+        kind = sounds[S, 0].astype(np.intp)
+        if not kind.any():                     # every voice silent: nothing to hear
+            out[L] = self._silence
+            return
         heads = self.heads
-        centre = data.geom_xpos[heads]                       # (n, 3)
-        frame = data.geom_xmat[heads].reshape(-1, 3, 3)      # columns: x, y, z axes in world
+        centre = data.geom_xpos[heads]                         # (n, 3)
+        frame = data.geom_xmat[heads]                          # (n, 9): row-major rotations
         radius = model.geom_size[heads, 0]
-        left_axis = frame[:, :, 1] * radius[:, None]
-        mouth = centre[S] + frame[S, :, 0] * radius[S, None]  # (s, 3)
-        ears = np.stack([centre[L] + left_axis[L], centre[L] - left_axis[L]], 1)   # (l, 2, 3)
-        dist = np.linalg.norm(mouth[:, None, None, :] - ears[None], axis=-1)      # (s, l, 2)
-        rel = mouth[:, None, :] - centre[None, L]                                  # (s, l, 3)
-        # the source's lateral sine: its direction's component along the listener's y axis
-        along = np.einsum("sli,li->sl", rel, frame[L, :, 1])
-        sin_lat = np.clip(along / np.maximum(np.linalg.norm(rel, axis=-1), 1e-9), -1.0, 1.0)
-        kind = self.sounds[S, 0].astype(np.intp)
-        level = (self.sounds[S, 1][:, None, None]
-                 - 20.0 * np.log10(np.maximum(dist, MIN_DISTANCE)))
-        shade = 0.5 * self.shadow[L][None, :] * sin_lat                            # (s, l)
+        Sx, Lx = self._s_index, self._l_index                  # slices when all agents
+        mouth = centre[Sx] + frame[Sx, 0::3] * radius[Sx, None]   # the x axis: the face
+        left = frame[Lx, 1::3]                                 # the y axis: to the left
+        rel = mouth[:, None, :] - centre[Lx][None]             # (s, l, 3)
+        r = radius[Lx]
+        along = (rel * left).sum(-1)                           # (s, l): along the ears' axis
+        rel2 = (rel * rel).sum(-1)
+        # squared mouth-to-ear distances: |rel -+ r y|^2, left and right
+        cross = 2.0 * r * along
+        d2 = np.stack([rel2 - cross, rel2 + cross], -1) + (r * r)[None, :, None]
+        level = sounds[S, 1][:, None, None] - 10.0 * np.log10(np.maximum(d2, MIN_DISTANCE ** 2))
+        sin_lat = np.clip(along / np.sqrt(np.maximum(rel2, 1e-18)), -1.0, 1.0)
+        shade = self._shade * sin_lat                          # (s, l)
         level[..., 0] += shade
         level[..., 1] -= shade
-        thr = self.threshold[L][None, :, None]
-        level = np.where(level > thr, level, 0.0)
-        heard = (kind[:, None] != 0) & (level > 0.0).any(-1)                      # (s, l)
+        level[level <= self._thr] = 0.0
+        heard = (level > 0.0).any(-1) & (kind != 0)[:, None]    # (s, l)
         level *= heard[..., None]
         k = len(SOUNDS)
-        rows = out[L].transpose(1, 0, 2)       # (s, l, width), a copy to fill
+        rows = np.zeros((len(S), len(L), self.width), np.float32)
         rows[..., 0] = ~heard
         si, li = np.nonzero(heard)
         rows[si, li, kind[si]] = 1.0
         rows[..., k:k + 2] = level
         rows[..., k + 2] = level[..., 0] - level[..., 1]
-        itd = 1000.0 * woodworth_itd(radius[L][None, :], np.arcsin(sin_lat))
-        rows[..., k + 3] = np.where(heard, itd, 0.0)
+        rows[..., k + 3] = heard * ((1000.0 / SPEED_OF_SOUND) * r
+                                    * (np.arcsin(sin_lat) + sin_lat))
         out[L] = rows.transpose(1, 0, 2)
 
 

@@ -13,6 +13,7 @@ from mimo_social.core.world import CLOTHES_PALETTE
 from mimo_social.envs import catalog, free_play_v0, high_five_v0
 from mimo_social.tasks.high_five import HighFiveController
 from mimo_social.recording import Recorder, read_batches
+from mimo_social.recording.plots import SOUND_PLOT
 from mimo_social.util.checks import ConfigError
 
 
@@ -81,6 +82,10 @@ def test_every_task_logs_its_plots(name, tmp_path):
     data = read_batches(tmp_path / f"{name}.rrd")
     n = len(env.possible_agents)
     views = plot_views(rec)
+    voiced = tuple(i for i, c in enumerate(env.agent_configs) if c.voice)
+    if voiced and SOUND_PLOT not in [p.name for p in plots]:     # the recorder's own plot
+        plots = [*plots, Plot(SOUND_PLOT, "dB SPL at 1 m", lambda e: e.sounds[:, 1], True,
+                              voiced)]
     assert list(views) == [p.title for p in plots]
     for p in plots:
         paths = views[p.title]
