@@ -28,13 +28,14 @@ import numpy as np
 
 from ..body.tables import load_body
 from ..core.config import PhysicsConfig
+from ..core.random_actions import random_action_block
 from ..envs import free_play_v0
 from ..senses import SENSES
 from .vision_cost import TURN_STEPS, bench_env
 
 __all__ = ["BUILD_BODIES", "ALL_DELAYS_MS", "MIN_TURNS", "build_times", "delay_cost",
            "acuity_cost", "measure", "format_results", "min_sim_seconds", "turns_of",
-           "compare_turns"]
+           "compare_turns", "hearing_cost", "format_hearing", "HEARING_CONFIGS"]
 
 #: turns of :data:`~mimo_social.bench.vision_cost.TURN_STEPS` steps a comparison needs
 MIN_TURNS = 10
@@ -135,6 +136,58 @@ def acuity_cost(sizes: Sequence[int] = (128, 256), sim_seconds: float = 10.0
             n_agents=2, age_months=0.0,
             vision={"width": size, "height": size, "acuity": acuity})
         for size in sizes for acuity in (None, "age")}, sim_seconds)
+
+
+#: the hearing comparison: two infants without vision, voices on, audition off vs on
+HEARING_CONFIGS = {"2 infants, voice": dict(n_agents=2, voice=True),
+                   "2 infants, voice + audition": dict(n_agents=2, voice=True, audition=True)}
+
+
+def hearing_cost(sim_seconds: float = 15.0, seed: int = 0) -> dict:
+    """ms per step of two infants with voices (no vision), audition off vs on, in turns of
+    :data:`TURN_STEPS` steps under the same smooth random actions and sounds
+    (:func:`~mimo_social.core.random_actions.random_action_block`, 100 untimed steps first);
+    ``audition_ms``: the audition's own ms per step (``env.timing``); ``comparison``: turns
+    and noise (:func:`compare_turns`)."""
+    runs = {}
+    for name, kw in HEARING_CONFIGS.items():
+        env = free_play_v0.parallel_env(max_steps=10 ** 9, **kw)
+        env.reset(seed=seed)
+        n = int(round(sim_seconds / env.dt))
+        runs[name] = {"env": env, "acts": random_action_block(env, 100 + n, seed), "n": n,
+                      "k": 0, "turns": []}
+    for r in runs.values():
+        for a in r["acts"][:100]:
+            r["env"].step(a)
+        r["env"].timing.update(dict.fromkeys(r["env"].timing, 0.0))
+    while any(r["k"] < r["n"] for r in runs.values()):
+        for r in runs.values():
+            stop = min(r["n"], r["k"] + TURN_STEPS)
+            env, acts = r["env"], r["acts"]
+            t0 = time.perf_counter()
+            for k in range(100 + r["k"], 100 + stop):
+                env.step(acts[k])
+            r["turns"].append(time.perf_counter() - t0)
+            r["k"] = stop
+    base, heard = runs.values()
+    out = {name: 1e3 * sum(r["turns"]) / r["n"] for name, r in runs.items()}
+    return {"ms_per_step": out,
+            "audition_ms": 1e3 * heard["env"].timing["audition"] / heard["n"],
+            "comparison": {"base": next(iter(runs)),
+                           **compare_turns(heard["turns"], base["turns"])}}
+
+
+def format_hearing(h: dict) -> str:
+    """A Markdown table of :func:`hearing_cost`."""
+    (base, b), (name, ms) = h["ms_per_step"].items()
+    c = h["comparison"]
+    return "\n".join([
+        "Hearing (two infants, no vision, voices on), ms per step (+-: two standard errors of "
+        "the per-turn ratio):", "", "| env | ms/step |", "| --- | --- |", f"| {base} | {b:.3f} |",
+        f"| {name} | {ms:.3f} ({100 * (ms / b - 1):+.1f} % +- {c['noise_pct']:.1f} % vs {base}, "
+        f"{c['turns']} turns) |", "",
+        f"The audition's own time (env.timing): {h['audition_ms']:.4f} ms per step, "
+        f"{100 * h['audition_ms'] / b:.1f} % of the step without it."])
 
 
 def _delay_base(name: str) -> str:

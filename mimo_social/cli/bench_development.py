@@ -3,6 +3,7 @@ of sensorimotor delays and of the acuity filter (:mod:`mimo_social.bench.develop
 
     mimo-social bench development                      # the figures of BENCHMARKS.md
     mimo-social bench development --sim-seconds 1 --repeats 1 --json out.json
+    mimo-social bench development --hearing            # audition's cost (docs/senses.md)
 
 Below ``--sim-seconds`` 15 (:func:`mimo_social.bench.development.min_sim_seconds`) a comparison
 has fewer than 10 turns of 100 steps to go on: a warning says so before the run and those
@@ -39,11 +40,20 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
     parser.add_argument("--repeats", type=positive_int, default=3,
                         help="builds per body; the median is shown (default 3)")
     parser.add_argument("--json", default=None, type=output_file, help="write all results here")
+    parser.add_argument("--hearing", action="store_true",
+                        help="only the cost of hearing: two infants with voices, no vision, "
+                             "audition off vs on, in turns of 100 steps")
     parser.set_defaults(func=run)
     return parser
 
 
 def run(args: argparse.Namespace) -> int:
+    if getattr(args, "hearing", False):
+        results = development.hearing_cost(args.sim_seconds)
+        print(development.format_hearing(results))
+        if args.json:
+            write_file(args.json, json.dumps(results, indent=1))
+        return 0
     least = development.min_sim_seconds()
     if args.sim_seconds < least:
         turns = development.turns_of(args.sim_seconds * development.ACUITY_SHARE)
