@@ -17,10 +17,10 @@ from types import ModuleType
 from ..core.gym_adapter import SingleAgentEnv
 from ..tasks import (catch, contingency, free_play, handover, high_five, imitation,
                      joint_attention, mirror, reach, rollover, selfbody, social_touch, standup,
-                     still_face)
+                     still_face, turn_taking)
 from . import (catch_v0, contingency_v0, free_play_v0, handover_v0, high_five_v0, imitation_v0,
                joint_attention_v0, mirror_v0, reach_v0, rollover_v0, selfbody_v0, social_touch_v0,
-               standup_v0, still_face_v0)
+               standup_v0, still_face_v0, turn_taking_v0)
 
 __all__ = ["EnvEntry", "CATALOG", "KINDS", "entry", "names", "make_gym", "register_envs"]
 
@@ -161,6 +161,10 @@ CATALOG: tuple[EnvEntry, ...] = (
              "reproduce the action a caregiver demonstrated, seen through the eyes",
              controller=imitation.ImitationController,
              measures=imitation.measures),
+    EnvEntry("turn_taking", turn_taking_v0, "mimo_social/TurnTaking-v0", "social",
+             "vocal turn-taking: a caregiver who answers the infant's sounds, or speaks regardless",
+             controller=turn_taking.TurnTakingInfantController,
+             measures=turn_taking.measures),
 )
 
 _BY_NAME = {e.name: e for e in CATALOG}

@@ -30,6 +30,7 @@ def zero_actions(env, agents=None):
         sp = env.action_space(a)
         if hasattr(sp, "spaces"):
             out[a] = {"motors": np.zeros(sp["motors"].shape, np.float32), "expression": 0}
+            _voice(out[a], sp, 0)
         else:
             out[a] = np.zeros(sp.shape, np.float32)
     return out
@@ -42,7 +43,18 @@ def random_actions(env, rng):
         box = sp["motors"] if hasattr(sp, "spaces") else sp
         u = rng.uniform(box.low, box.high).astype(np.float32)
         out[a] = {"motors": u, "expression": int(rng.integers(7))} if hasattr(sp, "spaces") else u
+        if hasattr(sp, "spaces") and "voice" in sp.spaces:
+            _voice(out[a], sp, int(rng.integers(sp["voice"].n)))
     return out
+
+
+def _voice(action, space, kind):
+    """An action of a Dict space with the voice (issue 33): its keys as the space's (the
+    expression only where the space has it), ``kind`` at loudness 0.5."""
+    if "voice" in space.spaces:
+        action.update(voice=kind, loudness=np.full(1, 0.5, np.float32))
+    if "expression" not in space.spaces:
+        action.pop("expression", None)
 
 
 def saved_model(model) -> bytes:

@@ -28,7 +28,9 @@ STANDARD_DISTANCE = {"high_five": 0.35, "mirror": 0.3, "joint_attention": 0.7,
                      "still_face": 0.696,
                      # the paradigms of issue 19 with an infant partner: face to face like
                      # mirror (contingency), the demonstrator seen whole (imitation)
-                     "contingency": 0.3, "imitation": 1.4}
+                     "contingency": 0.3, "imitation": 1.4,
+                     # vocal turn-taking (issue 33): face to face as contingency
+                     "turn_taking": 0.3}
 
 
 def run_episodes(task, seeds, per_agent=ADULT, **kwargs):

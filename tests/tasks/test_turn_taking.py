@@ -134,3 +134,136 @@ def test_bad_settings_are_refused_naming_the_field():
         VocalInfant(duration_s=(0.8, 0.3))
     with pytest.raises(RuntimeError, match="before reset"):
         VocalInfant().step(False)
+
+
+# -- the env ----------------------------------------------------------------------------------
+from mimo_social.envs import turn_taking_v0  # noqa: E402
+from mimo_social.partners.base import zero_action  # noqa: E402
+from mimo_social.tasks.turn_taking import TurnTakingInfantController  # noqa: E402
+from mimo_social.tasks.turn_taking.measures import effects  # noqa: E402
+
+STEPS = 1500
+
+
+class Silent:
+    """The zero action: silence, head and eyes at rest."""
+
+    def reset(self, env, agent, rng):
+        self.action = zero_action(env.action_space(agent))
+
+    def act(self, env, agent, obs):
+        return self.action
+
+
+def _episode(env, learner, condition, seed=0):
+    """Per step the infant's and the caregiver's sound kinds, and the last info."""
+    env.unwrapped.task.set_condition(condition)
+    env.reset(seed=seed)
+    learner.reset(env.unwrapped, "infant_0", np.random.default_rng(seed))
+    infant, care = [], []
+    for _ in range(STEPS):
+        *_, infos = env.step({"infant_0": learner.act(env.unwrapped, "infant_0", None)})
+        info = infos["infant_0"]
+        infant.append(int(info["infant_sound"]))
+        care.append(int(info["caregiver_sound"]))
+    return np.array(infant), np.array(care), info
+
+
+def test_the_scripted_env_answers_within_the_latency_and_measures_what_happened():
+    env = turn_taking_v0.scripted_env(max_steps=STEPS)
+    assert env.action_space("infant_0")["voice"].n == 6
+    infant, care, info = _episode(env, TurnTakingInfantController(), "contingent")
+    events = env.partners["caregiver_0"].events
+    answered = [e for e in events if e["answered"]]
+    assert answered and info["answers"] >= 1 and info["condition"] == 0
+    # each answer starts its latency after the offset, plus the step in which it is heard
+    onsets = np.flatnonzero(np.diff(np.r_[0, care != 0].astype(int)) == 1)
+    offsets = np.flatnonzero(np.diff(np.r_[0, infant != 0].astype(int)) == -1)
+    for e in answered:
+        offset = offsets[offsets < e["step"]][-1]
+        assert e["step"] == offset + 1
+        assert offset + 1 + e["latency_steps"] in onsets
+    # the infos are the measures of the logged sounds
+    got, _ = measure(infant, care, env.unwrapped.dt, 1.0)
+    for k, v in got.items():
+        assert info[k] == pytest.approx(v), k
+    assert set(care[care != 0]) == {5}      # speech
+
+
+def test_noncontingent_and_replay_do_not_depend_on_the_infant():
+    env = turn_taking_v0.scripted_env(max_steps=STEPS)
+    # before any contingent episode: a Poisson timer, the same whatever the infant does
+    a = _episode(env, TurnTakingInfantController(), "noncontingent", seed=3)[1]
+    b = _episode(env, Silent(), "noncontingent", seed=3)[1]
+    assert np.array_equal(a, b) and a.any()
+    # the replay of a contingent session is that session's caregiver, for any infant
+    live = _episode(env, TurnTakingInfantController(), "contingent", seed=5)[1]
+    recorded = env.partners["caregiver_0"].recorded
+    for learner in (Silent(), TurnTakingInfantController()):
+        replay, info = _episode(env, learner, "replay", seed=7)[1:]
+        assert np.array_equal(replay, live) and info["condition"] == 2
+    # yoked: as many utterances as the contingent session, the same for any infant
+    c = _episode(env, Silent(), "noncontingent", seed=8)[1]
+    d = _episode(env, TurnTakingInfantController(), "noncontingent", seed=8)[1]
+    assert np.array_equal(c, d)
+    count = lambda s: int(np.sum(np.diff(np.r_[0, s != 0].astype(int)) == 1))  # noqa: E731
+    assert count(c) == count(live) == len(recorded)
+    # onsets given to a new env
+    other = turn_taking_v0.scripted_env(max_steps=STEPS, onsets=recorded,
+                                        task_options={"condition": "replay"})
+    assert np.array_equal(_episode(other, Silent(), "replay")[1], live)
+
+
+def test_a_pickled_copy_continues_exactly_and_seeds_repeat():
+    import copy
+    import pickle
+    env = turn_taking_v0.scripted_env(max_steps=STEPS)
+    first = _episode(env, TurnTakingInfantController(), "contingent", seed=2)
+    again = _episode(env, TurnTakingInfantController(), "contingent", seed=2)
+    assert np.array_equal(first[0], again[0]) and np.array_equal(first[1], again[1])
+    env.reset(seed=4)
+    learner = TurnTakingInfantController()
+    learner.reset(env.unwrapped, "infant_0", np.random.default_rng(4))
+    for _ in range(300):
+        env.step({"infant_0": learner.act(env.unwrapped, "infant_0", None)})
+    twin, twin_learner = pickle.loads(pickle.dumps(env)), copy.deepcopy(learner)
+    outs = []
+    for e, p in ((env, learner), (twin, twin_learner)):
+        outs.append([e.step({"infant_0": p.act(e.unwrapped, "infant_0", None)})[4]["infant_0"]
+                     for _ in range(400)])
+    assert outs[0] == outs[1]
+
+
+@pytest.mark.parametrize("options, words", [
+    ({"condition": "live"}, ["condition='live'", "contingent", "noncontingent", "replay"]),
+    ({"latency_mean_s": -1}, ["latency_mean_s=-1", "allowed"]),
+    ({"response_probability": 2}, ["response_probability=2", "from 0 to 1"]),
+    ({"window_s": 0}, ["window_s=0", "allowed"]),
+    ({"success_answers": 0.5}, ["success_answers=0.5", "integer"]),
+])
+def test_bad_options_are_refused_naming_field_value_and_allowed(options, words):
+    with pytest.raises(ConfigError) as e:
+        turn_taking_v0.scripted_env(task_options=options)
+    for w in words:
+        assert w in str(e.value)
+
+
+def test_conditions_that_need_the_script_or_a_recording_are_refused():
+    with pytest.raises(ConfigError, match="needs the scripted caregiver"):
+        turn_taking_v0.parallel_env(task_options={"condition": "noncontingent"})
+    with pytest.raises(ConfigError, match="condition='replay' needs a recorded caregiver"):
+        turn_taking_v0.scripted_env(task_options={"condition": "replay"})
+    with pytest.raises(ConfigError, match="onsets"):
+        turn_taking_v0.scripted_env(onsets="abc")
+
+
+@pytest.mark.slow
+def test_the_scripted_infant_vocalises_more_with_the_contingent_caregiver():
+    res = effects(TurnTakingInfantController(), episodes=4, seed=0)
+    for other in ("noncontingent", "replay"):
+        d = res[f"contingent_minus_{other}"]
+        assert d["infant_rate_per_min"][0] > 0 and d["speech_like_fraction"][0] > 0.1
+        assert d["answered_fraction"][0] > 0.2
+    # zero and random learners do not learn from answers: the silent one is never answered
+    silent = effects(Silent(), episodes=1, seed=0)["summary"]
+    assert all(silent[c]["infant_rate_per_min"][0] == 0 for c in silent)
