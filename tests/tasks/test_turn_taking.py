@@ -267,3 +267,20 @@ def test_the_scripted_infant_vocalises_more_with_the_contingent_caregiver():
     # zero and random learners do not learn from answers: the silent one is never answered
     silent = effects(Silent(), episodes=1, seed=0)["summary"]
     assert all(silent[c]["infant_rate_per_min"][0] == 0 for c in silent)
+
+
+def test_the_caregiver_reaches_the_learner_only_through_its_ears():
+    env = turn_taking_v0.scripted_env(max_steps=STEPS)
+    assert set(env.observation_space("infant_0").spaces) == {"proprioception", "audition"}
+    env.reset(seed=1)
+    learner = TurnTakingInfantController()
+    learner.reset(env.unwrapped, "infant_0", np.random.default_rng(1))
+    heard = 0
+    for _ in range(STEPS):
+        obs, _, _, _, infos = env.step({"infant_0": learner.act(env.unwrapped, "infant_0",
+                                                                None)})
+        care = int(infos["infant_0"]["caregiver_sound"])
+        row = obs["infant_0"]["audition"][1]           # the caregiver's row (sources in order)
+        assert row[care] == 1.0 and row[:6].sum() == 1.0
+        heard += care == 5
+    assert heard > 0
