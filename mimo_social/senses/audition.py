@@ -113,8 +113,8 @@ class AuditionSystem:
                          else self.sources)
         self._l_index = (slice(None) if np.array_equal(self.listeners, everyone)
                          else self.listeners)
-        self._shade = 0.5 * self.shadow[self.listeners]
-        self._thr = self.threshold[self.listeners][None, :, None]
+        self._shade = 0.5 * self.shadow[self.listeners][:, None]        # (l, 1)
+        self._thr = self.threshold[self.listeners][:, None, None]
         self.sounds = np.zeros((n, 2))   # the env's (kind, dB at 1 m) per agent: connect()
         radius = max(MAX_HEAD_RADIUS, float(world.model.geom_size[self.heads, 0].max()))
         level = MAX_LEVEL_DB - 20.0 * np.log10(MIN_DISTANCE) + max(self.shadow) / 2.0
@@ -146,38 +146,45 @@ class AuditionSystem:
         if not kind.any():                     # every voice silent: nothing to hear
             out[L] = self._silence
             return
-        heads = self.heads
+        heads, Sx, Lx = self.heads, self._s_index, self._l_index   # slices when all agents
         centre = data.geom_xpos[heads]                         # (n, 3)
         frame = data.geom_xmat[heads]                          # (n, 9): row-major rotations
-        radius = model.geom_size[heads, 0]
-        Sx, Lx = self._s_index, self._l_index                  # slices when all agents
-        mouth = centre[Sx] + frame[Sx, 0::3] * radius[Sx, None]   # the x axis: the face
-        left = frame[Lx, 1::3]                                 # the y axis: to the left
-        rel = mouth[:, None, :] - centre[Lx][None]             # (s, l, 3)
-        r = radius[Lx]
-        along = (rel * left).sum(-1)                           # (s, l): along the ears' axis
+        r = model.geom_size[heads, 0:1]                        # (n, 1)
+        mouth = centre[Sx] + frame[Sx, 0::3] * r[Sx]           # the x axis: the face
+        rel = mouth[None] - centre[Lx][:, None]                # (l, s, 3) listener to mouth
+        along = (rel * frame[Lx, None, 1::3]).sum(-1)          # (l, s): along the y axis
         rel2 = (rel * rel).sum(-1)
-        # squared mouth-to-ear distances: |rel -+ r y|^2, left and right
-        cross = 2.0 * r * along
-        d2 = np.stack([rel2 - cross, rel2 + cross], -1) + (r * r)[None, :, None]
-        level = sounds[S, 1][:, None, None] - 10.0 * np.log10(np.maximum(d2, MIN_DISTANCE ** 2))
+        rl = r[Lx]                                             # (l, 1)
+        # squared mouth-to-ear distances |rel -+ r y|^2 (left, right), then levels in place
+        cross = 2.0 * rl * along
+        base = rel2 + rl * rl
+        level = np.empty(rel.shape[:2] + (2,))
+        np.subtract(base, cross, out=level[..., 0])
+        np.add(base, cross, out=level[..., 1])
+        np.maximum(level, MIN_DISTANCE ** 2, out=level)
+        np.log10(level, out=level)
+        level *= -10.0
+        level += sounds[S, 1][None, :, None]
         sin_lat = np.clip(along / np.sqrt(np.maximum(rel2, 1e-18)), -1.0, 1.0)
-        shade = self._shade * sin_lat                          # (s, l)
+        shade = self._shade * sin_lat                          # (l, s)
         level[..., 0] += shade
         level[..., 1] -= shade
         level[level <= self._thr] = 0.0
-        heard = (level > 0.0).any(-1) & (kind != 0)[:, None]    # (s, l)
+        heard = level.max(-1) > 0.0
+        heard &= kind != 0
         level *= heard[..., None]
         k = len(SOUNDS)
-        rows = np.zeros((len(S), len(L), self.width), np.float32)
+        rows = out if isinstance(Lx, slice) else np.empty((len(L),) + out.shape[1:], out.dtype)
+        rows.fill(0.0)
         rows[..., 0] = ~heard
-        si, li = np.nonzero(heard)
-        rows[si, li, kind[si]] = 1.0
+        li, si = np.nonzero(heard)
+        rows[li, si, kind[si]] = 1.0
         rows[..., k:k + 2] = level
         rows[..., k + 2] = level[..., 0] - level[..., 1]
-        rows[..., k + 3] = heard * ((1000.0 / SPEED_OF_SOUND) * r
+        rows[..., k + 3] = heard * ((1000.0 / SPEED_OF_SOUND) * rl
                                     * (np.arcsin(sin_lat) + sin_lat))
-        out[L] = rows.transpose(1, 0, 2)
+        if rows is not out:
+            out[L] = rows
 
 
 class Audition:

@@ -160,3 +160,19 @@ def test_hearing_and_voice_leave_the_world_unchanged():
         assert set(o2[a]) - set(o1[a]) == {"audition"}
         for key in o1[a]:
             assert np.array_equal(o1[a][key], o2[a][key])
+
+
+def test_some_listeners_and_some_voices():
+    """Ears on one agent only, a voice on the other only: one source row, heard by agent 0."""
+    env = pair((0.0, 1.5), listener={"voice": False, "audition": True},
+               speaker={"voice": True, "audition": False})
+    listener, speaker = env.possible_agents
+    assert "audition" not in env.observation_space(speaker).spaces
+    assert env.observation_space(listener)["audition"].shape == (1, K + 4)
+    motors = {a: np.zeros(env.action_space(a)["motors"].shape, np.float32)
+              for a in env.possible_agents}
+    obs, *_ = env.step({listener: {"motors": motors[listener], "expression": 0},
+                        speaker: {"motors": motors[speaker], "expression": 0, "voice": CRY,
+                                  "loudness": [1.0]}})
+    row = obs[listener]["audition"][0]
+    assert row[CRY] == 1.0 and row[ILD] > 6.0 and row[ITD] > 0.4
