@@ -63,6 +63,7 @@ __all__ = ["AuditionConfig", "AuditionSystem", "Audition", "SENSE", "FEATURES",
 #: the columns of a source's row after the kind one-hot
 FEATURES = ("level_left", "level_right", "ild", "itd")
 SPEED_OF_SOUND = 343.0     # m/s, air at 20 degrees C
+_LR = np.array([-1.0, 1.0])   # per ear (left, right): the sign of 2 r y in the squared distance
 MIN_DISTANCE = 0.05        # m: mouth-to-ear distances are held at this or more (our choice)
 MAX_HEAD_RADIUS = 0.15     # m: larger than any head here (adult ~0.09): the ITD bound
 
@@ -113,8 +114,10 @@ class AuditionSystem:
                          else self.sources)
         self._l_index = (slice(None) if np.array_equal(self.listeners, everyone)
                          else self.listeners)
-        self._shade = 0.5 * self.shadow[self.listeners][:, None]        # (l, 1)
-        self._thr = self.threshold[self.listeners][:, None, None]
+        # per agent (n, ...): the head-shadow term per ear (+ left, - right), the threshold
+        self._shade = (0.5 * self.shadow)[:, None, None] * _LR[::-1]
+        self._thr = self.threshold[:, None, None][self._l_index]
+        self._one_hot = np.eye(len(SOUNDS), dtype=np.float32)
         self.sounds = np.zeros((n, 2))   # the env's (kind, dB at 1 m) per agent: connect()
         radius = max(MAX_HEAD_RADIUS, float(world.model.geom_size[self.heads, 0].max()))
         level = MAX_LEVEL_DB - 20.0 * np.log10(MIN_DISTANCE) + max(self.shadow) / 2.0
@@ -127,6 +130,7 @@ class AuditionSystem:
         shape = (len(self.sources), self.width)
         self.space = spaces.Box(np.broadcast_to(low, shape).copy(),
                                 np.broadcast_to(high, shape).copy(), dtype=np.float32)
+        self.reset(world.model, world.data)
 
     def connect(self, sounds: np.ndarray) -> None:
         """Hear the env's sounds: ``(n_agents, 2)`` kind id and level in dB SPL at 1 m, the
@@ -134,6 +138,12 @@ class AuditionSystem:
         self.sounds = sounds
 
     def reset(self, model, data) -> None:
+        """The head radii (they change only with an age change, at a reset), then hear."""
+        r = model.geom_size[self.heads, 0]
+        self._radius = r[:, None]                              # (n, 1)
+        self._r2 = (r * r)[:, None]
+        self._two_r = 2.0 * self._radius
+        self._itd_scale = (1000.0 / SPEED_OF_SOUND) * self._radius   # ms per (theta + sin)
         self.update(model, data)
 
     def update(self, model, data) -> None:
@@ -148,41 +158,31 @@ class AuditionSystem:
             return
         heads, Sx, Lx = self.heads, self._s_index, self._l_index   # slices when all agents
         centre = data.geom_xpos[heads]                         # (n, 3)
-        frame = data.geom_xmat[heads]                          # (n, 9): row-major rotations
-        r = model.geom_size[heads, 0:1]                        # (n, 1)
-        mouth = centre[Sx] + frame[Sx, 0::3] * r[Sx]           # the x axis: the face
-        rel = mouth[None] - centre[Lx][:, None]                # (l, s, 3) listener to mouth
-        along = (rel * frame[Lx, None, 1::3]).sum(-1)          # (l, s): along the y axis
-        rel2 = (rel * rel).sum(-1)
-        rl = r[Lx]                                             # (l, 1)
-        # squared mouth-to-ear distances |rel -+ r y|^2 (left, right), then levels in place
-        cross = 2.0 * rl * along
-        base = rel2 + rl * rl
-        level = np.empty(rel.shape[:2] + (2,))
-        np.subtract(base, cross, out=level[..., 0])
-        np.add(base, cross, out=level[..., 1])
-        np.maximum(level, MIN_DISTANCE ** 2, out=level)
-        np.log10(level, out=level)
+        frame = data.geom_xmat[heads].reshape(-1, 3, 3)        # columns: x, y, z axes
+        mouth = centre[Sx] + frame[Sx, :, 0] * self._radius[Sx]   # on the face (+x)
+        # each mouth in each listener's head frame, (l, s, 3); y: towards the left ear
+        local = np.matmul(mouth[None] - centre[Lx][:, None], frame[Lx])
+        y = local[..., 1]
+        dist2 = (local * local).sum(-1)
+        # squared distances to the ears at (0, +-r, 0): dist2 + r^2 -+ 2 r y
+        d2 = (dist2 + self._r2[Lx])[..., None] + (y * self._two_r[Lx])[..., None] * _LR
+        sin_lat = y / np.sqrt(dist2 + 1e-18)
+        np.minimum(np.maximum(sin_lat, -1.0, out=sin_lat), 1.0, out=sin_lat)
+        feat = np.empty(d2.shape[:2] + (len(FEATURES),))
+        level = feat[..., :2]
+        np.log10(np.maximum(d2, MIN_DISTANCE ** 2), out=level)
         level *= -10.0
-        level += sounds[S, 1][None, :, None]
-        sin_lat = np.clip(along / np.sqrt(np.maximum(rel2, 1e-18)), -1.0, 1.0)
-        shade = self._shade * sin_lat                          # (l, s)
-        level[..., 0] += shade
-        level[..., 1] -= shade
+        level += sounds[S, 1][None, :, None] + sin_lat[..., None] * self._shade[Lx]
         level[level <= self._thr] = 0.0
-        heard = level.max(-1) > 0.0
-        heard &= kind != 0
+        heard = (level.max(-1) > 0.0) & (kind != 0)           # (l, s)
         level *= heard[..., None]
+        np.subtract(level[..., 0], level[..., 1], out=feat[..., 2])
+        np.multiply(np.arcsin(sin_lat) + sin_lat, self._itd_scale[Lx] * heard,
+                    out=feat[..., 3])
         k = len(SOUNDS)
         rows = out if isinstance(Lx, slice) else np.empty((len(L),) + out.shape[1:], out.dtype)
-        rows.fill(0.0)
-        rows[..., 0] = ~heard
-        li, si = np.nonzero(heard)
-        rows[li, si, kind[si]] = 1.0
-        rows[..., k:k + 2] = level
-        rows[..., k + 2] = level[..., 0] - level[..., 1]
-        rows[..., k + 3] = heard * ((1000.0 / SPEED_OF_SOUND) * rl
-                                    * (np.arcsin(sin_lat) + sin_lat))
+        rows[..., :k] = self._one_hot[np.where(heard, kind, 0)]
+        rows[..., k:] = feat
         if rows is not out:
             out[L] = rows
 

@@ -176,3 +176,18 @@ def test_some_listeners_and_some_voices():
                                   "loudness": [1.0]}})
     row = obs[listener]["audition"][0]
     assert row[CRY] == 1.0 and row[ILD] > 6.0 and row[ITD] > 0.4
+
+
+def test_without_head_shadow_the_near_ear_is_louder_by_the_distance_law():
+    env = pair((0.0, 0.5), audition={"head_shadow_db": 0.0})
+    row = heard(env, None)
+    w = env.world
+    ears = w.data.geom_xpos[w.agents[0].head_geom] + np.outer(
+        [1, -1], w.data.geom_xmat[w.agents[0].head_geom].reshape(3, 3)[:, 1]
+        * w.model.geom_size[w.agents[0].head_geom, 0])
+    h = w.agents[1].head_geom
+    mouth = w.data.geom_xpos[h] + w.data.geom_xmat[h].reshape(3, 3)[:, 0] * w.model.geom_size[h, 0]
+    d = np.linalg.norm(mouth - ears, axis=1)
+    assert row[ILD] == pytest.approx(20 * np.log10(d[1] / d[0]), abs=1e-3)
+    assert row[ILD] > 1.5
+    assert row[LEFT] == pytest.approx(level_db(CRY, 1.0) - 20 * np.log10(d[0]), abs=1e-3)
