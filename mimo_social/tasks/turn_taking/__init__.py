@@ -81,8 +81,13 @@ baselines:
     --episodes 20 --seed 1000`): uniform random actions (a new kind each step: the infant is
     rarely silent when the caregiver begins, so few of its answers count) 3 / 20 successes,
     return 6.05 +- 2.77; zero action (silence) 0 / 20, 0 +- 0 (never answered); scripted
-    `TurnTakingInfantController` 19 / 20, 13.8 +- 2.62, success at step 4386 on average. No
-    trained learner yet (recipe `train/recipes/turn_taking.toml`: not measured)
+    `TurnTakingInfantController` 19 / 20, 13.8 +- 2.62, success at step 4386 on average (the same
+    figures with the learner's audition on and off: no policy here reads it). A hack and an
+    upper bound, same seeds (`python tests/tasks/test_turn_taking.py`): babbling on every step 0
+    / 20, 0 answers (no offset, nothing to answer); one step of babble whenever both have been
+    silent 1.5 s 20 / 20, 14.4 +- 1.5 answers, and 0.3 s 20 / 20, 27.75 +- 1.4: the reward's
+    optimum is to vocalise briefly and leave the turn, i.e. uses the contingency. No trained
+    learner yet (recipe `train/recipes/turn_taking.toml`: not measured)
 summary:
     `measures.run` / `measures.effects` run blocks of a contingent, a non-contingent (yoked to
     the block's contingent episode) and a replay episode; measured, 10 blocks, seeds 1000-1009
