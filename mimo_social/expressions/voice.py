@@ -70,13 +70,18 @@ if tuple(k.name for k in VOICE_TABLE) != SOUNDS:   # one table, in the order of 
 MAX_LEVEL_DB = max(max(k.infant_db[1], k.adult_db[1]) for k in VOICE_TABLE)
 
 
+#: per kind (quietest, loudest) at 1 m as plain floats: an infant's, an adult's
+_RANGES = {adult: tuple((float(lo), float(hi)) for lo, hi in (
+    (k.adult_db if adult else k.infant_db) for k in VOICE_TABLE)) for adult in (False, True)}
+
+
 def level_ranges(adult: bool) -> np.ndarray:
     """``(len(SOUNDS), 2)`` float64: per kind (quietest, loudest) dB SPL at 1 m."""
-    return np.array([k.adult_db if adult else k.infant_db for k in VOICE_TABLE], float)
+    return np.array(_RANGES[bool(adult)], float)
 
 
 def level_db(kind: int, loudness: float, adult: bool = False) -> float:
     """The level at 1 m (dB SPL) of ``kind`` (an index of :data:`SOUNDS`) at ``loudness``
     in [0, 1]: linear in dB from the kind's quietest (0) to its loudest (1)."""
-    lo, hi = level_ranges(adult)[int(kind)]
-    return float(lo + float(loudness) * (hi - lo))
+    lo, hi = _RANGES[bool(adult)][int(kind)]
+    return lo + float(loudness) * (hi - lo)
