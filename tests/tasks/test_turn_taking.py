@@ -286,6 +286,13 @@ def test_the_caregiver_reaches_the_learner_only_through_its_ears():
     assert heard > 0
 
 
+def test_measures_latencies_are_the_scheduled_answers_in_control_steps():
+    from mimo_social.tasks.turn_taking.measures import latencies
+    got = latencies(episodes=2, seed=0, env_kwargs={"max_steps": STEPS})
+    assert got and all(x >= 0 for x in got)
+    assert all(abs(x / DT - round(x / DT)) < 1e-9 for x in got)
+
+
 class Always:
     """A hack: babble on every step (never an offset, so never answered)."""
 
