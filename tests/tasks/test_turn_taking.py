@@ -293,6 +293,35 @@ def test_measures_latencies_are_the_scheduled_answers_in_control_steps():
     assert all(abs(x / DT - round(x / DT)) < 1e-9 for x in got)
 
 
+def test_the_answers_are_an_event_line_of_the_recording(tmp_path):
+    """The replay shows each caregiver answer: /plots/caregiver_answer is 2 on the step an answer
+    begins (1 on another utterance onset, else 0)."""
+    from mimo_social.recording import Recorder, read_batches
+    env = turn_taking_v0.scripted_env(max_steps=STEPS)
+    learner = TurnTakingInfantController()
+    obs, _ = env.reset(seed=1002)
+    learner.reset(env.unwrapped, "infant_0", np.random.default_rng(1002))
+    answers = []
+    with Recorder(env, tmp_path / "tt.rrd", eyes=False) as rec:
+        rec.log_reset(obs)
+        for _ in range(STEPS):
+            act = {"infant_0": learner.act(env.unwrapped, "infant_0", None)}
+            obs, rewards, _, _, infos = env.step(act)
+            rec.log_step(act, rewards, obs)
+            if infos["infant_0"]["answer"]:
+                answers.append(int(infos["infant_0"]["step"]))
+    data = read_batches(tmp_path / "tt.rrd")
+    logged = {}
+    for batch in data["/plots/caregiver_answer"]:
+        if "Scalars:scalars" in batch.schema.names:
+            for k, v in zip(batch.column("step").to_pylist(),
+                            batch.column("Scalars:scalars").to_pylist()):
+                if v is not None:
+                    logged[k] = v[0]
+    assert answers and sorted(k for k, v in logged.items() if v == 2.0) == answers
+    assert set(logged.values()) <= {0.0, 1.0, 2.0}
+
+
 class Always:
     """A hack: babble on every step (never an offset, so never answered)."""
 
