@@ -54,8 +54,9 @@ import numpy as np
 from gymnasium import spaces
 
 from ..expressions.voice import MAX_LEVEL_DB, SOUNDS
-from ..util.checks import check_number
+from ..util.checks import check_bool, check_number
 from .base import SenseEntry
+from .waveform import binaural_frames, frame_samples, peak
 
 __all__ = ["AuditionConfig", "AuditionSystem", "Audition", "SENSE", "FEATURES",
            "SPEED_OF_SOUND", "MIN_DISTANCE", "MAX_HEAD_RADIUS", "woodworth_itd"]
@@ -74,6 +75,8 @@ class AuditionConfig:
 
     threshold_db: float = 0.0      # dB SPL: a level at or below it is not heard (0)
     head_shadow_db: float = 8.0    # dB: ILD of the head shadow at 90 degrees (our choice)
+    # a binaural pressure frame of the step too: "audition_waveform" (:mod:`.waveform`)
+    waveform: bool = False
 
     def __post_init__(self):
         put = partial(object.__setattr__, self)
@@ -81,6 +84,7 @@ class AuditionConfig:
                                          0.0, 120.0))
         put("head_shadow_db", check_number("audition", "head_shadow_db", self.head_shadow_db,
                                            0.0, 30.0))
+        put("waveform", check_bool("audition", "waveform", self.waveform))
 
 
 def woodworth_itd(radius, lateral):
@@ -130,6 +134,13 @@ class AuditionSystem:
         shape = (len(self.sources), self.width)
         self.space = spaces.Box(np.broadcast_to(low, shape).copy(),
                                 np.broadcast_to(high, shape).copy(), dtype=np.float32)
+        # the binaural frames (waveform=True): one control step of samples per ear
+        self.wave = any(c.waveform for c in configs if c) and len(self.sources) > 0
+        physics = world.physics
+        self.n_samples = frame_samples(physics.timestep * physics.frame_skip)
+        self.waves = np.zeros((n, 2, self.n_samples if self.wave else 0), np.float32)
+        p = peak(len(self.sources), float(level))
+        self.wave_space = spaces.Box(-p, p, (2, self.n_samples), np.float32)
         self.reset(world.model, world.data)
 
     def connect(self, sounds: np.ndarray) -> None:
@@ -155,6 +166,7 @@ class AuditionSystem:
         kind = sounds[S, 0].astype(np.intp)
         if not kind.any():                     # every voice silent: nothing to hear
             out[L] = self._silence
+            self.waves[L] = 0.0
             return
         heads, Sx, Lx = self.heads, self._s_index, self._l_index   # slices when all agents
         centre = data.geom_xpos[heads]                         # (n, 3)
@@ -185,6 +197,9 @@ class AuditionSystem:
         rows[..., k:] = feat
         if rows is not out:
             out[L] = rows
+        if self.wave:
+            self.waves[L] = binaural_frames(kind, level, feat[..., 3], float(data.time),
+                                            self.n_samples)
 
 
 class Audition:
@@ -192,19 +207,26 @@ class Audition:
 
     name = "audition"
 
-    def __init__(self, system: AuditionSystem, index: int):
+    def __init__(self, system: AuditionSystem, index: int, config: AuditionConfig):
         self.system, self.index = system, index
         space = system.space   # a Box of its own per agent
         self.spaces = {self.name: spaces.Box(space.low.copy(), space.high.copy(),
                                              dtype=np.float32)}
+        self.waveform = bool(config.waveform and system.wave)
+        if self.waveform:
+            w = system.wave_space
+            self.spaces["audition_waveform"] = spaces.Box(w.low.copy(), w.high.copy(),
+                                                          dtype=np.float32)
 
     def observe(self, model, data, out: dict) -> None:
         out[self.name] = self.system.features[self.index].copy()
+        if self.waveform:
+            out["audition_waveform"] = self.system.waves[self.index].copy()
 
 
 def build_audition(world, configs):
     system = AuditionSystem(world, configs)
-    return system, [Audition(system, i) if c else None for i, c in enumerate(configs)]
+    return system, [Audition(system, i, c) if c else None for i, c in enumerate(configs)]
 
 
 SENSE = SenseEntry("audition", AuditionConfig, shared=build_audition)

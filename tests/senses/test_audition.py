@@ -191,3 +191,28 @@ def test_without_head_shadow_the_near_ear_is_louder_by_the_distance_law():
     assert row[ILD] == pytest.approx(20 * np.log10(d[1] / d[0]), abs=1e-3)
     assert row[ILD] > 1.5
     assert row[LEFT] == pytest.approx(level_db(CRY, 1.0) - 20 * np.log10(d[0]), abs=1e-3)
+
+
+@pytest.mark.parametrize("side", [1, -1])
+def test_the_binaural_frame_carries_level_and_itd(side):
+    from mimo_social.senses.waveform import SAMPLE_RATE
+
+    env = pair((0.0, side * 1.0), audition={"waveform": True})
+    listener = env.possible_agents[0]
+    assert env.observation_space(listener)["audition_waveform"].shape == (2, 160)
+    obs = say(env)[listener]
+    w, row = obs["audition_waveform"].astype(float), obs["audition"][1]
+    assert env.observation_space(listener)["audition_waveform"].contains(
+        obs["audition_waveform"])
+    rms_db = 20 * np.log10(np.sqrt((w ** 2).mean(1)) / 20e-6)
+    assert rms_db == pytest.approx(row[[LEFT, RIGHT]], abs=1.0)
+    lag = np.argmax(np.correlate(w[1], w[0], "full")) - (w.shape[1] - 1)
+    assert lag == pytest.approx(row[ITD] * 1e-3 * SAMPLE_RATE, abs=1.0)
+    assert side * lag >= 7
+    silent = say(env, (SILENCE, SILENCE))[listener]["audition_waveform"]
+    assert not silent.any()
+
+
+def test_no_waveform_by_default():
+    env = pair((1.0, 0.0))
+    assert "audition_waveform" not in env.observation_space(env.possible_agents[0]).spaces
