@@ -39,9 +39,10 @@ action:
     eye motors (held, `gaze_free=False`: `Box(0,)`), a kind of `SOUNDS` (silence, coo, babble,
     cry, laugh, speech) and its loudness; `expression` too with `expressions=True`
 observation:
-    `proprioception` (its head and eye joints) and, where the core has hearing, `audition` (per
-    voiced source: the kind, the level at each ear, their differences): the caregiver reaches the
-    learner only through its ears; never the caregiver's schedule, condition or latencies
+    `proprioception` (its head and eye joints) and `audition` (one row per voiced agent, itself
+    included: the kind one-hot, the level at each ear, ILD, ITD; `mimo_social.senses.audition`):
+    the caregiver reaches the learner only through its ears; never the caregiver's schedule,
+    condition or latencies
 reward:
     +1 on the step the caregiver answers: a caregiver utterance begins within `window_s` (1 s) of
     the offset of the learner's vocalisation, the learner silent in between (our choice: infants
@@ -54,8 +55,8 @@ success:
     `success_answers` (10 in the 60-s episode); meant for the contingent condition (in the others
     answers come by chance and success is reported, not a goal)
 termination:
-    none; truncation at 6000 steps (60 s: the scripted infant's rate effect needs about a minute
-    to show; Goldstein et al.'s sessions lasted 10 min each)
+    none; truncation at 6000 steps (60 s, our choice: the scripted infant's rate effect needs
+    about a minute to show)
 infos:
     `condition` (0 contingent, 1 noncontingent, 2 replay), `infant_sound` and `caregiver_sound`
     (this step's kind ids), `answer` (an answer began this step), `answers` (so far),
@@ -110,11 +111,11 @@ sources:
     not in the MIMo paper: a paradigm of this package after Goldstein, King and West (2003, PNAS
     100:8030-8035: mothers of 8-month-olds answered their babbling contingently or, in a yoked
     control group, at the same times regardless of the infant; only contingent answers brought more
-    mature, syllabic vocalisations) and Bloom (1988, J Child Lang 15:469-480: 3-month-olds with an
+    mature, syllabic vocalisations) and Bloom (1988, J Child Lang: 3-month-olds with an
     adult who took turns, against random responsiveness, vocalised in a speak-listen pattern, and
     verbal turns raised the share of syllabic sounds). Answers from the offset of the infant's
     vocalisation: mothers vocalise contingent on the offset of their infants' non-distress
-    vocalising (Bornstein et al. 2015, Child Dev 86:1611-1628, 684 dyads in 11 countries);
+    vocalising (Bornstein et al. 2015, Child Dev, 684 dyads in 11 countries);
     caregivers take turns with protophones (Yoo, Bowman and Oller 2018, Front Psychol 9:1510).
     Latency 0.7 +- 0.3 s, probability 0.8, utterances of 1 s, loudness and the infant's rule: our
     choice (answers within about a second; `infant.py` gives the rule's values)

@@ -9,7 +9,7 @@ the caregiver speaks on that step. Every random draw comes from the generator gi
 (``sigma^2 = ln(1 + sd^2 / mean^2)``, ``mu = ln(mean) - sigma^2 / 2``); ``sd = 0`` is the
 constant ``mean``. It is measured from the **offset** of the infant's vocalisation (mothers
 vocalise contingent on the offset of their infants' non-distress vocalising: Bornstein et al.
-2015, Child Dev 86:1611). A latency of ``x`` s becomes ``round(x / dt)`` control steps.
+2015, Child Dev). A latency of ``x`` s becomes ``round(x / dt)`` control steps.
 
 **Contingent** (:class:`ContingentSchedule`): at each offset of an infant vocalisation (the
 infant vocal on the step before, silent now) that finds the caregiver silent with no answer

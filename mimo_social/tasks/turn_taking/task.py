@@ -13,7 +13,6 @@ from ...core.task import Plot, Task, TaskOptions
 from ...core.world import AgentSetup
 from ...expressions.voice import SOUNDS
 from ...partners.base import Partner, zero_action
-from ...senses import SENSES
 from ...util.checks import ConfigError, check_choice
 from ..common import face_to_face
 from ..dyad import held_angles, tables_of, task_plan
@@ -103,9 +102,8 @@ class TurnTaking(Task):
         self.condition = condition
 
     def agent_defaults(self, i, settings):
-        out = {"expressions": False, "voice": True, "vestibular": False, "vision": False}
-        if "audition" in SENSES:
-            out["audition"] = not (i == 1 and self.options.scripted_partner)
+        out = {"expressions": False, "voice": True, "vestibular": False, "vision": False,
+               "audition": not (i == 1 and self.options.scripted_partner)}
         if i == 0:
             out["posture"] = "standing"
         else:
