@@ -334,23 +334,40 @@ class Always:
 
 
 class Bidder:
-    """An upper bound: one step of babble whenever both have been silent ``wait`` steps (it
-    reads the sounds from the world, as the scripted infant does)."""
+    """An upper bound: ``length`` steps of babble whenever both have been silent ``wait`` steps
+    (it reads the sounds from the world, as the scripted infant does)."""
 
-    def __init__(self, wait: int):
-        self.wait = wait
+    def __init__(self, wait: int, length: int = 20):
+        self.wait, self.length = wait, length
 
     def reset(self, env, agent, rng):
         self.base = dict(zero_action(env.action_space(agent)),
                          loudness=np.full(1, 0.5, np.float32))
-        self.quiet = 0
+        self.quiet = self.left = 0
 
     def act(self, env, agent, obs):
         s = env.sounds
+        if self.left:
+            self.left -= 1
+            return dict(self.base, voice=np.int64(2 if self.left else 0))
         self.quiet = self.quiet + 1 if s[0, 0] == 0 and s[1, 0] == 0 else 0
-        bid = self.quiet >= self.wait
-        self.quiet = 0 if bid else self.quiet
-        return dict(self.base, voice=np.int64(2 if bid else 0))
+        if self.quiet >= self.wait:
+            self.quiet, self.left = 0, self.length
+            return dict(self.base, voice=np.int64(2))
+        return dict(self.base, voice=np.int64(0))
+
+
+class Flicker:
+    """A hack PPO found (issue 33's pilot): a voice switched on and off every few steps, so that
+    some offset is always recent when an utterance begins; seeded per episode."""
+
+    def reset(self, env, agent, rng):
+        self.base = dict(zero_action(env.action_space(agent)),
+                         loudness=np.full(1, 0.5, np.float32))
+        self.rng = rng
+
+    def act(self, env, agent, obs):
+        return dict(self.base, voice=np.int64(2 if self.rng.random() < 0.64 else 0))
 
 
 def hack_figures(episodes: int = 20, seed: int = 1000) -> dict:
@@ -358,8 +375,8 @@ def hack_figures(episodes: int = 20, seed: int = 1000) -> dict:
     from mimo_social.core.episodes import run_episodes
     env = turn_taking_v0.scripted_env()
     out = {}
-    for name, policy in (("always babble", Always()), ("bidder 1.5 s", Bidder(150)),
-                         ("bidder 0.3 s", Bidder(30)),
+    for name, policy in (("always babble", Always()), ("flicker", Flicker()),
+                         ("bidder 1.5 s", Bidder(150)), ("bidder 0.3 s", Bidder(30)),
                          ("scripted", TurnTakingInfantController())):
         finals = [e.last_infos["infant_0"]
                   for e in run_episodes(env, {"infant_0": policy}, episodes, seed)]
@@ -374,7 +391,9 @@ def hack_figures(episodes: int = 20, seed: int = 1000) -> dict:
 def test_hacks_score_less_and_the_optimum_uses_the_contingency():
     got = hack_figures(episodes=3)
     assert got["always babble"][:2] == (0, 0.0)
-    assert got["bidder 0.3 s"][1] > got["scripted"][1]
+    assert got["flicker"][1] < got["scripted"][1] / 2
+    # taking turns earns what the scripted infant earns (20 episodes: 15.25 against 13.8)
+    assert got["bidder 0.3 s"][0] == 3 and got["bidder 0.3 s"][1] >= got["scripted"][1]
 
 
 if __name__ == "__main__":   # the table's figures of the hacks (20 episodes, seeds 1000-1019)

@@ -51,6 +51,7 @@ class TurnTakingOptions(TaskOptions):
     caregiver_loudness: float = 0.25
     timer_rate_hz: float = 0.25
     window_s: float = 1.0
+    min_vocal_s: float = 0.2
     success_answers: int = 10
     reward_free: bool = False
     gaze_free: bool = True
@@ -66,6 +67,7 @@ class TurnTakingOptions(TaskOptions):
         self._number("caregiver_loudness", 0.0, 1.0)
         self._number("timer_rate_hz", 0.0, 10.0)
         self._number("window_s", 0.05, 10.0)
+        self._number("min_vocal_s", 0.01, 5.0)
         self._int("success_answers", 1, 10_000)
         self._bool("reward_free")
         self._bool("gaze_free")
@@ -143,7 +145,7 @@ class TurnTaking(Task):
         self.episode_condition = self.condition
         self._weights = np.zeros(2) if o.reward_free else \
             np.array([1.0, 0.0 if o.scripted_partner else 1.0])
-        self.measures = TurnMeasures(env.dt, o.window_s)
+        self.measures = TurnMeasures(env.dt, o.window_s, o.min_vocal_s)
         self._kinds = (0, 0)
         self._answer = self._care_on = False
 

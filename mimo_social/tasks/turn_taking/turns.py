@@ -12,10 +12,11 @@ offset the first silent step after it. Counted per episode:
 * **response latency**: at each caregiver onset while the infant is silent, the time since
   the infant's last offset when no caregiver onset came between (``latencies``, seconds: the
   caregiver's answer or a chance utterance); ``mean_latency_s`` (0 when none);
-* ``answered_fraction``: the share of the infant's vocalisations answered, i.e. followed by a
-  caregiver onset within ``window_s`` (1 s) of their offset, before the infant vocalises again
-  (a vocalisation is resolved when answered, when the window passes, or at the infant's next
-  onset);
+* ``answered_fraction``: the share of the infant's vocalisations of at least ``min_vocal_s``
+  (0.2 s) answered, i.e. followed by a caregiver onset within ``window_s`` (1 s) of their
+  offset, before the infant vocalises again (a vocalisation is resolved when answered, when the
+  window passes, or at the infant's next onset); shorter ones are never answers (a policy that
+  flickers its voice on and off would otherwise find a recent offset before any utterance);
 * **turns**: speaker switches within ``window_s``: a caregiver onset answering an infant
   vocalisation (as above) or an infant onset within ``window_s`` of a caregiver offset while
   the caregiver is silent; ``turns`` counts both, ``infant_turns`` the second kind,
@@ -41,11 +42,14 @@ INFO_KEYS = ("infant_vocalisations", "infant_rate_per_min", "vocal_fraction",
 
 class TurnMeasures:
     """The measures of one episode (see the module docstring); ``dt`` the control step in
-    seconds, ``window_s`` the turn window."""
+    seconds, ``window_s`` the turn window, ``min_vocal_s`` the shortest vocalisation that can be
+    answered."""
 
-    def __init__(self, dt: float, window_s: float = 1.0):
+    def __init__(self, dt: float, window_s: float = 1.0, min_vocal_s: float = 0.2):
         self.dt = float(dt)
         self.window = max(0, int(round(float(window_s) / self.dt)))
+        self.min_vocal = max(1, int(round(float(min_vocal_s) / self.dt)))
+        self._start = 0                       # the infant's current vocalisation's onset
         self.steps = 0
         self._prev = (False, False)
         self.vocal_steps = 0
@@ -74,7 +78,9 @@ class TurnMeasures:
             self.resolved += 1
             self._open = None
         if i_off:
-            self._last_off = self._open = t
+            self._last_off = t
+            if t - self._start >= self.min_vocal:
+                self._open = t
         if c_off:
             self._care_off = t
         if c_on:
@@ -91,6 +97,7 @@ class TurnMeasures:
             self._last_off = None
             self._care_off = None
         if i_on:
+            self._start = t
             self.infant_onsets += 1
             kind = int(infant_kind)
             self.speech_like += kind in SPEECH_LIKE
@@ -122,14 +129,15 @@ class TurnMeasures:
                 "mean_turn_gap_s": float(np.mean(self.gaps)) if self.gaps else 0.0}
 
 
-def measure(infant, caregiver, dt: float, window_s: float = 1.0) -> tuple[dict, list[float]]:
+def measure(infant, caregiver, dt: float, window_s: float = 1.0,
+            min_vocal_s: float = 0.2) -> tuple[dict, list[float]]:
     """:class:`TurnMeasures` over two arrays of sound kinds (one per step): its infos and the
     response latencies (s)."""
     infant, caregiver = np.asarray(infant, int), np.asarray(caregiver, int)
     if infant.shape != caregiver.shape or infant.ndim != 1:
         raise ValueError(f"measure: infant {infant.shape} and caregiver {caregiver.shape} "
                          "must be 1-D arrays of the same length")
-    m = TurnMeasures(dt, window_s)
+    m = TurnMeasures(dt, window_s, min_vocal_s)
     for a, b in zip(infant.tolist(), caregiver.tolist()):
         m.update(a, b)
     return m.infos(), list(m.latencies)
