@@ -61,12 +61,13 @@ def add_parser(subparsers) -> None:
     p = subparsers.add_parser(
         "paradigm", help="a paradigm's per-phase / per-condition / per-action measures and its "
         "effect for several learners side by side",
-        description="Run a paradigm (still_face: per phase; contingency: per condition; "
-        "imitation: per demonstrated action) with each learner on the same seeded episodes and "
-        "print its measures as one markdown table, a column per learner, and for still_face "
-        "and contingency a table of the paradigm's effect (still face: still-phase drop and "
-        "reunion recovery of smiling and gaze, rise of self-touch; contingency: live minus "
-        "replay, live minus non-contingent). Learners: scripted (the "
+        description="Run a paradigm (still_face: per phase; contingency and turn_taking: per "
+        "condition; imitation: per demonstrated action) with each learner on the same seeded "
+        "episodes and print its measures as one markdown table, a column per learner, and for "
+        "still_face, contingency and turn_taking a table of the paradigm's effect (still face: "
+        "still-phase drop and reunion recovery of smiling and gaze, rise of self-touch; "
+        "contingency: live minus replay, live minus non-contingent; turn taking: contingent "
+        "minus non-contingent vocalisation rate and speech-like share). Learners: scripted (the "
         "task's scripted infant baseline), random, zero (the resting action) or a run folder of "
         "'mimo-social train' / 'compare' (--mode scripted) on the same task.")
     p.add_argument("task", choices=PARADIGMS, help="the paradigm (a catalogue task)")
