@@ -258,12 +258,19 @@ def facing_gaze(setups: Sequence[AgentSetup], which: Sequence[int]) -> list[dict
     """For agents ``which`` of a pair, the head and eye angles (joint -> rad) that look at the
     other's face (head centre), measured on a copy of the pair with those joints free; a few
     rounds, each with the other's head turned as the last round found (a turned head moves its
-    centre)."""
-    free = []
-    for s in setups:
-        frozen = {k: v for k, v in s.frozen.items() if k not in GAZE_JOINTS}
-        free.append(AgentSetup(_measuring_config(s.config), s.position, s.facing, frozen,
-                               base="fixed"))
+    centre). Cached per pair (bodies, places, held angles): an age change at reset back to an
+    age seen before compiles no measuring copy."""
+    key = tuple((_measuring_config(s.config), tuple(float(x) for x in s.position),
+                 tuple(float(x) for x in s.facing),
+                 _frozen_key({k: v for k, v in s.frozen.items() if k not in GAZE_JOINTS}))
+                for s in setups)
+    return [dict(g) for g in _gaze(key, tuple(int(i) for i in which))]
+
+
+@lru_cache(maxsize=64)
+def _gaze(key: tuple, which: tuple) -> tuple:
+    free = [AgentSetup(config, position, facing, dict(frozen), base="fixed")
+            for config, position, facing, frozen in key]
     w = World(free)
     m = w.model
     looks = {i: LookAt(w, i) for i in which}
@@ -277,13 +284,13 @@ def facing_gaze(setups: Sequence[AgentSetup], which: Sequence[int]) -> list[dict
         for i, q in angles.items():
             pose[looks[i].qpos] = q
     out = []
-    for i in range(len(setups)):
+    for i in range(len(key)):
         if i not in looks:
             out.append({})
             continue
         names = [w.agents[i].joint_names[k] for k in looks[i].joints]
         out.append({n: float(v) for n, v in zip(names, pose[looks[i].qpos])})
-    return out
+    return tuple(out)
 
 
 @dataclass(frozen=True)
