@@ -57,7 +57,7 @@ from ..util.checks import check_bool, check_int
 from ..util.names import reject_old_names
 from .acuity import acuity_blur, check_acuity, cutoff_for
 from .base import SenseEntry
-from .fovea import check_fovea, foveal_warp
+from .fovea import FoveaConfig, check_fovea, foveal_warp
 
 __all__ = ["VisionConfig", "VisionSystem", "VisionSense", "build_vision", "vision_system",
            "eye_images", "render_now", "anaglyph", "save_anaglyph", "write_png", "EYES", "SENSE"]
@@ -78,7 +78,7 @@ class VisionConfig:
     # image centre, 1 to 16) or a mapping {"strength": ..., "render_scale": ...}; the eye is
     # rendered render_scale (1 to 8, default: the strength rounded up) times larger and warped
     # to width x height, centre magnified, the whole field of view kept (docs/senses.md)
-    fovea: float | dict | None = None
+    fovea: FoveaConfig | float | dict | None = None
 
     def __post_init__(self):
         for key in ("width", "height"):
