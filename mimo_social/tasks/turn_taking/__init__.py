@@ -91,8 +91,10 @@ baselines:
     / 20, 0 answers (no offset, nothing to answer); babble switched on and off at random each
     step (64 % on: the PPO pilot's hack, version history) 0 / 20, 0; 0.2 s of babble whenever
     both have been silent 1.5 s 20 / 20, 13.45 +- 1.4 answers, and 0.3 s 20 / 20, 15.25 +- 1.6:
-    the reward's optimum is to vocalise and leave the turn, i.e. uses the contingency. No trained
-    learner yet (recipe `train/recipes/turn_taking.toml`: not measured)
+    the reward's optimum is to vocalise and leave the turn, i.e. uses the contingency. Learner
+    (recipe `turn_taking`, PPO, 1M steps, seeds 0 and 1, 30 episodes; `mimo-social recipe
+    turn_taking --seeds 0,1`): 0 % with the mean action and sampled in both (return 0.0 and
+    0.2), 32-33 min a seed (docs/training/issue30/recipes/turn_taking)
 summary:
     `measures.run` / `measures.effects` run blocks of a contingent, a non-contingent (yoked to
     the block's contingent episode) and a replay episode; measured, 10 blocks, seeds 1000-1009
