@@ -35,7 +35,8 @@ from .vision_cost import TURN_STEPS, bench_env
 
 __all__ = ["BUILD_BODIES", "ALL_DELAYS_MS", "MIN_TURNS", "build_times", "delay_cost",
            "acuity_cost", "measure", "format_results", "min_sim_seconds", "turns_of",
-           "compare_turns", "hearing_cost", "format_hearing", "HEARING_CONFIGS"]
+           "compare_turns", "hearing_cost", "format_hearing", "HEARING_CONFIGS",
+           "hearing_paths", "format_hearing_paths"]
 
 #: turns of :data:`~mimo_social.bench.vision_cost.TURN_STEPS` steps a comparison needs
 MIN_TURNS = 10
@@ -198,6 +199,56 @@ def format_hearing(h: dict) -> str:
             f"{c['base']}, {c['turns']} turns; audition {c['audition_ms']:.3f} ms = "
             f"{100 * c['audition_ms'] / ms[c['base']]:.1f} %)")
         lines.append(f"| {name} | {t:.3f}{extra} |")
+    return "\n".join(lines)
+
+
+def hearing_paths(agents: Sequence[int] = (2, 3, 4, 6, 8), steps: int = 600,
+                  seed: int = 0) -> list[dict]:
+    """The audition update's µs per step inside the env (right after the physics), computed
+    with Python floats and with numpy arrays (``AuditionSystem.scalar``), per number of agents
+    in free play (every agent voiced and hearing: agents^2 pairs), the two taking turns of
+    :data:`TURN_STEPS` steps under the same random actions and sounds, 100 untimed steps
+    first; ``default``: the way the env takes for that many pairs."""
+    rows = []
+    for n in agents:
+        env = free_play_v0.parallel_env(max_steps=10 ** 9, n_agents=n, voice=True,
+                                        audition=True)
+        env.reset(seed=seed)
+        system = env.unwrapped.systems["audition"]
+        default = system.scalar
+        acts = random_action_block(env, 100 + 2 * steps, seed)
+        for a in acts[:100]:
+            env.step(a)
+        spent = {True: 0.0, False: 0.0}
+        update = type(system).update
+
+        def timed(model, data):
+            t = time.perf_counter()
+            update(system, model, data)
+            spent[system.scalar] += time.perf_counter() - t
+
+        system.update = timed
+        for k in range(100, 100 + 2 * steps, TURN_STEPS):
+            system.scalar = (k // TURN_STEPS) % 2 == 0
+            for a in acts[k:k + TURN_STEPS]:
+                env.step(a)
+        del system.update
+        system.scalar = default
+        rows.append({"agents": n, "pairs": len(system.listeners) * len(system.sources),
+                     "floats_us": 1e6 * spent[True] / steps,
+                     "arrays_us": 1e6 * spent[False] / steps,
+                     "default": "floats" if default else "arrays"})
+        env.close()
+    return rows
+
+
+def format_hearing_paths(rows: list[dict]) -> str:
+    """A Markdown table of :func:`hearing_paths`."""
+    lines = ["The audition update inside the step, µs, Python floats vs numpy arrays:", "",
+             "| agents | pairs | floats | arrays | the env takes |",
+             "| --- | --- | --- | --- | --- |"]
+    lines += [f"| {r['agents']} | {r['pairs']} | {r['floats_us']:.1f} | {r['arrays_us']:.1f} | "
+              f"{r['default']} |" for r in rows]
     return "\n".join(lines)
 
 

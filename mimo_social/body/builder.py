@@ -264,9 +264,16 @@ def _add_iris_pupil(body, eye: str, r: float, centre: np.ndarray, friction) -> N
                   rgba=PUPIL_RGBA, **visual)
 
 
+def mouth_position(head_geom) -> np.ndarray:
+    """The mouth site in the head's body frame: the head sphere's front (its centre + r x)."""
+    return np.asarray(head_geom.pos, float) + (float(head_geom.size[0]), 0.0, 0.0)
+
+
 def _add_sites_cameras_sensors(spec, bodies, tables: BodyTables) -> None:
     head_geom = next(g for g in tables.geoms if g.name == "head")
     bodies["head"].add_site(name="head_centre", pos=head_geom.pos, size=[0.005, 0, 0])
+    # the mouth: on the face's front, where a voice comes from (senses/audition.py)
+    bodies["head"].add_site(name="mouth", pos=mouth_position(head_geom), size=[0.005, 0, 0])
     for site in tables.sites:  # palm centres and fingertips, the same names in every hand version
         bodies[site.body].add_site(name=site.name, pos=site.pos, size=[0.005, 0, 0])
     for side in ("right", "left"):

@@ -42,7 +42,8 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
     parser.add_argument("--json", default=None, type=output_file, help="write all results here")
     parser.add_argument("--hearing", action="store_true",
                         help="only the cost of hearing: two infants with voices, no vision, "
-                             "audition off vs on, in turns of 100 steps")
+                             "audition off vs on, in turns of 100 steps; then the update's "
+                             "two ways (Python floats, numpy arrays) at 2-8 agents")
     parser.set_defaults(func=run)
     return parser
 
@@ -51,6 +52,8 @@ def run(args: argparse.Namespace) -> int:
     if getattr(args, "hearing", False):
         results = development.hearing_cost(args.sim_seconds)
         print(development.format_hearing(results))
+        results["paths"] = development.hearing_paths()
+        print("\n" + development.format_hearing_paths(results["paths"]))
         if args.json:
             write_file(args.json, json.dumps(results, indent=1))
         return 0

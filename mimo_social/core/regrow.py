@@ -36,7 +36,7 @@ import mujoco
 import numpy as np
 
 from ..body.builder import (EYE_CAMERA_X, GEOM_FRICTION, IRIS, PUPIL, axis_angle_quat,
-                            quat_mul)
+                            mouth_position, quat_mul)
 from ..body.inertia import (BOX, CAPSULE, CYLINDER, ELLIPSOID, SPHERE, body_inertials,
                             boxes_in_parent, geom_aabb, geom_moments, geom_rbound,
                             quat_matrices)
@@ -70,6 +70,7 @@ class AgentMaps:
     joint: np.ndarray             # (J,) joint id of each table joint, -1: folded away
     site: np.ndarray              # (T,) site id of each table site
     head_site: int
+    mouth_site: int               # -1: none (a model pickled before it had one)
     head_geom_row: int            # the table row of the head geom
     cameras: list                 # (table geom index of the eye, camera id)
     actuator: np.ndarray          # (J,) actuator id of each table joint, -1: none
@@ -113,7 +114,7 @@ def agent_maps(world, i: int) -> AgentMaps:
         root=int(a.root_body), geom=geoms, eyes=eyes,
         joint=np.array([_id(m, "joint", p + j.name) for j in t.joints], np.intp),
         site=np.array([_id(m, "site", p + s.name) for s in t.sites], np.intp),
-        head_site=int(a.head_site),
+        head_site=int(a.head_site), mouth_site=_id(m, "site", p + "mouth"),
         head_geom_row=next(k for k, g in enumerate(t.geoms) if g.name == "head"),
         cameras=cams, actuator=acts, geoms=np.asarray(a.geom_ids, np.intp), bodies=bodies,
         bvh=nodes, bvh_base=base[nodes])
@@ -164,6 +165,8 @@ def _write_body(m, maps: AgentMaps, t: BodyTables) -> None:
         g = t.geoms[k]
         m.cam_pos[c] = np.asarray(g.pos, float) + (EYE_CAMERA_X * g.size[0], 0.0, 0.0)
     m.site_pos[maps.head_site] = t.geoms[maps.head_geom_row].pos
+    if maps.mouth_site >= 0:
+        m.site_pos[maps.mouth_site] = mouth_position(t.geoms[maps.head_geom_row])
     for k, s in enumerate(t.sites):
         m.site_pos[maps.site[k]] = s.pos
     for k, j in enumerate(t.joints):

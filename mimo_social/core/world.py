@@ -25,11 +25,13 @@ from ..body.builder import axis_angle_quat, build_infant, quat_mul
 from ..body.postures import posture_joints, posture_pitch
 from ..expressions.switch import FaceTextures
 from ..scenery import SCENES, add_playroom, clear_toys
+from ..senses import SENSES
 from ..util.checks import check_choice
 from ..util.names import agent_names
 from .config import AgentConfig, PhysicsConfig
 from .delays import check_delay_steps, delay_sensors, fill_sensor_history
 from .regrow import agent_maps, regrow_agent, regrow_props
+from .scene_parts import Prop, add_floor, add_lights, add_prop
 
 __all__ = ["AgentSetup", "Prop", "AgentIndex", "World", "CLOTHES_PALETTE"]
 
@@ -51,23 +53,6 @@ class AgentSetup:
     base: str = "free"                               # "free" or "fixed"
     actuated: tuple[str, ...] | None = None          # motor joints in the action; None: all
     gaze_joints: tuple[str, ...] = ()                # joints the task points at a target
-
-
-@dataclass(frozen=True)
-class Prop:
-    """A simple object in the scene (free to move unless ``fixed``)."""
-
-    name: str
-    shape: str = "sphere"            # sphere | box | capsule | cylinder
-    size: tuple[float, ...] = (0.025,)
-    pos: tuple[float, float, float] = (0.0, 0.0, 0.5)
-    mass: float = 0.1
-    rgba: tuple[float, float, float, float] = (0.9, 0.2, 0.2, 1.0)
-    fixed: bool = False
-    # bodies held to this prop by a weld equality, with their agent prefix
-    # ("infant_0/right_hand"); each is held at its pose relative to the prop in the world's
-    # initial pose, and :meth:`World.hold_welds` re-anchors them to the current one
-    welds: tuple[str, ...] = ()
 
 
 @dataclass
@@ -202,8 +187,8 @@ class World:
                 spec.option.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
         else:
             if floor:
-                self._add_floor(spec)
-            self._add_lights(spec)
+                add_floor(spec)
+            add_lights(spec)
         builds = []
         for i, setup in enumerate(agents):
             cfg = setup.config
@@ -230,8 +215,11 @@ class World:
             self.faces.bind_material(mat)
             spec.geom(f"{prefix}head").material = f"{prefix}face"
             builds.append((build, pose_q))
+        for entry in SENSES.values():    # what a sense adds to the model (hearing's sensors)
+            if entry.add_to_spec is not None:
+                entry.add_to_spec(spec, self.names, [s.config for s in agents])
         for p in props:
-            body = self._add_prop(spec, p)
+            body = add_prop(spec, p)
             if self.room is not None and self.ROOM_SLEEP and not p.fixed:
                 body.sleep = mujoco.mjtSleepPolicy.mjSLEEP_NEVER   # tasks move their props
         self.spec = spec
@@ -277,48 +265,6 @@ class World:
         spec.visual.global_.offwidth = 640
         spec.visual.global_.offheight = 480
         spec.visual.quality.shadowsize = 0
-
-    @staticmethod
-    def _add_floor(spec):
-        tex = spec.add_texture(name="floor_checker", type=mujoco.mjtTexture.mjTEXTURE_2D,
-                               builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER, width=256, height=256,
-                               rgb1=[0.82, 0.78, 0.70], rgb2=[0.74, 0.70, 0.62])
-        mat = spec.add_material(name="floor", texrepeat=[8, 8], reflectance=0.0)
-        mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = tex.name
-        spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE,
-                                size=[10, 10, 0.1], material="floor", condim=3)
-
-    @staticmethod
-    def _add_lights(spec):
-        for pos, direction in (((0, -2, 3), (0, 0.5, -1)), ((2, 2, 3), (-0.5, -0.5, -1))):
-            spec.worldbody.add_light(pos=pos, dir=direction, diffuse=[0.55, 0.55, 0.55],
-                                     castshadow=False, type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL)
-        spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
-        spec.visual.headlight.diffuse = [0.25, 0.25, 0.25]
-
-    @staticmethod
-    def _add_prop(spec, p: Prop):
-        shapes = {"sphere": mujoco.mjtGeom.mjGEOM_SPHERE, "box": mujoco.mjtGeom.mjGEOM_BOX,
-                  "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
-                  "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER}
-        if p.shape not in shapes:
-            raise ValueError(f"prop {p.name}: shape {p.shape!r}; allowed: {list(shapes)}")
-        body = spec.worldbody.add_body(name=p.name, pos=p.pos)
-        if not p.fixed:
-            body.add_freejoint(name=f"{p.name}_free")
-        size = np.zeros(3)
-        size[: len(p.size)] = p.size
-        body.add_geom(name=p.name, type=shapes[p.shape], size=size, mass=p.mass, rgba=p.rgba,
-                      condim=3)
-        for other in p.welds:
-            if spec.body(other) is None:
-                raise ValueError(f"prop {p.name}: cannot weld unknown body {other!r}")
-            eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_WELD, objtype=mujoco.mjtObj.mjOBJ_BODY,
-                                   name=f"{p.name}__{other}", name1=other, name2=p.name)
-            data = np.array(eq.data)
-            data[:3] = 0.0  # the anchor: the prop's origin
-            eq.data = data
-        return body
 
     @staticmethod
     def _rest_pose(build, posture: str, setup: AgentSetup):

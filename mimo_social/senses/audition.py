@@ -41,45 +41,65 @@ voice. Bounds: one-hot [0, 1]; levels [0, the loudest level of the voice table a
 :data:`MIN_DISTANCE` plus half the head shadow]; ILD +- that; ITD +- Woodworth's at 90 degrees
 for a head of :data:`MAX_HEAD_RADIUS` (or the largest head of the world, if larger).
 
-All listeners and sources are computed at once in numpy, once per control step (a shared
-system, :class:`AuditionSystem`), after the physics, from the head frames.
+Where each mouth is, seen from each head, MuJoCo computes in C: one ``framepos`` sensor per
+listener and source (:func:`add_hearing_sensors`: the source's ``mouth`` site in the listener's
+``head_centre`` frame, the head sphere's frame), read as one block of ``sensordata``; the
+acoustics follow once per control step (a shared system, :class:`AuditionSystem`), after the
+physics: with up to :data:`SCALAR_PAIRS` listener-source pairs in one pass of Python floats,
+with more in numpy over all pairs at once (on a few pairs numpy's cost per call outweighs its
+speed per value: ``mimo-social bench development --hearing`` times both ways).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 from functools import partial
 
+import mujoco
 import numpy as np
 from gymnasium import spaces
 
 from ..expressions.voice import MAX_LEVEL_DB, SOUNDS
 from ..util.checks import check_bool, check_number
 from .base import SenseEntry
+from .echoic import EchoicMemory
 from .waveform import binaural_frames, frame_samples, peak
 
 __all__ = ["AuditionConfig", "AuditionSystem", "Audition", "SENSE", "FEATURES",
-           "SPEED_OF_SOUND", "MIN_DISTANCE", "MAX_HEAD_RADIUS", "woodworth_itd"]
+           "SPEED_OF_SOUND", "MIN_DISTANCE", "MAX_HEAD_RADIUS", "woodworth_itd",
+           "add_hearing_sensors", "sensor_name"]
 
 #: the columns of a source's row after the kind one-hot
 FEATURES = ("level_left", "level_right", "ild", "itd")
 SPEED_OF_SOUND = 343.0     # m/s, air at 20 degrees C
 _LR = np.array([-1.0, 1.0])   # per ear (left, right): the sign of 2 r y in the squared distance
+_SILENT_DB = -1000.0       # a silent source's level: below every threshold
+#: at most this many (listener, source) pairs are heard with Python floats, more with numpy
+#: arrays: with few pairs numpy's cost per call outweighs its speed per value (docs/senses.md)
+SCALAR_PAIRS = 48
 MIN_DISTANCE = 0.05        # m: mouth-to-ear distances are held at this or more (our choice)
 MAX_HEAD_RADIUS = 0.15     # m: larger than any head here (adult ~0.09): the ITD bound
 
 
 @dataclass(frozen=True)
 class AuditionConfig:
-    """The hearing threshold and the head shadow."""
+    """The hearing threshold, the head shadow, the binaural frame and the echoic memory."""
 
     threshold_db: float = 0.0      # dB SPL: a level at or below it is not heard (0)
     head_shadow_db: float = 8.0    # dB: ILD of the head shadow at 90 degrees (our choice)
     # a binaural pressure frame of the step too: "audition_waveform" (:mod:`.waveform`)
     waveform: bool = False
+    # echoic memory (:mod:`.echoic`): "audition_memory", the loudest level heard from each source
+    # in each bin of memory_bin_s over the last memory_s seconds (0: off)
+    memory_s: float = 0.0
+    memory_bin_s: float = 0.1
 
     def __post_init__(self):
         put = partial(object.__setattr__, self)
+        put("memory_s", check_number("audition", "memory_s", self.memory_s, 0.0, 10.0))
+        put("memory_bin_s", check_number("audition", "memory_bin_s", self.memory_bin_s,
+                                         0.001, 10.0))
         put("threshold_db", check_number("audition", "threshold_db", self.threshold_db,
                                          0.0, 120.0))
         put("head_shadow_db", check_number("audition", "head_shadow_db", self.head_shadow_db,
@@ -91,6 +111,35 @@ def woodworth_itd(radius, lateral):
     """Woodworth's ITD in seconds for a spherical head of ``radius`` (m) and a source at
     ``lateral`` (rad, its angle to the median plane; > 0 on the left: the left ear leads)."""
     return np.asarray(radius) / SPEED_OF_SOUND * (lateral + np.sin(lateral))
+
+
+def sensor_name(listener: str, source: str) -> str:
+    """The MuJoCo sensor of ``source``'s mouth in ``listener``'s head frame."""
+    return f"hearing/{listener}/{source}"
+
+
+def add_hearing_sensors(spec, names, configs) -> None:
+    """One ``framepos`` sensor per listener (an agent with audition on) and source (an agent
+    with voice on), listener-major, so that the whole block is one slice of ``sensordata``."""
+    sources = [n for n, c in zip(names, configs) if c.voice]
+    for listener, c in zip(names, configs):
+        if c.audition is None:
+            continue
+        for source in sources:
+            spec.add_sensor(name=sensor_name(listener, source),
+                            type=mujoco.mjtSensor.mjSENS_FRAMEPOS,
+                            objtype=mujoco.mjtObj.mjOBJ_SITE, objname=f"{source}/mouth",
+                            reftype=mujoco.mjtObj.mjOBJ_SITE, refname=f"{listener}/head_centre")
+
+
+def _sensor_block(model, names, listeners, sources) -> slice:
+    """The ``sensordata`` slice of every (listener, source) sensor, listener-major."""
+    adr = [int(model.sensor_adr[model.sensor(sensor_name(names[i], names[j])).id])
+           for i in listeners for j in sources]
+    start = adr[0] if adr else 0
+    if adr != list(range(start, start + 3 * len(adr), 3)):
+        raise RuntimeError(f"audition: the hearing sensors are not one block: {adr}")
+    return slice(start, start + 3 * len(adr))
 
 
 class AuditionSystem:
@@ -113,14 +162,19 @@ class AuditionSystem:
         self._silence = np.zeros((len(self.listeners), len(self.sources), self.width),
                                  np.float32)
         self._silence[..., 0] = 1.0            # every source heard as silence
-        everyone = np.arange(n)
-        self._s_index = (slice(None) if np.array_equal(self.sources, everyone)
-                         else self.sources)
-        self._l_index = (slice(None) if np.array_equal(self.listeners, everyone)
-                         else self.listeners)
-        # per agent (n, ...): the head-shadow term per ear (+ left, - right), the threshold
-        self._shade = (0.5 * self.shadow)[:, None, None] * _LR[::-1]
-        self._thr = self.threshold[:, None, None][self._l_index]
+        # the listeners' constants, (l, 1, ...) against the (l, s, ...) pair arrays
+        L = self.listeners
+        self._shade = (0.5 * self.shadow[L])[:, None, None] * _LR[::-1]   # + left, - right
+        self._thr = self.threshold[L][:, None, None]
+        self._block = _sensor_block(world.model, world.names, L, self.sources)
+        self._pairs = (len(L), len(self.sources), 3)
+        self._source_list = self.sources.tolist()
+        # the rows are written in place when every agent listens, else into a buffer first
+        self._in_place = np.array_equal(L, np.arange(n))
+        self._rows = self.features if self._in_place else np.zeros(
+            (len(L), len(self.sources), self.width), np.float32)
+        #: Python floats for at most SCALAR_PAIRS pairs, numpy arrays for more
+        self.scalar = len(L) * len(self.sources) <= SCALAR_PAIRS
         self._one_hot = np.eye(len(SOUNDS), dtype=np.float32)
         self.sounds = np.zeros((n, 2))   # the env's (kind, dB at 1 m) per agent: connect()
         radius = max(MAX_HEAD_RADIUS, float(world.model.geom_size[self.heads, 0].max()))
@@ -141,6 +195,16 @@ class AuditionSystem:
         self.waves = np.zeros((n, 2, self.n_samples if self.wave else 0), np.float32)
         p = peak(len(self.sources), float(level))
         self.wave_space = spaces.Box(-p, p, (2, self.n_samples), np.float32)
+        self.level_max = float(level)
+        # echoic memory of the listeners that have it on: listener row -> its memory
+        dt = physics.timestep * physics.frame_skip
+        self.memories = {}
+        for row, i in enumerate(self.listeners):
+            c = configs[i]
+            if c.memory_s > 0:
+                bin_steps = max(1, int(round(c.memory_bin_s / dt)))
+                frames = int(np.ceil(c.memory_s / (bin_steps * dt) - 1e-9))
+                self.memories[int(i)] = (row, EchoicMemory(len(self.sources), frames, bin_steps))
         self.reset(world.model, world.data)
 
     def connect(self, sounds: np.ndarray) -> None:
@@ -149,57 +213,112 @@ class AuditionSystem:
         self.sounds = sounds
 
     def reset(self, model, data) -> None:
-        """The head radii (they change only with an age change, at a reset), then hear."""
-        r = model.geom_size[self.heads, 0]
-        self._radius = r[:, None]                              # (n, 1)
-        self._r2 = (r * r)[:, None]
-        self._two_r = 2.0 * self._radius
-        self._itd_scale = (1000.0 / SPEED_OF_SOUND) * self._radius   # ms per (theta + sin)
+        """The head radii (they change only with an age change, at a reset), the echoic
+        memories cleared, then hear."""
+        for _, memory in self.memories.values():
+            memory.reset()
+        r = model.geom_size[self.heads[self.listeners], 0][:, None, None]    # (l, 1, 1)
+        self._r2 = r[..., 0] ** 2                              # (l, 1)
+        self._two_r = 2.0 * r * _LR                            # (l, 1, 2): the ears' -+ 2 r y
+        self._itd_scale = (1000.0 / SPEED_OF_SOUND) * r[..., 0]   # ms per (theta + sin theta)
+        # the same per listener as Python floats: r^2, 2 r, half the shadow, threshold, ITD scale
+        self._listener_floats = list(zip(
+            self._r2[:, 0].tolist(), (2.0 * r[:, 0, 0]).tolist(),
+            self._shade[:, 0, 0].tolist(), self._thr[:, 0, 0].tolist(),
+            self._itd_scale[:, 0].tolist()))
         self.update(model, data)
 
     def update(self, model, data) -> None:
         L, S = self.listeners, self.sources
-        out = self.features
         if not len(L) or not len(S):
             return
-        sounds = self.sounds
-        kind = sounds[S, 0].astype(np.intp)
+        kind = self.sounds[S, 0]
         if not kind.any():                     # every voice silent: nothing to hear
-            out[L] = self._silence
+            self.features[L] = self._silence
             self.waves[L] = 0.0
+            for _, memory in self.memories.values():
+                memory.push(0.0)
             return
-        heads, Sx, Lx = self.heads, self._s_index, self._l_index   # slices when all agents
-        centre = data.geom_xpos[heads]                         # (n, 3)
-        frame = data.geom_xmat[heads].reshape(-1, 3, 3)        # columns: x, y, z axes
-        mouth = centre[Sx] + frame[Sx, :, 0] * self._radius[Sx]   # on the face (+x)
-        # each mouth in each listener's head frame, (l, s, 3); y: towards the left ear
-        local = np.matmul(mouth[None] - centre[Lx][:, None], frame[Lx])
+        # each mouth in each listener's head frame (MuJoCo's sensors, brought up to the poses
+        # the senses read: mj_step computed them before its last integration), (l, s, 3)
+        mujoco.mj_sensorPos(model, data)
+        local = data.sensordata[self._block]
+        rows = self._rows
+        if self.scalar:
+            self._hear_floats(local, rows)
+        else:
+            self._hear_arrays(local.reshape(self._pairs), kind, rows)
+        if not self._in_place:
+            self.features[L] = rows
+        if self.memories:
+            k = len(SOUNDS)
+            loudest = np.maximum(rows[..., k], rows[..., k + 1])     # (l, s): the louder ear
+            for row, memory in self.memories.values():
+                memory.push(loudest[row])
+        if self.wave:
+            k = len(SOUNDS)
+            self.waves[L] = binaural_frames(kind.astype(np.intp), rows[..., k:k + 2],
+                                            rows[..., k + 3], float(data.time), self.n_samples)
+
+    def _hear_arrays(self, local, kind, rows) -> None:
+        """Every pair's row at once in numpy (many pairs); ``local`` (l, s, 3)."""
         y = local[..., 1]
         dist2 = (local * local).sum(-1)
-        # squared distances to the ears at (0, +-r, 0): dist2 + r^2 -+ 2 r y
-        d2 = (dist2 + self._r2[Lx])[..., None] + (y * self._two_r[Lx])[..., None] * _LR
+        # the level at each ear, (l, s, 2): the squared distance to the ears at (0, +-r, 0) is
+        # dist2 + r^2 -+ 2 r y; the source's level, spherical spreading, the head shadow
+        level = y[..., None] * self._two_r
+        level += (dist2 + self._r2)[..., None]
+        np.maximum(level, MIN_DISTANCE ** 2, out=level)
+        np.log10(level, out=level)
+        level *= -10.0
+        level += np.where(kind != 0, self.sounds[self.sources, 1], _SILENT_DB)[:, None]
         sin_lat = y / np.sqrt(dist2 + 1e-18)
         np.minimum(np.maximum(sin_lat, -1.0, out=sin_lat), 1.0, out=sin_lat)
-        feat = np.empty(d2.shape[:2] + (len(FEATURES),))
-        level = feat[..., :2]
-        np.log10(np.maximum(d2, MIN_DISTANCE ** 2), out=level)
-        level *= -10.0
-        level += sounds[S, 1][None, :, None] + sin_lat[..., None] * self._shade[Lx]
-        level[level <= self._thr] = 0.0
-        heard = (level.max(-1) > 0.0) & (kind != 0)           # (l, s)
-        level *= heard[..., None]
-        np.subtract(level[..., 0], level[..., 1], out=feat[..., 2])
-        np.multiply(np.arcsin(sin_lat) + sin_lat, self._itd_scale[Lx] * heard,
-                    out=feat[..., 3])
+        level += sin_lat[..., None] * self._shade
+        level *= level > self._thr             # at or below the threshold: not heard (0)
+        heard = level.any(-1)                  # (l, s); a silent source is never heard
         k = len(SOUNDS)
-        rows = out if isinstance(Lx, slice) else np.empty((len(L),) + out.shape[1:], out.dtype)
-        rows[..., :k] = self._one_hot[np.where(heard, kind, 0)]
-        rows[..., k:] = feat
-        if rows is not out:
-            out[L] = rows
-        if self.wave:
-            self.waves[L] = binaural_frames(kind, level, feat[..., 3], float(data.time),
-                                            self.n_samples)
+        rows[..., :k] = self._one_hot[np.where(heard, kind, 0).astype(np.intp)]
+        rows[..., k:k + 2] = level
+        np.subtract(level[..., 0], level[..., 1], out=rows[..., k + 2])
+        itd = np.arcsin(sin_lat)
+        itd += sin_lat
+        itd *= self._itd_scale
+        itd *= heard
+        rows[..., k + 3] = itd
+
+    def _hear_floats(self, local, rows) -> None:
+        """Every pair's row with Python floats, the same formulas as :meth:`_hear_arrays` (few
+        pairs: there numpy's cost per call outweighs its speed per value)."""
+        k, width = len(SOUNDS), self.width
+        loc = local.tolist()
+        sounds = self.sounds.tolist()
+        voices = [sounds[j] for j in self._source_list]
+        values = [0.0] * (len(loc) // 3 * width)
+        floor = MIN_DISTANCE ** 2
+        p = 0
+        for r2, two_r, shade, threshold, itd_scale in self._listener_floats:
+            for kind, db in voices:
+                base = p // 3 * width
+                if kind:
+                    x, y, z = loc[p], loc[p + 1], loc[p + 2]
+                    dist2 = x * x + y * y + z * z
+                    s = y / math.sqrt(dist2 + 1e-18)
+                    s = 1.0 if s > 1.0 else (-1.0 if s < -1.0 else s)
+                    near, side = dist2 + r2, two_r * y
+                    left = db - 10.0 * math.log10(max(near - side, floor)) + s * shade
+                    right = db - 10.0 * math.log10(max(near + side, floor)) - s * shade
+                    left = left if left > threshold else 0.0
+                    right = right if right > threshold else 0.0
+                    if left or right:
+                        values[base + int(kind)] = 1.0
+                        values[base + k:base + k + 4] = (
+                            left, right, left - right, (math.asin(s) + s) * itd_scale)
+                        p += 3
+                        continue
+                values[base] = 1.0             # heard as silence
+                p += 3
+        rows.reshape(-1)[:] = values             # a view: rows are contiguous
 
 
 class Audition:
@@ -217,11 +336,17 @@ class Audition:
             w = system.wave_space
             self.spaces["audition_waveform"] = spaces.Box(w.low.copy(), w.high.copy(),
                                                           dtype=np.float32)
+        self.memory = system.memories.get(index, (0, None))[1]
+        if self.memory is not None:
+            self.spaces["audition_memory"] = spaces.Box(
+                0.0, system.level_max, (self.memory.frames, len(system.sources)), np.float32)
 
     def observe(self, model, data, out: dict) -> None:
         out[self.name] = self.system.features[self.index].copy()
         if self.waveform:
             out["audition_waveform"] = self.system.waves[self.index].copy()
+        if self.memory is not None:
+            out["audition_memory"] = self.memory.read()
 
 
 def build_audition(world, configs):
@@ -229,4 +354,5 @@ def build_audition(world, configs):
     return system, [Audition(system, i, c) if c else None for i, c in enumerate(configs)]
 
 
-SENSE = SenseEntry("audition", AuditionConfig, shared=build_audition)
+SENSE = SenseEntry("audition", AuditionConfig, shared=build_audition,
+                   add_to_spec=add_hearing_sensors)

@@ -54,13 +54,16 @@ class SenseEntry:
 
     ``per_agent(config, world, index, actuation)`` builds agent ``index``'s sense;
     ``shared(world, configs)`` builds the world's system and every agent's sense (None where
-    the sense is off) from the configs of all agents (None where off).
+    the sense is off) from the configs of all agents (None where off). ``add_to_spec(spec,
+    names, agent_configs)``, when given, adds what the sense needs to the world's MjSpec before
+    it compiles (e.g. MuJoCo sensors), from every agent's name and ``AgentConfig``.
     """
 
     name: str
     config: type
     per_agent: Callable[..., Sense] | None = None
     shared: Callable[..., tuple[SharedSystem, list[Sense | None]]] | None = None
+    add_to_spec: Callable[..., None] | None = None
 
     def __post_init__(self):
         if (self.per_agent is None) == (self.shared is None):

@@ -69,3 +69,13 @@ def test_every_configuration_warms_up_before_it_is_timed(monkeypatch):
     (row,) = vision_cost.bench_env({"touch": dict(n_agents=1, touch=True)}, sim_seconds=0.15)
     assert len(made) == vision_cost.WARMUP_STEPS + 15
     assert len(row["turn_s"]) == 1 and row["sim_s"] == pytest.approx(0.15)
+
+
+def test_hearing_paths_time_both_ways_and_name_the_one_taken():
+    """The audition update's two ways are both timed inside the step, at each agent count."""
+    rows = development.hearing_paths(agents=(2, 8), steps=100)
+    assert [r["pairs"] for r in rows] == [4, 64]
+    assert [r["default"] for r in rows] == ["floats", "arrays"]
+    assert all(r["floats_us"] > 0 and r["arrays_us"] > 0 for r in rows)
+    table = development.format_hearing_paths(rows)
+    assert "| 8 | 64 |" in table and table.count("\n") == 5

@@ -216,3 +216,118 @@ def test_the_binaural_frame_carries_level_and_itd(side):
 def test_no_waveform_by_default():
     env = pair((1.0, 0.0))
     assert "audition_waveform" not in env.observation_space(env.possible_agents[0]).spaces
+
+
+def _random_steps(env, steps, seed):
+    """``steps`` steps of random motors and random sounds; yields after each."""
+    rng = np.random.default_rng(seed)
+    for _ in range(steps):
+        action = {}
+        for a in env.possible_agents:
+            space = env.action_space(a)
+            action[a] = {"motors": rng.uniform(-1, 1, space["motors"].shape).astype(np.float32),
+                         "expression": 0}
+            if "voice" in space.spaces:
+                action[a].update(voice=int(rng.integers(len(SOUNDS))),
+                                 loudness=[float(rng.uniform())])
+        env.step(action)
+        yield
+
+
+@pytest.mark.parametrize("settings", [
+    dict(n_agents=2),
+    dict(n_agents=3, per_agent=[{"body": "adult"}, {"audition": False}, {"voice": False}]),
+    dict(n_agents=2, audition={"threshold_db": 60.0, "head_shadow_db": 15.0}),
+])
+def test_python_floats_and_numpy_arrays_hear_the_same(settings):
+    """The two ways of computing the rows (few pairs: Python floats, many: numpy) agree."""
+    settings = {"voice": True, "audition": True, **settings}
+    env = free_play_v0.parallel_env(max_steps=10 ** 6, **settings)
+    env.reset(seed=2)
+    system, w = env.unwrapped.systems["audition"], env.world
+    assert system.scalar             # a few pairs: the floats by default
+    for _ in _random_steps(env, 60, 1):
+        system.update(w.model, w.data)
+        floats = system.features.copy()
+        system.scalar = False
+        system.update(w.model, w.data)
+        system.scalar = True
+        arrays = system.features
+        assert np.array_equal(floats[..., :K], arrays[..., :K])
+        np.testing.assert_allclose(floats, arrays, rtol=1e-6, atol=1e-5)
+
+
+def test_hearing_follows_the_poses_the_other_senses_read():
+    """Levels from the head poses after the step (not MuJoCo's sensors of the state before its
+    last integration): the mouth-to-ear distances of the geoms match the ILD at every step."""
+    env = pair((0.0, 0.4), audition={"head_shadow_db": 0.0})
+    w, listener, speaker = env.world, env.world.agents[0], env.world.agents[1]
+    rng = np.random.default_rng(4)
+    for _ in range(40):
+        motors = {a: rng.uniform(-1, 1, env.action_space(a)["motors"].shape).astype(np.float32)
+                  for a in env.possible_agents}
+        obs, *_ = env.step({a: {"motors": m, "expression": 0, "voice": CRY, "loudness": [1.0]}
+                            for a, m in motors.items()})
+        row = obs["infant_0"]["audition"][1]
+        h, g = listener.head_geom, speaker.head_geom
+        ears = w.data.geom_xpos[h] + np.outer(
+            [1, -1], w.data.geom_xmat[h].reshape(3, 3)[:, 1] * w.model.geom_size[h, 0])
+        mouth = w.data.geom_xpos[g] + (w.data.geom_xmat[g].reshape(3, 3)[:, 0]
+                                       * w.model.geom_size[g, 0])
+        d = np.linalg.norm(mouth - ears, axis=1)
+        assert row[ILD] == pytest.approx(20 * np.log10(d[1] / d[0]), abs=1e-4)
+
+
+def test_after_an_age_change_the_ears_hear_as_a_fresh_body():
+    """The mouth and the ears move with the head at an age change without compiling."""
+    grown = free_play_v0.parallel_env(n_agents=2, voice=True, audition=True, age_months=6.0,
+                                      max_steps=100)
+    grown.reset(seed=0)
+    grown.set_age(age_months=18.0)
+    fresh = free_play_v0.parallel_env(n_agents=2, voice=True, audition=True, age_months=18.0,
+                                      max_steps=100)
+    o1, _ = grown.reset(seed=5)
+    o2, _ = fresh.reset(seed=5)
+    for kinds in [(CRY, 2), (1, SILENCE), (4, 5)]:
+        a, b = say(grown, kinds), say(fresh, kinds)
+        for agent in a:
+            np.testing.assert_allclose(a[agent]["audition"], b[agent]["audition"], atol=1e-4)
+    assert say(grown)["infant_0"]["audition"][1, CRY] == 1.0
+
+
+def test_echoic_memory_keeps_what_was_heard_and_moves_it_back():
+    """A 30-ms cry stays in the memory's newest frame for a bin, then moves one frame back a
+    bin later; silence leaves zeros; the memory is cleared at reset."""
+    env = pair((1.0, 0.0), audition={"memory_s": 0.5, "memory_bin_s": 0.1})
+    space = env.observation_space("infant_0")["audition_memory"]
+    assert space.shape == (5, 2)
+    memories = [say(env, (SILENCE, CRY if t < 3 else SILENCE))["infant_0"]["audition_memory"]
+                for t in range(25)]
+    assert all(space.contains(m) for m in memories)
+    first = heard_level = memories[0][0, 1]
+    assert heard_level > 60.0 and memories[0][0, 0] == 0.0     # the listener itself was silent
+    assert [(m[:, 1] > 0).tolist() for m in (memories[9], memories[10], memories[22])] == [
+        [True, False, False, False, False], [True, True, False, False, False],
+        [False, False, True, False, False]]
+    assert memories[22][2, 1] == pytest.approx(first, abs=0.1)   # the loudest of 3 steps
+    assert env.reset(seed=1)[0]["infant_0"]["audition_memory"].sum() == 0.0
+
+
+def test_echoic_memory_holds_the_loudest_level_of_each_bin_and_pickles():
+    env = pair((1.0, 0.0), audition={"memory_s": 0.2, "memory_bin_s": 0.05})
+    quiet = say(env, (SILENCE, CRY), loudness=0.0)["infant_0"]["audition_memory"][0, 1]
+    loud = say(env, (SILENCE, CRY), loudness=1.0)["infant_0"]["audition_memory"][0, 1]
+    assert loud > quiet > 0.0
+    assert say(env, (SILENCE, CRY), loudness=0.0)["infant_0"]["audition_memory"][0, 1] == loud
+    copy = pickle.loads(pickle.dumps(env))
+    for kinds in [(1, 0), (0, 0), (2, 3), (0, 0)]:
+        a, b = say(env, kinds), say(copy, kinds)
+        assert np.array_equal(a["infant_0"]["audition_memory"], b["infant_0"]["audition_memory"])
+
+
+def test_without_memory_there_is_no_memory_key_and_bad_memory_is_refused():
+    env = pair((1.0, 0.0))
+    assert "audition_memory" not in env.observation_space("infant_0").spaces
+    for bad in ({"memory_s": -1.0}, {"memory_s": 11.0}, {"memory_bin_s": 0.0}):
+        with pytest.raises(ConfigError, match="memory"):
+            pair((1.0, 0.0), audition=bad)
