@@ -19,7 +19,8 @@ from test_layers import GRAPH, MODULES, PKG  # this folder is on the path (pytes
 
 TASKS = PKG / "tasks"
 #: the modules of tasks/ that are not a task's folder: helpers several tasks share
-SHARED = {"mimo_social.tasks", "mimo_social.tasks.common", "mimo_social.tasks.dyad"}
+SHARED = {"mimo_social.tasks", "mimo_social.tasks.common", "mimo_social.tasks.dyad",
+          "mimo_social.tasks.facing_pair"}
 
 
 def _folder(module: str) -> str | None:

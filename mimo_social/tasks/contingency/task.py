@@ -8,14 +8,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...body.joint_groups import GAZE_JOINTS, held_posture
 from ...core.task import Plot, Task, TaskOptions
-from ...core.world import AgentSetup
 from ...expressions.faces import EXPRESSIONS
 from ...partners.base import Partner
 from ...util.checks import ConfigError, check_choice
-from ..common import face_to_face
-from ..dyad import held_angles, tables_of, task_plan
+from ..facing_pair import FacingPair
 from ...core.factory import make_aec, make_parallel, with_options
 
 __all__ = ["CONDITIONS", "MEASURES", "ContingencyOptions", "Contingency", "ContingencyCaregiver",
@@ -141,7 +138,7 @@ class ContingencyMeasures:
                 "contingency_index": response - baseline}
 
 
-class Contingency(Task):
+class Contingency(FacingPair, Task):
     name = "contingency"
     n_agents_range = (2, 2)
     default_n_agents = 2
@@ -169,42 +166,7 @@ class Contingency(Task):
         scripted = i == 1 and self.options.scripted_partner
         out = {"expressions": True, "vestibular": False,
                "vision": False if scripted else {"width": EYE_SIZE, "height": EYE_SIZE}}
-        if i == 0:
-            out["posture"] = "standing"
-        else:
-            body = settings.get("body", "adult")
-            out["body"] = body
-            out["posture"] = "kneeling" if body == "adult" else "standing"
-        return out
-
-    def _free(self, i) -> tuple[str, ...]:
-        """Agent i's motor joints: the learner's head and eyes with ``gaze_free``, else none."""
-        return GAZE_JOINTS if i == 0 and self.options.gaze_free else ()
-
-    def held_joints(self, i, config):
-        """Agent i's held joints (rad): all but its free ones, standing knees a little bent, or
-        its own posture's angles (the kneeling adult)."""
-        angles = held_angles(config, "standing", {"right_knee": -5, "left_knee": -5})
-        return held_posture(tables_of(config), keep=self._free(i), angles=angles)
-
-    def setup(self, i, config):
-        plan = task_plan(self, "standing", self.options.distance, self.held_joints, (0, 1))
-        pos, facing = face_to_face(i, plan.distance)
-        free = self._free(i)
-        aimed = {k: v for k, v in plan.gaze[i].items() if k not in free}
-        frozen = {**self.held_joints(i, config), **aimed}
-        return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
-                          frozen=frozen, base="fixed", actuated=free)
-
-    def bind(self, env):
-        """The learner's head and eye dofs (``gaze_free``: gravity on them is cancelled)."""
-        a = env.world.agents[0]
-        self._head_dofs = a.dof_adr[a.actuated_joint_idx]
-
-    def before_physics(self, env):
-        if len(self._head_dofs):     # head support: a zero action holds the head up
-            d = env.world.data
-            d.qfrc_applied[self._head_dofs] = d.qfrc_bias[self._head_dofs]
+        return {**out, **self.pair_defaults(i, settings)}
 
     # -- running -------------------------------------------------------------------------------
     def reset(self, env, rng):

@@ -7,15 +7,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...body.joint_groups import GAZE_JOINTS, held_posture
 from ...core.factory import make_aec, make_parallel, with_options
 from ...core.task import Plot, Task, TaskOptions
-from ...core.world import AgentSetup
 from ...expressions.voice import SOUNDS
 from ...partners.base import Partner, zero_action
 from ...util.checks import ConfigError, check_choice
-from ..common import face_to_face
-from ..dyad import held_angles, tables_of, task_plan
+from ..facing_pair import FacingPair
 from .schedule import (ContingentSchedule, Latency, TimedSchedule, poisson_onsets, steps_of,
                        yoked_onsets)
 from .turns import INFO_KEYS, TurnMeasures
@@ -79,7 +76,7 @@ class TurnTakingOptions(TaskOptions):
                 "'contingent'")
 
 
-class TurnTaking(Task):
+class TurnTaking(FacingPair, Task):
     name = "turn_taking"
     n_agents_range = (2, 2)
     default_n_agents = 2
@@ -106,38 +103,7 @@ class TurnTaking(Task):
     def agent_defaults(self, i, settings):
         out = {"expressions": False, "voice": True, "vestibular": False, "vision": False,
                "audition": not (i == 1 and self.options.scripted_partner)}
-        if i == 0:
-            out["posture"] = "standing"
-        else:
-            body = settings.get("body", "adult")
-            out["body"] = body
-            out["posture"] = "kneeling" if body == "adult" else "standing"
-        return out
-
-    def _free(self, i) -> tuple[str, ...]:
-        return GAZE_JOINTS if i == 0 and self.options.gaze_free else ()
-
-    def held_joints(self, i, config):
-        angles = held_angles(config, "standing", {"right_knee": -5, "left_knee": -5})
-        return held_posture(tables_of(config), keep=self._free(i), angles=angles)
-
-    def setup(self, i, config):
-        plan = task_plan(self, "standing", self.options.distance, self.held_joints, (0, 1))
-        pos, facing = face_to_face(i, plan.distance)
-        free = self._free(i)
-        aimed = {k: v for k, v in plan.gaze[i].items() if k not in free}
-        frozen = {**self.held_joints(i, config), **aimed}
-        return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
-                          frozen=frozen, base="fixed", actuated=free)
-
-    def bind(self, env):
-        a = env.world.agents[0]
-        self._head_dofs = a.dof_adr[a.actuated_joint_idx]
-
-    def before_physics(self, env):
-        if len(self._head_dofs):     # head support: a zero action holds the head up
-            d = env.world.data
-            d.qfrc_applied[self._head_dofs] = d.qfrc_bias[self._head_dofs]
+        return {**out, **self.pair_defaults(i, settings)}
 
     # -- running -------------------------------------------------------------------------------
     def reset(self, env, rng):
