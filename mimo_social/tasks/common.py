@@ -1,4 +1,5 @@
-"""Helpers shared by the tasks: placement, contacts, skin settings, postures, settling.
+"""Helpers shared by the tasks: placement, contacts, skin settings, postures, settling, the
+summary of a paradigm's conditions.
 
 Tasks import these (and :mod:`mimo_social.body.joint_groups`, :mod:`mimo_social.core.kinematics`);
 no task imports another task's module.
@@ -16,7 +17,8 @@ from ..util.checks import ConfigError
 
 __all__ = ["CROSS_LEGGED_DEG", "HAND_TOUCH_DENSITY", "face_to_face", "geoms_touching",
            "ContactProbe", "parts_outside", "skin_parts", "right_hand_parts", "touch_only_on",
-           "require_skin", "hands_setting", "settle"]
+           "require_skin", "hands_setting", "settle", "condition_means",
+           "condition_rows", "condition_effects", "format_condition_effects"]
 
 #: sitting cross-legged, the trunk bent forward, the left hand on the lap (the self-body pose;
 #: social touch uses its legs)
@@ -147,3 +149,64 @@ def settle(env, steps: int, gravity: bool = True) -> None:
         m.opt.gravity[:] = saved
     d.time = 0.0
     mujoco.mj_forward(m, d)
+
+
+def condition_means(finals: Sequence[Mapping[str, Any]], conditions: Sequence[str],
+                    measures: Sequence[str]) -> dict[str, dict[str, tuple[float, float]]]:
+    """Per condition, each of ``measures``' mean and sd over the episodes, from each episode's
+    last-step info (its ``condition`` code is the index in ``conditions``); conditions without
+    an episode are left out; ``"episodes"``: their count."""
+    out: dict[str, dict[str, tuple[float, float]]] = {}
+    for code, cond in enumerate(conditions):
+        got = [f for f in finals if int(f["condition"]) == code]
+        if not got:
+            continue
+        out[cond] = {m: (float(np.mean([float(r[m]) for r in got])),
+                         float(np.std([float(r[m]) for r in got]))) for m in measures}
+        out[cond]["episodes"] = (float(len(got)), 0.0)
+    return out
+
+
+def condition_rows(summaries: Sequence[Mapping], conditions: Sequence[str],
+                   measures: Sequence[str]) -> list[tuple[str, list[str]]]:
+    """The lines of a table of :func:`condition_means` results, a cell per learner: per
+    condition (those every summary has) each measure, mean +- sd over episodes."""
+    out = []
+    for cond in conditions:
+        if not all(cond in s for s in summaries):
+            continue
+        for m in measures:
+            out.append((f"{cond}: {m}", [f"{s[cond][m][0]:.2f} +- {s[cond][m][1]:.2f}"
+                                         for s in summaries]))
+    return out
+
+
+def condition_effects(finals: Sequence[Mapping[str, Any]], blocks: int,
+                      conditions: Sequence[str], measures: Sequence[str]) -> dict:
+    """A paradigm's effect from ``blocks`` blocks of one episode per condition (``finals``:
+    the last-step infos, block by block, in the order of ``conditions``): per other condition
+    ``"<first>_minus_<other>"``, each measure's per-block difference of the first condition
+    minus that one, mean and sd over blocks; ``"episodes"``: ``blocks``."""
+    v = np.array([[float(f[m]) for m in measures] for f in finals], float)
+    v = v.reshape(blocks, len(conditions), len(measures))     # block x condition x measure
+    out: dict[str, Any] = {"episodes": blocks}
+    for k, other in enumerate(conditions[1:], start=1):
+        d = v[:, 0] - v[:, k]
+        out[f"{conditions[0]}_minus_{other}"] = {
+            m: (float(mean), float(sd)) for m, mean, sd in zip(measures, d.mean(axis=0),
+                                                              d.std(axis=0))}
+    return out
+
+
+def format_condition_effects(result: Mapping, title: str, conditions: Sequence[str],
+                             measures: Sequence[str]) -> str:
+    """:func:`condition_effects`' result as a markdown table: a row per measure, a column per
+    difference (mean +- sd over blocks)."""
+    cols = [f"{conditions[0]}_minus_{c}" for c in conditions[1:]]
+    lines = [f"{title} effects over {result['episodes']} blocks (mean +- sd)",
+             "| measure | " + " | ".join(c.replace("_", " ") for c in cols) + " |",
+             "|---" * (len(cols) + 1) + "|"]
+    for m in measures:
+        cells = [f"{result[c][m][0]:+.3f} +- {result[c][m][1]:.3f}" for c in cols]
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)

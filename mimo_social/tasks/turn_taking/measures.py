@@ -16,11 +16,11 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence
 
-import numpy as np
-
 from ...core.episodes import run_episodes
 from ...partners.policy_adapter import as_learner
 from ...util.checks import check_int
+from ..common import (condition_effects, condition_means, condition_rows,
+                      format_condition_effects)
 from .task import CONDITIONS, MEASURES, scripted_env
 
 __all__ = ["UNIT", "AGENT", "EFFECT_MEASURES", "summarize", "run", "rows", "effects",
@@ -37,15 +37,7 @@ EFFECT_MEASURES = ("infant_rate_per_min", "speech_like_fraction", "answered_frac
 def summarize(finals: Sequence[Mapping[str, Any]]) -> dict[str, dict[str, tuple[float, float]]]:
     """Per condition, each :data:`MEASURES` entry's mean and sd over episodes, from each
     episode's last-step info (its ``condition`` code says the condition)."""
-    out: dict[str, dict[str, tuple[float, float]]] = {}
-    for code, cond in enumerate(CONDITIONS):
-        got = [f for f in finals if int(f["condition"]) == code]
-        if not got:
-            continue
-        out[cond] = {m: (float(np.mean([float(r[m]) for r in got])),
-                         float(np.std([float(r[m]) for r in got]))) for m in MEASURES}
-        out[cond]["episodes"] = (float(len(got)), 0.0)
-    return out
+    return condition_means(finals, CONDITIONS, MEASURES)
 
 
 def _blocks(env, learner, episodes: int, seed: int) -> list[dict]:
@@ -73,14 +65,7 @@ def run(learner, episodes: int, seed: int, env) -> dict:
 def rows(summaries: Sequence[Mapping]) -> list[tuple[str, list[str]]]:
     """The table's lines for :func:`run`'s summaries, a cell per learner: per condition each
     measure (mean +- sd over blocks)."""
-    out = []
-    for cond in CONDITIONS:
-        if not all(cond in s for s in summaries):
-            continue
-        for m in MEASURES:
-            out.append((f"{cond}: {m}", [f"{s[cond][m][0]:.2f} +- {s[cond][m][1]:.2f}"
-                                         for s in summaries]))
-    return out
+    return condition_rows(summaries, CONDITIONS, MEASURES)
 
 
 def effects(policy, episodes: int = 10, seed: int = 0,
@@ -96,28 +81,15 @@ def effects(policy, episodes: int = 10, seed: int = 0,
         finals = _blocks(env, as_learner(policy, deterministic), episodes, seed)
     finally:
         env.close()
-    v = np.array([[float(f[m]) for m in EFFECT_MEASURES] for f in finals], float)
-    v = v.reshape(episodes, len(CONDITIONS), len(EFFECT_MEASURES))
-    out: dict[str, Any] = {"episodes": episodes}
-    for k, other in enumerate(CONDITIONS[1:], start=1):
-        d = v[:, 0] - v[:, k]
-        out[f"contingent_minus_{other}"] = {
-            m: (float(mean), float(sd))
-            for m, mean, sd in zip(EFFECT_MEASURES, d.mean(axis=0), d.std(axis=0))}
+    out = condition_effects(finals, episodes, CONDITIONS, EFFECT_MEASURES)
     out["summary"] = summarize(finals)
     return out
 
 
 def format_effects(result: Mapping) -> str:
-    """:func:`effects`' result as a markdown table (mean +- sd over blocks)."""
-    cols = [f"contingent_minus_{c}" for c in CONDITIONS[1:]]
-    lines = [f"turn-taking effects over {result['episodes']} blocks (mean +- sd)",
-             "| measure | " + " | ".join(c.replace("_", " ") for c in cols) + " |",
-             "|---" * (len(cols) + 1) + "|"]
-    for m in EFFECT_MEASURES:
-        cells = [f"{result[c][m][0]:+.3f} +- {result[c][m][1]:.3f}" for c in cols]
-        lines.append(f"| {m} | " + " | ".join(cells) + " |")
-    return "\n".join(lines)
+    """:func:`effects`' result as a markdown table: a row per measure, a column per
+    difference (mean +- sd over blocks)."""
+    return format_condition_effects(result, "turn-taking", CONDITIONS, EFFECT_MEASURES)
 
 
 def latencies(episodes: int = 5, seed: int = 0, controller: Any = None,
