@@ -26,6 +26,6 @@ if ! $PY -c "import torch" >/dev/null 2>&1; then
   echo "[setup] installing torch==2.13.0 (CPU build)"
   $PY -m pip install -q "torch==2.13.0"
 fi
-echo "[setup] installing mimo-social with its train, dev and docs extras"
-$PY -m pip install -q -e ".[train,dev,docs]"
+echo "[setup] installing mimo-social with its train, dev, docs and gpu extras"
+$PY -m pip install -q -e ".[train,dev,docs,gpu]"
 echo "[setup] done"

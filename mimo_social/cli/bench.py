@@ -9,6 +9,7 @@
     mimo-social bench training     PPO's steps/s against the env alone     (cli/bench_training.py)
     mimo-social bench soak         growth of memory, threads, open files   (cli/bench_soak.py)
     mimo-social bench ages         age change at reset vs fresh build      (cli/bench_ages.py)
+    mimo-social bench gpu          MuJoCo Warp worlds: agent-steps/s       (cli/bench_gpu.py)
 
 Each module has ``NAME``, ``HELP``, ``add_parser(subparsers, name, **kw)`` and ``run(args)``.
 
@@ -26,7 +27,7 @@ import functools
 import sys
 
 from . import bench_ages, bench_development, bench_engines, bench_floor, bench_recording
-from . import bench_sim, bench_soak, bench_training, bench_vision
+from . import bench_gpu, bench_sim, bench_soak, bench_training, bench_vision
 
 __all__ = ["MEASUREMENTS", "OLD_NAMES", "add_parser", "old_form"]
 
@@ -34,7 +35,7 @@ __all__ = ["MEASUREMENTS", "OLD_NAMES", "add_parser", "old_form"]
 MEASUREMENTS = {module.NAME: module for module in (bench_sim, bench_floor, bench_vision,
                                                    bench_recording, bench_development,
                                                    bench_engines, bench_training,
-                                                   bench_soak, bench_ages)}
+                                                   bench_soak, bench_ages, bench_gpu)}
 #: old top-level command -> its measurement (kept for one release, not listed in the help)
 OLD_NAMES = {"bench-vision": "vision", "bench-recording": "recording",
              "bench-development": "development", "bench-engines": "engines", "soak": "soak"}

@@ -26,7 +26,7 @@ LAYERS = {
     "partners": 4,
     "tasks": 5,
     "envs": 6,
-    "recording": 7,
+    "recording": 7, "gpu": 7,
     "train": 8, "bench": 8, "experiments": 8, "figures": 8,
     "cli": 9,
 }

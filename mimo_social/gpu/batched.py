@@ -1,0 +1,205 @@
+"""N worlds of one CPU env's scene stepped together on MuJoCo Warp (``mujoco_warp``).
+
+:class:`BatchedEnv` takes an env of the catalogue as built on the CPU (e.g.
+``free_play_v0.parallel_env(n_agents=2)``), resets it once, puts its compiled model on the
+Warp device and makes ``nworld`` copies of its reset state there. Each :meth:`BatchedEnv.step`
+maps every agent's batched motor actions to controls as the CPU env does
+(:mod:`mimo_social.gpu.controls`), advances every world by the env's ``frame_skip`` physics
+steps of its ``timestep`` and reads every agent's proprioception in the CPU sense's layout
+(:mod:`mimo_social.gpu.proprioception`). Actions and observations are torch tensors on the
+device (``wp.to_torch``: no copy); numpy actions are taken too.
+
+What stays on the CPU (docs/gpu.md): the other senses (vestibular, touch, vision, audition),
+muscles, expressions and voice (visual and auditory only: the batched actions are the motors),
+and the task's logic (rewards, success, terminations, its per-step hooks and its resets: every
+world restarts from the one reset state of the CPU env).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.world import World
+from .controls import AgentControls
+from .device import describe, pick_device, require
+from .proprioception import BatchedProprioception
+
+__all__ = ["BatchedEnv", "STATE_FIELDS"]
+
+#: the fields of MuJoCo Warp's data that hold a world's state, restored at a reset
+STATE_FIELDS = ("time", "qpos", "qvel", "act", "history", "qacc_warmstart", "ctrl",
+                "qfrc_applied", "xfrc_applied", "eq_active", "mocap_pos", "mocap_quat",
+                "userdata")
+#: the fields read each step (as tensors, no copy)
+READ_FIELDS = ("qpos", "qvel", "qacc", "ctrl", "qfrc_actuator", "actuator_force")
+
+
+class BatchedEnv:
+    """``nworld`` copies of ``env`` (a :class:`~mimo_social.core.env.MimoParallelEnv`) on the
+    Warp device ``device`` (None: ``"cuda"`` when Warp sees a GPU, else ``"cpu"``).
+
+    ``env`` is reset with ``seed``; that state is every world's start and reset state.
+    ``nconmax`` / ``njmax``: contacts / constraint rows allocated per world (None: from the
+    reset state, with room to spare); a step that needs more raises a RuntimeError naming
+    the setting to raise. Steps are checked for divergence as the CPU world checks them
+    (:attr:`World.VEL_LIMIT`, :attr:`World.ACC_LIMIT`), once per control step: a world past
+    them is put back to the reset state and flagged in the step's ``unstable``.
+    """
+
+    def __init__(self, env, nworld: int, device: str | None = None, seed: int | None = 0,
+                 nconmax: int | None = None, njmax: int | None = None):
+        wp, mjw, torch = require()
+        if isinstance(nworld, bool) or not isinstance(nworld, (int, np.integer)) or nworld < 1:
+            raise ValueError(f"nworld={nworld!r} not allowed; allowed: an integer >= 1")
+        self.nworld = int(nworld)
+        self.device = pick_device(device)
+        self.device_name = describe(self.device)
+        self._wp, self._mjw, self._torch = wp, mjw, torch
+        self.env = env
+        self.agents = list(env.possible_agents)
+        self.frame_skip = int(env.physics.frame_skip)
+        self.timestep = float(env.physics.timestep)
+        self.dt = self.timestep * self.frame_skip
+        env.reset(seed=seed)
+        mjm, mjd = env.world.model, env.world.data
+        self.nconmax, self.njmax = self._sizes(mjm, mjd, len(self.agents), nconmax, njmax)
+        with wp.ScopedDevice(self.device):
+            self.model = mjw.put_model(mjm)
+            self.data = mjw.put_data(mjm, mjd, nworld=self.nworld, nconmax=self.nconmax,
+                                     njmax=self.njmax)
+        self.naconmax = self.nconmax * self.nworld
+        self.tensors = {f: wp.to_torch(getattr(self.data, f)) for f in READ_FIELDS}
+        self._state = {f: wp.to_torch(getattr(self.data, f)) for f in STATE_FIELDS
+                       if getattr(self.data, f, None) is not None
+                       and getattr(self.data, f).size}
+        self._start = {f: t[0].clone() for f, t in self._state.items()}
+        tdev = self.tensors["qpos"].device
+        self.controls, self.senses = [], []
+        for i, name in enumerate(self.agents):
+            act = env.actuation[i]
+            delays = env.delay_steps(name)
+            observed = _positional_reset_u(act, mjm, mjd)
+            c = AgentControls(name, act, delays["motor"], env.controls[i], self.nworld,
+                              torch, tdev, reset_observed=observed)
+            self.controls.append(c)
+            prop = [s for s in env.senses[i] if s.name == "proprioception"]
+            self.senses.append(BatchedProprioception(prop[0], delays["proprioception"], c,
+                                                     self.nworld, torch, tdev)
+                               if prop else None)
+        self._graph = None
+        self.steps = 0
+
+    # -- sizes -----------------------------------------------------------------------------------
+    @staticmethod
+    def _sizes(mjm, mjd, n_agents, nconmax, njmax) -> tuple[int, int]:
+        """Contacts and constraint rows per world: given, or from the reset state with room for
+        every agent lying on the floor touching another (an infant lying down: 30-40 contacts;
+        4 rows a pyramidal contact, 6 an elliptic)."""
+        if nconmax is None:
+            nconmax = max(4 * int(mjd.ncon), 96 * n_agents)
+        if njmax is None:
+            rows = int(mjd.nefc) - 4 * int(mjd.ncon)     # limits, equalities, friction loss
+            njmax = max(2 * max(rows, 0) + 6 * nconmax, 256)
+        for key, v in (("nconmax", nconmax), ("njmax", njmax)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+                raise ValueError(f"{key}={v!r} not allowed; allowed: an integer >= 1 or None")
+        return int(nconmax), int(njmax)
+
+    # -- the loop --------------------------------------------------------------------------------
+    def reset(self, worlds=None) -> dict:
+        """Every world (``worlds``: a bool mask or tensor of ``nworld``, the worlds to reset;
+        None: all) back to the reset state; returns the observations (agent -> sense ->
+        ``(nworld, size)`` tensor; rows of worlds not reset: not meaningful)."""
+        torch = self._torch
+        dev = self.tensors["qpos"].device
+        mask = torch.ones(self.nworld, dtype=torch.bool, device=dev) if worlds is None else \
+            torch.as_tensor(worlds, dtype=torch.bool, device=dev).reshape(self.nworld)
+        for f, t in self._state.items():
+            t[mask] = self._start[f]
+        for c in self.controls:
+            c.reset(None if worlds is None else mask)
+        with self._wp.ScopedDevice(self.device):
+            self._mjw.forward(self.model, self.data)
+        if worlds is None:
+            self.steps = 0
+        return {a: ({} if s is None else {s.name: s.reset(self.tensors,
+                                                          None if worlds is None else mask)})
+                for a, s in zip(self.agents, self.senses)}
+
+    def step(self, actions) -> tuple[dict, object]:
+        """One control step of every world. ``actions``: agent -> ``(nworld, n_controls)``
+        motor values (torch or numpy; each agent's motor Box, clipped into it). Returns the
+        observations (agent -> sense -> ``(nworld, size)``) and ``unstable``, a bool tensor of
+        the worlds that diverged and were reset."""
+        if not hasattr(actions, "keys") or set(actions) != set(self.agents):
+            raise ValueError(f"actions must be a dict with one (nworld, n_controls) array per "
+                             f"agent of {self.agents}; got "
+                             f"{sorted(actions) if hasattr(actions, 'keys') else type(actions)}")
+        checked = [c.check(actions[a]) for a, c in zip(self.agents, self.controls)]
+        ctrl = self.tensors["ctrl"]
+        for c, u in zip(self.controls, checked):
+            c.step(u, ctrl)
+        self._physics()
+        self.steps += 1
+        self._check_overflow()
+        unstable = self._unstable()
+        obs = {a: ({} if s is None else {s.name: s.observe(self.tensors)})
+               for a, s in zip(self.agents, self.senses)}
+        if bool(unstable.any()):
+            fresh = self.reset(unstable)
+            for a in self.agents:
+                for k, v in fresh[a].items():
+                    obs[a][k][unstable] = v[unstable]
+        return obs, unstable
+
+    def _physics(self) -> None:
+        """``frame_skip`` physics steps of every world; on a GPU replayed as one CUDA graph."""
+        wp, mjw = self._wp, self._mjw
+        with wp.ScopedDevice(self.device):
+            if not wp.get_device(self.device).is_cuda:
+                for _ in range(self.frame_skip):
+                    mjw.step(self.model, self.data)
+                return
+            if self._graph is None:
+                with wp.ScopedCapture(force_module_load=True) as capture:
+                    for _ in range(self.frame_skip):
+                        mjw.step(self.model, self.data)
+                self._graph = capture.graph
+            wp.capture_launch(self._graph)
+
+    def _check_overflow(self) -> None:
+        nacon = int(self.data.nacon.numpy()[0])
+        nefc = int(self.data.nefc.numpy().max())
+        if nacon > self.naconmax:
+            raise RuntimeError(f"{nacon} contacts in the {self.nworld} worlds, beyond the "
+                               f"{self.naconmax} allocated; give a larger nconmax (now "
+                               f"{self.nconmax} per world)")
+        if nefc > self.njmax:
+            raise RuntimeError(f"{nefc} constraint rows in a world, beyond njmax={self.njmax}; "
+                               f"give a larger njmax")
+
+    def _unstable(self):
+        torch = self._torch
+        v, a = self.tensors["qvel"], self.tensors["qacc"]
+        ok = (v.abs() <= World.VEL_LIMIT).all(dim=1) & (a.abs() <= World.ACC_LIMIT).all(dim=1)
+        return ~ok.to(torch.bool)
+
+    # -- reading ---------------------------------------------------------------------------------
+    @property
+    def qpos(self):
+        """Every world's ``qpos``, ``(nworld, nq)`` float32 tensor (a view)."""
+        return self.tensors["qpos"]
+
+    def n_controls(self, agent: str) -> int:
+        """The number of motor values of ``agent``'s actions."""
+        return self.controls[self.agents.index(agent)].n
+
+
+def _positional_reset_u(act, mjm, mjd):
+    """The controls a positional agent reports at reset (the targets of the pose it holds:
+    :meth:`Positional.reset`), else None."""
+    lo, hi = getattr(act, "lo", None), getattr(act, "hi", None)
+    if lo is None or act.name != "positional":
+        return None
+    q = mjd.qpos[mjm.jnt_qposadr[mjm.actuator_trnid[act.actuator_ids, 0]]]
+    return np.clip(2.0 * (q - lo) / (hi - lo) - 1.0, -1.0, 1.0)

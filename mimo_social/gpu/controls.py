@@ -1,0 +1,124 @@
+"""Batched actions to MuJoCo controls, as the CPU env turns one agent's action into
+``data.ctrl`` (:meth:`mimo_social.core.env.MimoParallelEnv.step`), for every world at once.
+
+Per agent and world: the motor values are clipped into the action Box, delayed by the agent's
+motor delay (a ring of ``k + 1`` rows filled at reset with the controls in force then, the
+CPU env's :class:`~mimo_social.core.delays.MotorDelay`), then mapped by the actuation model:
+
+* spring-damper: ``ctrl = u T_pos`` for ``u >= 0``, ``u T_neg`` below (the motors' maximum
+  voluntary torques; :class:`~mimo_social.body.actuation.SpringDamper`);
+* positional: ``ctrl = lo + (u + 1) (hi - lo) / 2``, the target angle of MuJoCo's servo
+  (:class:`~mimo_social.body.actuation.Positional`; the servo gains are in the compiled model).
+
+Muscles compute their torques in Python before every physics step (activation dynamics and the
+force-length-velocity curves): no plain MuJoCo control reproduces them, so they are refused.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..body.actuation import Positional, SpringDamper
+
+__all__ = ["AgentControls", "SUPPORTED", "check_actuation"]
+
+#: the actuation models the device reproduces (``AgentConfig.actuation``)
+SUPPORTED = ("spring_damper", "positional")
+
+
+def check_actuation(agent: str, act) -> None:
+    """A ValueError naming ``agent`` and its actuation model when the device cannot run it."""
+    if type(act) not in (SpringDamper, Positional):
+        raise ValueError(f"{agent}: actuation={getattr(act, 'name', type(act).__name__)!r} does "
+                         f"not run on the GPU backend (muscle torques are computed in Python "
+                         f"before every physics step); allowed: {', '.join(SUPPORTED)}")
+
+
+class AgentControls:
+    """One agent's actions for ``nworld`` worlds: clipping, motor delay, actuation mapping.
+
+    ``act``: the agent's actuation object in the CPU env; ``delay``: its motor delay in
+    control steps; ``reset_controls``: its controls in force at reset (``env.controls[i]``);
+    ``reset_observed``: the controls its proprioception reports at reset (None: those; a
+    positional agent reports the targets of the pose it holds, :meth:`Positional.reset`)."""
+
+    def __init__(self, agent: str, act, delay: int, reset_controls, nworld: int, torch, device,
+                 reset_observed=None):
+        check_actuation(agent, act)
+        self.agent = agent
+        self.positional = isinstance(act, Positional)
+        self.nworld = int(nworld)
+        self.n = act.n_controls
+        self.delay = int(delay)
+        self._torch = torch
+        as_t = lambda x: torch.as_tensor(np.asarray(x, np.float32), device=device)  # noqa: E731
+        self.low, self.high = as_t(act.control_low), as_t(act.control_high)
+        self.ids = torch.as_tensor(np.asarray(act.actuator_ids, np.int64), device=device)
+        if self.positional:
+            self.a, self.b = as_t(act.lo), as_t(0.5 * (act.hi - act.lo))
+        else:
+            self.a, self.b = as_t(act.torque_neg), as_t(act.torque_pos)
+        self._reset = as_t(reset_controls)
+        self._observed = self._reset if reset_observed is None else as_t(reset_observed)
+        self.ring = torch.zeros((self.delay + 1, self.nworld, self.n), dtype=torch.float32,
+                                device=device)
+        self.applied = torch.zeros((self.nworld, self.n), dtype=torch.float32, device=device)
+        self._next = 0
+        self.reset()
+
+    def reset(self, worlds=None) -> None:
+        """The controls in force at reset, in every slot of the ring (``worlds``: a bool mask
+        of the worlds to reset; None: all)."""
+        if worlds is None:
+            self.ring[:] = self._reset
+            self.applied[:] = self._observed
+            self._next = 0
+        else:
+            self.ring[:, worlds] = self._reset
+            self.applied[worlds] = self._observed
+
+    def check(self, u):
+        """``u`` as a float32 tensor ``(nworld, n)`` on the device; a ValueError naming the agent
+        for a wrong shape or NaN/inf."""
+        t = self._torch
+        u = t.as_tensor(u, device=self.low.device)
+        if tuple(u.shape) != (self.nworld, self.n):
+            raise ValueError(f"{self.agent}: actions of shape {tuple(u.shape)}; expected "
+                             f"({self.nworld}, {self.n}): one row of {self.n} motor values per "
+                             f"world")
+        if u.dtype.is_complex or u.dtype == t.bool or not u.dtype.is_floating_point and \
+                u.dtype not in (t.int8, t.int16, t.int32, t.int64, t.uint8):
+            raise ValueError(f"{self.agent}: actions of dtype {u.dtype}; expected real numbers")
+        u = u.to(t.float32)
+        if not bool(t.isfinite(u).all()):
+            raise ValueError(f"{self.agent}: actions hold NaN/inf; values must be finite")
+        return u
+
+    def step(self, u, ctrl) -> None:
+        """Clip ``u`` (checked), push it through the delay ring and write the agent's controls
+        into ``ctrl`` (the batched ``data.ctrl`` as a tensor, ``(nworld, nu)``)."""
+        t = self._torch
+        clipped = t.minimum(t.maximum(u, self.low), self.high)
+        if self.delay:
+            self.ring[self._next] = clipped
+            self._next = (self._next + 1) % (self.delay + 1)
+            self.applied = self.ring[self._next].clone()
+        else:
+            self.applied = clipped
+        ctrl[:, self.ids] = self.map(self.applied).to(ctrl.dtype)
+
+    def map(self, u):
+        """The MuJoCo controls of applied controls ``u`` (see the module)."""
+        if self.positional:
+            return self.a + (u + 1.0) * self.b
+        return u * self._torch.where(u >= 0.0, self.b, self.a)
+
+    def observation(self, data_tensors):
+        """The actuation part of proprioception, ``[u, torque]`` per motor: spring-damper the
+        applied torque, positional the servo's output (``actuator_force``)."""
+        t = self._torch
+        if self.positional:
+            torque = data_tensors["actuator_force"][:, self.ids]
+        else:
+            torque = self.applied * t.where(self.applied >= 0.0, self.b, self.a)
+        return t.cat([self.applied, torque.to(t.float32)], dim=1)
