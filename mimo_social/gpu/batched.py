@@ -7,7 +7,9 @@ maps every agent's batched motor actions to controls as the CPU env does
 (:mod:`mimo_social.gpu.controls`), advances every world by the env's ``frame_skip`` physics
 steps of its ``timestep`` and reads every agent's proprioception in the CPU sense's layout
 (:mod:`mimo_social.gpu.proprioception`). Actions and observations are torch tensors on the
-device (``wp.to_torch``: no copy); numpy actions are taken too.
+device (``wp.to_torch``: no copy); numpy actions are taken too. On a GPU, Warp works on torch's
+current stream and the physics steps of a control step are one CUDA graph (this path has not
+run on a GPU yet: no GPU was lent when it was written, docs/gpu.md).
 
 What stays on the CPU (docs/gpu.md): the other senses (vestibular, touch, vision, audition),
 muscles, expressions and voice (visual and auditory only: the batched actions are the motors),
@@ -16,6 +18,8 @@ world restarts from the one reset state of the CPU env).
 """
 
 from __future__ import annotations
+
+import contextlib
 
 import numpy as np
 
@@ -118,7 +122,7 @@ class BatchedEnv:
             t[mask] = self._start[f]
         for c in self.controls:
             c.reset(None if worlds is None else mask)
-        with self._wp.ScopedDevice(self.device):
+        with self._on_device():
             self._mjw.forward(self.model, self.data)
         if worlds is None:
             self.steps = 0
@@ -155,17 +159,31 @@ class BatchedEnv:
     def _physics(self) -> None:
         """``frame_skip`` physics steps of every world; on a GPU replayed as one CUDA graph."""
         wp, mjw = self._wp, self._mjw
-        with wp.ScopedDevice(self.device):
-            if not wp.get_device(self.device).is_cuda:
+        with self._on_device() as stream:
+            if stream is None:
                 for _ in range(self.frame_skip):
                     mjw.step(self.model, self.data)
                 return
             if self._graph is None:
-                with wp.ScopedCapture(force_module_load=True) as capture:
+                with wp.ScopedCapture(stream=stream, force_module_load=True) as capture:
                     for _ in range(self.frame_skip):
                         mjw.step(self.model, self.data)
                 self._graph = capture.graph
-            wp.capture_launch(self._graph)
+            wp.capture_launch(self._graph, stream=stream)
+
+    @contextlib.contextmanager
+    def _on_device(self):
+        """Warp's work on the device; on a GPU on torch's current stream (the actions written
+        by torch come before the physics that reads them, the observations after it): yields
+        that Warp stream, None on the CPU."""
+        wp = self._wp
+        with wp.ScopedDevice(self.device):
+            if not wp.get_device(self.device).is_cuda:
+                yield None
+                return
+            stream = wp.stream_from_torch(self.tensors["qpos"].device)
+            with wp.ScopedStream(stream):
+                yield stream
 
     def _check_overflow(self) -> None:
         nacon = int(self.data.nacon.numpy()[0])
