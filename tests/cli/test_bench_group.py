@@ -11,7 +11,7 @@ from mimo_social import cli
 from mimo_social.cli import bench
 
 NEW = ["sim", "floor", "vision", "recording", "development", "engines", "training", "soak",
-       "ages"]
+       "ages", "gpu"]
 #: old command line -> the same command under its new name (every argument has a default but
 #: engines' --out)
 OLD = {

@@ -143,3 +143,31 @@ def test_random_actions_and_the_flat_action_carry_the_voice(env):
     wrapped = FlattenParallel(free_play_v0.parallel_env(n_agents=2, voice=True, audition=True))
     wrapped.reset(seed=0)
     wrapped.step({a: wrapped.action_space(a).sample() for a in wrapped.agents})
+
+
+def test_a_voice_only_agent_takes_its_sound_id():
+    """No motors, no face: the flat action is the sound id (Discrete), at a fixed loudness;
+    the SB3 env of the turn-taking learner with its gaze held is such an agent."""
+    from gymnasium import spaces
+
+    from mimo_social.core.action_decoder import VOICE_ONLY_LOUDNESS, ActionDecoder
+    from mimo_social.train.envs import make_sb3_single
+
+    space = spaces.Dict({"motors": spaces.Box(-1, 1, (0,), np.float32),
+                         "voice": spaces.Discrete(len(SOUNDS)),
+                         "loudness": spaces.Box(0, 1, (1,), np.float32)})
+    decode = ActionDecoder(space)
+    assert decode.space == spaces.Discrete(len(SOUNDS))
+    action = decode(3)
+    assert action["voice"] == 3 and action["loudness"][0] == VOICE_ONLY_LOUDNESS
+    assert space.contains(action)
+    assert decode.encode(action) == 3
+    for bad in (1.5, "coo", [1, 2]):
+        with pytest.raises(ValueError, match="infant_0: action field 'voice'"):
+            decode(bad, "infant_0")
+    env = make_sb3_single("mimo_social/TurnTaking-v0", task_options={"gaze_free": False})
+    assert env.action_space == spaces.Discrete(len(SOUNDS))
+    env.reset(seed=0)
+    info = env.step(2)[-1]
+    assert info["infant_sound"] == 2
+    env.close()
