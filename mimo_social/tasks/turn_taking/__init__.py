@@ -92,9 +92,11 @@ baselines:
     step (64 % on: the PPO pilot's hack, version history) 0 / 20, 0; 0.2 s of babble whenever
     both have been silent 1.5 s 20 / 20, 13.45 +- 1.4 answers, and 0.3 s 20 / 20, 15.25 +- 1.6:
     the reward's optimum is to vocalise and leave the turn, i.e. uses the contingency. Learner
-    (recipe `turn_taking`, PPO, 1M steps, seeds 0 and 1, 30 episodes; `mimo-social recipe
-    turn_taking --seeds 0,1`): 0 % with the mean action and sampled in both (return 0.0 and
-    0.2), 32-33 min a seed (docs/training/issue30/recipes/turn_taking)
+    (recipe `turn_taking`, `mimo-social recipe turn_taking --seeds 0,1`, 30 episodes): echoic
+    memory on (audition `memory_s` 2), gaze held (the action: the sound kind), a warm start
+    cloned from 20 scripted episodes, PPO 200k steps with the cloning kept: sampled 100 % in
+    both seeds (return 18.7, 16.7), the most likely sound 0 % (silence), 12 min a seed; plain
+    PPO, 1M steps, no memory: 0 % both ways (docs/training/issue30/recipes/turn_taking*)
 summary:
     `measures.run` / `measures.effects` run blocks of a contingent, a non-contingent (yoked to
     the block's contingent episode) and a replay episode; measured, 10 blocks, seeds 1000-1009
