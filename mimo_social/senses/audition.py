@@ -93,6 +93,7 @@ class AuditionConfig:
     # echoic memory (:mod:`.echoic`): "audition_memory", the loudest level heard from each source
     # in each bin of memory_bin_s over the last memory_s seconds (0: off)
     memory_s: float = 0.0
+    # s: the width of one bin of the echoic memory (rounded to whole control steps, at least one)
     memory_bin_s: float = 0.1
 
     def __post_init__(self):

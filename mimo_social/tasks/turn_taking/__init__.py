@@ -114,7 +114,16 @@ summary:
     (+0.01 / +0.005; 0.40 in each condition, 2 of 5 kinds), its vocalisations per minute (about
     840: a new kind nearly every step) +12 +- 16 / +18 +- 23 (noise); zero action 0 on every
     measure. The caregiver's latencies, as scheduled, follow the configured lognormal
-    (`tests/tasks/test_turn_taking.py`, a Kolmogorov-Smirnov check; `measures.latencies`)
+    (`tests/tasks/test_turn_taking.py`, a Kolmogorov-Smirnov check; `measures.latencies`).
+    Learnt infants (the recipe's two seeds, sampled actions, 10 blocks, seeds 1000-1009:
+    `mimo-social paradigm turn_taking --learner RUN0 RUN1 --stochastic --episodes 10 --seed
+    1000`; docs/training/issue30/recipes/turn_taking/paradigm.md): contingent minus
+    noncontingent / minus replay, seed 0 and seed 1: answered share +0.24 and +0.30 / +0.06 and
+    +0.19, turns +10.9 and +12.4 / +2.0 and +5.6, speech-like share +0.10 and +0.11 / -0.01 and
+    +0.05; vocalisations per minute -1.8 and -0.9 / -0.2 and -1.0 (27-34 a minute in every
+    condition): unlike the scripted infant, whose rule raises its rate within the episode as
+    answers come, the learnt policy is the same in every condition (it does not learn within an
+    episode), so it takes more turns where answers come but does not vocalise more
 sources:
     not in the MIMo paper: a paradigm of this package after Goldstein, King and West (2003, PNAS
     100:8030-8035: mothers of 8-month-olds answered their babbling contingently or, in a yoked
