@@ -48,6 +48,17 @@ def is_expression_only(space: spaces.Space) -> bool:
             and isinstance(space["expression"], spaces.Discrete))
 
 
+def _one_id(action, who: str, field: str, what: str, first: int, n: int, agent: str):
+    """``action`` as one integer id of ``n`` from ``first`` (np.int64), else a ValueError naming
+    the agent, the field, the value and what is allowed."""
+    allowed = f"one {what} id, an integer {first}..{first + n - 1}"
+    v = _numbers(action, who, field, allowed)
+    if v.size != 1 or not np.isfinite(v).all() or v.ravel()[0] != int(v.ravel()[0]):
+        raise ValueError(f"{who}: action field {field!r} = {action!r:.120} not allowed "
+                         f"({agent}); {allowed}")
+    return np.int64(int(v.ravel()[0]))
+
+
 def is_voice_only(space: spaces.Space) -> bool:
     """True for ``Dict(motors=Box with no values, voice=Discrete, loudness=Box((1,)))``."""
     return (isinstance(space, spaces.Dict) and set(space.spaces) == {"motors", "voice", "loudness"}
@@ -113,22 +124,13 @@ class ActionDecoder:
 
     def __call__(self, action, who: str = "agent"):
         if self.voice_only:
-            first = self.voice_start
-            allowed = f"one sound id, an integer {first}..{first + self.n_voices - 1}"
-            v = _numbers(action, who, "voice", allowed)
-            if v.size != 1 or not np.isfinite(v).all() or v.ravel()[0] != int(v.ravel()[0]):
-                raise ValueError(f"{who}: action field 'voice' = {action!r:.120} not allowed "
-                                 f"(a voice-only agent); {allowed}")
-            return {"motors": self._motors, "voice": np.int64(int(v.ravel()[0])),
-                    "loudness": self._loudness.copy()}
+            kind = _one_id(action, who, "voice", "sound", self.voice_start, self.n_voices,
+                           "a voice-only agent")
+            return {"motors": self._motors, "voice": kind, "loudness": self._loudness.copy()}
         if self.discrete:
-            first = self.expression_start
-            allowed = f"one expression id, an integer {first}..{first + self.n_expressions - 1}"
-            e = _numbers(action, who, "expression", allowed)
-            if e.size != 1 or not np.isfinite(e).all() or e.ravel()[0] != int(e.ravel()[0]):
-                raise ValueError(f"{who}: action field 'expression' = {action!r:.120} not "
-                                 f"allowed (a face-only agent); {allowed}")
-            return {"motors": self._motors, "expression": np.int64(int(e.ravel()[0]))}
+            face = _one_id(action, who, "expression", "expression", self.expression_start,
+                           self.n_expressions, "a face-only agent")
+            return {"motors": self._motors, "expression": face}
         layout = f"{self.n_motors} motors" + (
             f" + {self.n_expressions} expression logits" if self.n_expressions else "") + (
             f" + {self.n_voices} voice logits + loudness" if self.n_voices else "")
