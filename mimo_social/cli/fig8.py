@@ -8,13 +8,19 @@ an interrupted reproduction goes on), then writes ``OUT/fig8.png``, ``OUT/fig8.m
 
 from __future__ import annotations
 
-from ..train.fig8 import FIG8_STEPS, FIG8_TASKS, fig8
+from ..train.fig8 import FIG8_STEPS, FIG8_TASKS, fig8, redraw
 from ._args import comma_choices, non_negative_int, output_dir, positive_int, seed
 
 __all__ = ["add_parser"]
 
 
 def _main(args) -> int:
+    if args.redraw:
+        png = redraw(args.redraw, args.recipe_runs, tasks=args.tasks)
+        print(f"wrote {png}")
+        return 0
+    if args.out is None:
+        raise ValueError("--out is needed (or --redraw FIGURE_DIR); allowed: a directory")
     steps = {t: {k: v for k, v in (("ppo", args.ppo_steps), ("sac", args.sac_steps)) if v}
              for t in args.tasks}
     png = fig8(args.out, args.seeds, args.tasks, steps=steps, jobs=args.jobs,
@@ -33,7 +39,7 @@ def add_parser(subparsers) -> None:
         "reach, standup, selfbody and catch (and the shipped recipes with --recipes), then plot "
         "the learning curves over environment steps and wall time and evaluate the final "
         f"models. Default budgets: {budgets}.")
-    p.add_argument("--out", type=output_dir, required=True, help="output directory")
+    p.add_argument("--out", type=output_dir, default=None, help="output directory")
     p.add_argument("--seeds", type=positive_int, default=5, help="seeds per algorithm (0..n-1)")
     p.add_argument("--tasks", type=comma_choices(FIG8_TASKS, "task"), default=list(FIG8_TASKS),
                    help="comma-separated subset of " + ",".join(FIG8_TASKS))
@@ -53,4 +59,10 @@ def add_parser(subparsers) -> None:
     p.add_argument("--eval-seed", type=seed, default=1000, help="seed of the first of them")
     p.add_argument("--plot-only", action="store_true", help="plot and tabulate existing runs")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    p.add_argument("--redraw", metavar="FIGURE_DIR", default=None,
+                   help="draw FIGURE_DIR/fig8.png again from its <task>/compare.csv files (no "
+                   "models needed, nothing trained)")
+    p.add_argument("--recipe-runs", metavar="DIR", default=None,
+                   help="with --redraw: the recipe runs DIR/<task>/seed<k> (config.json, "
+                   "progress.csv) beside the learners")
     p.set_defaults(func=_main)

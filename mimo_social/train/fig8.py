@@ -25,7 +25,7 @@ from typing import Mapping, Sequence
 
 from .tasks import TrainInputError
 
-__all__ = ["FIG8_TASKS", "FIG8_STEPS", "fig8"]
+__all__ = ["FIG8_TASKS", "FIG8_STEPS", "fig8", "redraw"]
 
 #: the paper's four learning tasks (its Fig. 8 a-d)
 FIG8_TASKS = ("reach", "standup", "selfbody", "catch")
@@ -145,3 +145,60 @@ def fig8(out: str | Path = "runs/fig8", seeds: int = 5, tasks: Sequence[str] = F
                                                "recipes": recipes, "machine": _machine()},
                                               indent=1))
     return png
+
+
+def _split_compare(csv: Path, task_dir: Path) -> None:
+    """``compare.csv`` (a row per evaluation of every run) back into one ``<group>_seed<k>``
+    folder per run with its ``progress.csv`` and the ``config.json`` fields the plots read."""
+    import csv as csvlib
+    with csv.open() as f:
+        rows = list(csvlib.DictReader(f))
+    runs: dict[tuple[str, str], list[dict]] = {}
+    for row in rows:
+        runs.setdefault((row["algo"], row["seed"]), []).append(row)
+    for (group, seed), rs in runs.items():
+        algo, _, recipe = group.partition(" ")
+        run = task_dir / f"{'recipe' if recipe else algo}_seed{seed}"
+        run.mkdir(parents=True, exist_ok=True)
+        fields = [k for k in rs[0] if k not in ("algo", "seed")]
+        lines = [",".join(fields)] + [",".join(r[k] for k in fields) for r in rs]
+        (run / "progress.csv").write_text("\n".join(lines) + "\n")
+        config = {"algo": algo, "seed": int(seed), **({"recipe": task_dir.name} if recipe else {})}
+        (run / "config.json").write_text(json.dumps(config))
+
+
+def redraw(figure_dir: str | Path, recipe_runs: str | Path | None = None,
+           png: str | Path | None = None, tasks: Sequence[str] = FIG8_TASKS) -> Path:
+    """Fig. 8 drawn again from what a reproduction leaves in the documentation, without its
+    models: each task's ``FIGURE_DIR/<task>/compare.csv`` (PPO and SAC, every evaluation of
+    every seed) and, with ``recipe_runs``, the recipe runs under ``RECIPE_RUNS/<task>/seed<k>``
+    (their ``config.json`` and ``progress.csv``, as ``mimo-social recipe`` writes them; they
+    replace any recipe rows of ``compare.csv``). Steps on a log axis when a recipe's budget is
+    over five times the learners'. Returns the PNG (default ``FIGURE_DIR/fig8.png``)."""
+    import shutil
+    import tempfile
+    from .plots import plot_fig8
+
+    figure_dir = Path(figure_dir)
+    found = [t for t in tasks if (figure_dir / t / "compare.csv").exists()]
+    if not found:
+        raise TrainInputError(f"{figure_dir}: no <task>/compare.csv for any of {list(tasks)}; "
+                              "allowed: a folder that `mimo-social fig8` wrote")
+    longest = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for task in found:
+            _split_compare(figure_dir / task / "compare.csv", Path(tmp) / task)
+            ours = [r for r in (sorted(Path(recipe_runs).glob(f"{task}/seed*"))
+                                if recipe_runs else []) if (r / "progress.csv").exists()]
+            for old in sorted((Path(tmp) / task).glob("recipe_seed*")) if ours else []:
+                shutil.rmtree(old)
+            for run in ours:
+                dest = Path(tmp) / task / f"recipe_{run.name}"
+                dest.mkdir(parents=True, exist_ok=True)
+                shutil.copy(run / "progress.csv", dest / "progress.csv")
+                config = json.loads((run / "config.json").read_text())
+                config.setdefault("recipe", task)
+                (dest / "config.json").write_text(json.dumps(config))
+                longest[task] = max(longest.get(task, 0), int(config.get("steps", 0)))
+        log = any(n > 5 * max(FIG8_STEPS[t].values()) for t, n in longest.items())
+        return plot_fig8(tmp, found, png or figure_dir / "fig8.png", log_steps=log)

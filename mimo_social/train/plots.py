@@ -297,11 +297,13 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
     return png
 
 
-def plot_fig8(out: str | Path, tasks, png: str | Path | None = None) -> Path:
+def plot_fig8(out: str | Path, tasks, png: str | Path | None = None,
+              log_steps: bool = False) -> Path:
     """The paper's Fig. 8 from ``OUT/<task>/<group>_seed<k>`` runs: a row per task, the
     evaluation return against environment steps (left) and wall time (right); per algorithm (and
     recipe) a thin line per seed, the mean over seeds (solid: mean action; dashed: sampled
-    actions) and the min-max band."""
+    actions) and the min-max band. ``log_steps``: both x axes logarithmic (budgets that differ
+    tenfold side by side)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -326,6 +328,8 @@ def plot_fig8(out: str | Path, tasks, png: str | Path | None = None) -> Path:
                         None, ls="--")
             ax.set_title(f"{task}: evaluation return", fontsize=10)
             ax.set_xlabel(xlabel)
+            if log_steps:
+                ax.set_xscale("log")
             if j == 0:
                 _steps_axis(ax)
             ax.set_ylabel("episode return")

@@ -4,6 +4,7 @@ figure over the tasks, a compare plot and a baselines table per task."""
 
 import json
 import os
+from pathlib import Path
 
 import pytest
 
@@ -63,3 +64,44 @@ def test_fig8_refuses_other_tasks_and_bad_counts(tmp_path, capsys):
     with pytest.raises(SystemExit) as e:
         main(["fig8", "--out", str(tmp_path), "--tasks", "reach,juggle"])
     assert e.value.code == 2 and "unknown task 'juggle'" in capsys.readouterr().err
+
+
+def _capture_plot(monkeypatch):
+    """Replace the figure with a record of the runs it was given (groups, seeds, last steps)."""
+    import mimo_social.train.plots as plots
+    seen = {}
+
+    def record(out, tasks, png=None, log_steps=False):
+        for t in tasks:
+            seen[t] = {g: sorted((c["seed"], int(p["timesteps"][-1])) for c, p in rs)
+                       for g, rs in runs_by_group(Path(out) / t).items()}
+        seen["log"] = log_steps
+        return png
+    monkeypatch.setattr(plots, "plot_fig8", record)
+    return seen
+
+
+def test_fig8_redraw_from_compare_csv_and_recipe_runs(tmp_path, monkeypatch, capsys):
+    from mimo_social.train.fig8 import redraw
+    fields = "algo,seed,timesteps,wall_time_s,eval_return_mean,eval_return_mean_stochastic"
+    rows = ["ppo,0,2048,1.0,-5,-4", "ppo,0,4096,2.0,-3,-2", "ppo,1,2048,1.1,-6,-5",
+            "sac,0,64,3.0,-9,-9", "ppo recipe,0,5000,4.0,1,1"]
+    (tmp_path / "fig" / "catch").mkdir(parents=True)
+    (tmp_path / "fig" / "catch" / "compare.csv").write_text("\n".join([fields, *rows]) + "\n")
+    seen = _capture_plot(monkeypatch)
+    redraw(tmp_path / "fig")
+    assert seen["catch"] == {"ppo": [(0, 4096), (1, 2048)], "sac": [(0, 64)],
+                             "ppo recipe": [(0, 5000)]}
+    assert seen["log"] is False
+    # recipe runs replace the recipe rows; a budget over 5x the learners' draws steps on a log axis
+    run = tmp_path / "recipes" / "catch" / "seed1"
+    run.mkdir(parents=True)
+    (run / "config.json").write_text(json.dumps({"algo": "ppo", "seed": 1, "steps": 2_000_000,
+                                                 "recipe": "catch"}))
+    (run / "progress.csv").write_text(fields.split(",", 2)[2] + "\n2000000,60,880,881\n")
+    redraw(tmp_path / "fig", tmp_path / "recipes")
+    assert seen["catch"]["ppo recipe"] == [(1, 2_000_000)] and seen["log"] is True
+    with pytest.raises(TrainInputError, match="compare.csv"):
+        redraw(tmp_path / "recipes")
+    assert main(["fig8", "--seeds", "2"]) == 2
+    assert "--out is needed" in capsys.readouterr().err
