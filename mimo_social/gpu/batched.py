@@ -26,16 +26,25 @@ import numpy as np
 from ..core.world import World
 from .controls import AgentControls
 from .device import describe, pick_device, require
+from .contacts import BatchedContacts
 from .proprioception import BatchedProprioception
+from .vestibular import BatchedVestibular
 
-__all__ = ["BatchedEnv", "STATE_FIELDS"]
+__all__ = ["BatchedEnv", "STATE_FIELDS", "DERIVED_FIELDS"]
 
 #: the fields of MuJoCo Warp's data that hold a world's state, restored at a reset
 STATE_FIELDS = ("time", "qpos", "qvel", "act", "history", "qacc_warmstart", "ctrl",
                 "qfrc_applied", "xfrc_applied", "eq_active", "mocap_pos", "mocap_quat",
                 "userdata")
 #: the fields read each step (as tensors, no copy)
-READ_FIELDS = ("qpos", "qvel", "qacc", "ctrl", "qfrc_actuator", "actuator_force")
+READ_FIELDS = ("qpos", "qvel", "qacc", "ctrl", "qfrc_actuator", "actuator_force", "qfrc_bias",
+               "qfrc_spring", "sensordata", "site_xpos", "xpos", "xmat", "geom_xpos", "geom_xmat")
+#: the derived fields a world's reset copies from the CPU env beside its state: what the
+#: observations, the partners and the next step read before the physics recomputes them, and
+#: the poses of the geoms fixed to the world (MuJoCo Warp computes those only once, when the
+#: data is made: a task that moves a fixed body at reset, reach's ball, moves them per world)
+DERIVED_FIELDS = ("qacc", "qfrc_actuator", "actuator_force", "qfrc_bias", "qfrc_spring",
+                  "sensordata", "geom_xpos", "geom_xmat")
 
 
 class BatchedEnv:
@@ -51,7 +60,8 @@ class BatchedEnv:
     """
 
     def __init__(self, env, nworld: int, device: str | None = None, seed: int | None = 0,
-                 nconmax: int | None = None, njmax: int | None = None):
+                 nconmax: int | None = None, njmax: int | None = None,
+                 batch_fields: tuple[str, ...] = ()):
         wp, mjw, torch = require()
         if isinstance(nworld, bool) or not isinstance(nworld, (int, np.integer)) or nworld < 1:
             raise ValueError(f"nworld={nworld!r} not allowed; allowed: an integer >= 1")
@@ -59,6 +69,7 @@ class BatchedEnv:
         self.device = pick_device(device)
         self.device_name = describe(self.device)
         self._wp, self._mjw, self._torch = wp, mjw, torch
+        self.torch = torch
         self.env = env
         self.agents = list(env.possible_agents)
         self.frame_skip = int(env.physics.frame_skip)
@@ -68,11 +79,16 @@ class BatchedEnv:
         mjm, mjd = env.world.model, env.world.data
         self.nconmax, self.njmax = self._sizes(mjm, mjd, len(self.agents), nconmax, njmax)
         with wp.ScopedDevice(self.device):
-            self.model = mjw.put_model(mjm)
+            self.model = mjw.put_model(mjm, {f: self.nworld for f in batch_fields})
             self.data = mjw.put_data(mjm, mjd, nworld=self.nworld, nconmax=self.nconmax,
                                      njmax=self.njmax)
         self.naconmax = self.nconmax * self.nworld
-        self.tensors = {f: wp.to_torch(getattr(self.data, f)) for f in READ_FIELDS}
+        self.tensors = {f: wp.to_torch(getattr(self.data, f)) for f in READ_FIELDS
+                        if getattr(self.data, f).size}
+        #: the model's per-world fields (``batch_fields``) as ``(nworld, ...)`` tensors
+        self.model_tensors = {f: wp.to_torch(getattr(self.model, f)) for f in batch_fields}
+        self.contacts = BatchedContacts(self.model, self.data, mjm, self.nworld, wp, mjw, torch,
+                                        self._on_device)
         self._state = {f: wp.to_torch(getattr(self.data, f)) for f in STATE_FIELDS
                        if getattr(self.data, f, None) is not None
                        and getattr(self.data, f).size}
@@ -86,10 +102,14 @@ class BatchedEnv:
             c = AgentControls(name, act, delays["motor"], env.controls[i], self.nworld,
                               torch, tdev, reset_observed=observed)
             self.controls.append(c)
-            prop = [s for s in env.senses[i] if s.name == "proprioception"]
-            self.senses.append(BatchedProprioception(prop[0], delays["proprioception"], c,
-                                                     self.nworld, torch, tdev)
-                               if prop else None)
+            senses = []
+            for s in env.senses[i]:
+                if s.name == "proprioception":
+                    senses.append(BatchedProprioception(s, delays["proprioception"], c,
+                                                        self.nworld, torch, tdev))
+                elif s.name == "vestibular":
+                    senses.append(BatchedVestibular(s, torch, tdev))
+            self.senses.append(senses)
         self._graph = None
         self.steps = 0
 
@@ -113,11 +133,9 @@ class BatchedEnv:
     def reset(self, worlds=None) -> dict:
         """Every world (``worlds``: a bool mask or tensor of ``nworld``, the worlds to reset;
         None: all) back to the reset state; returns the observations (agent -> sense ->
-        ``(nworld, size)`` tensor; rows of worlds not reset: not meaningful)."""
-        torch = self._torch
-        dev = self.tensors["qpos"].device
-        mask = torch.ones(self.nworld, dtype=torch.bool, device=dev) if worlds is None else \
-            torch.as_tensor(worlds, dtype=torch.bool, device=dev).reshape(self.nworld)
+        ``(nworld, size)`` tensor; rows of worlds not reset: not meaningful). Runs the
+        forward dynamics of every world (see :meth:`load` for a reset that runs none)."""
+        mask = self._mask(worlds)
         for f, t in self._state.items():
             t[mask] = self._start[f]
         for c in self.controls:
@@ -126,15 +144,64 @@ class BatchedEnv:
             self._mjw.forward(self.model, self.data)
         if worlds is None:
             self.steps = 0
-        return {a: ({} if s is None else {s.name: s.reset(self.tensors,
-                                                          None if worlds is None else mask)})
-                for a, s in zip(self.agents, self.senses)}
+        return self._reset_obs(None if worlds is None else mask)
 
-    def step(self, actions) -> tuple[dict, object]:
+    def _mask(self, worlds):
+        torch, dev = self._torch, self.tensors["qpos"].device
+        if worlds is None:
+            return torch.ones(self.nworld, dtype=torch.bool, device=dev)
+        return torch.as_tensor(worlds, dtype=torch.bool, device=dev).reshape(self.nworld)
+
+    def _reset_obs(self, mask) -> dict:
+        return {a: {s.name: s.reset(self.tensors, mask) for s in senses}
+                for a, senses in zip(self.agents, self.senses)}
+
+    def snapshot(self, env) -> dict:
+        """The state of ``env`` (the CPU env this batched env was made from, just reset: e.g.
+        with another seed) that :meth:`load` puts into a world: the state fields, the derived
+        fields the observations and partners read (:data:`DERIVED_FIELDS`), the model fields
+        batched per world, and every agent's controls at reset (host work)."""
+        mjm, mjd = env.world.model, env.world.data
+        snap = {f: np.array(getattr(mjd, f), dtype=np.float64) for f in self._state}
+        snap.update({f: np.array(getattr(mjd, f), dtype=np.float64) for f in DERIVED_FIELDS
+                     if f in self.tensors})
+        snap.update({"model." + f: np.array(getattr(mjm, f), dtype=np.float64)
+                     for f in self.model_tensors})
+        snap["controls"] = [np.array(c, dtype=np.float64) for c in env.controls]
+        snap["observed"] = [_positional_reset_u(act, mjm, mjd) for act in env.actuation]
+        return snap
+
+    def load(self, worlds, snaps) -> dict:
+        """Put ``snaps`` (from :meth:`snapshot`, one per world) into the worlds ``worlds`` (a
+        sequence of world indices); the other worlds are not touched (no physics runs: the
+        derived fields come from the snapshots). Returns the observations as :meth:`reset`
+        (rows of the worlds not loaded: not meaningful)."""
+        torch = self._torch
+        idx = torch.as_tensor(np.asarray(worlds, dtype=np.int64), device=self.qpos.device)
+        if len(snaps) != len(idx):
+            raise ValueError(f"{len(snaps)} snapshots for {len(idx)} worlds")
+        if not len(idx):
+            return self._reset_obs(self._mask(np.zeros(self.nworld, bool)))
+        fields = [(f, t) for f, t in self._state.items()] + \
+            [(f, self.tensors[f]) for f in DERIVED_FIELDS if f in self.tensors] + \
+            [("model." + f, t) for f, t in self.model_tensors.items()]
+        for f, t in fields:
+            rows = torch.as_tensor(np.stack([s[f] for s in snaps]), device=t.device)
+            t[idx] = rows.reshape((len(idx),) + tuple(t.shape[1:])).to(t.dtype)
+        mask = torch.zeros(self.nworld, dtype=torch.bool, device=self.qpos.device)
+        mask[idx] = True
+        for i, c in enumerate(self.controls):
+            observed = [s["observed"][i] for s in snaps]
+            c.reset(mask, np.stack([s["controls"][i] for s in snaps]),
+                    None if observed[0] is None else np.stack(observed), idx)
+        return self._reset_obs(mask)
+
+    def step(self, actions, reset_unstable: bool = True) -> tuple[dict, object]:
         """One control step of every world. ``actions``: agent -> ``(nworld, n_controls)``
         motor values (torch or numpy; each agent's motor Box, clipped into it). Returns the
         observations (agent -> sense -> ``(nworld, size)``) and ``unstable``, a bool tensor of
-        the worlds that diverged and were reset."""
+        the worlds that diverged (put back to the reset state unless ``reset_unstable`` is
+        False: then the caller resets them)."""
         if not hasattr(actions, "keys") or set(actions) != set(self.agents):
             raise ValueError(f"actions must be a dict with one (nworld, n_controls) array per "
                              f"agent of {self.agents}; got "
@@ -147,9 +214,9 @@ class BatchedEnv:
         self.steps += 1
         self._check_overflow()
         unstable = self._unstable()
-        obs = {a: ({} if s is None else {s.name: s.observe(self.tensors)})
-               for a, s in zip(self.agents, self.senses)}
-        if bool(unstable.any()):
+        obs = {a: {s.name: s.observe(self.tensors) for s in senses}
+               for a, senses in zip(self.agents, self.senses)}
+        if reset_unstable and bool(unstable.any()):
             fresh = self.reset(unstable)
             for a in self.agents:
                 for k, v in fresh[a].items():
@@ -161,15 +228,22 @@ class BatchedEnv:
         wp, mjw = self._wp, self._mjw
         with self._on_device() as stream:
             if stream is None:
-                for _ in range(self.frame_skip):
-                    mjw.step(self.model, self.data)
+                self._steps()
                 return
             if self._graph is None:
                 with wp.ScopedCapture(stream=stream, force_module_load=True) as capture:
-                    for _ in range(self.frame_skip):
-                        mjw.step(self.model, self.data)
+                    self._steps()
                 self._graph = capture.graph
             wp.capture_launch(self._graph, stream=stream)
+
+    def _steps(self) -> None:
+        """``frame_skip`` physics steps, then the bodies', geoms' and sites' poses brought up to
+        the state they left (MuJoCo's step leaves those of the state before its last
+        integration), as the CPU world does after its steps (``mj_kinematics``); the contacts
+        stay those of the last step's start, as on the CPU."""
+        for _ in range(self.frame_skip):
+            self._mjw.step(self.model, self.data)
+        self._mjw.kinematics(self.model, self.data)
 
     @contextlib.contextmanager
     def _on_device(self):

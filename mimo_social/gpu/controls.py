@@ -66,32 +66,49 @@ class AgentControls:
         self._next = 0
         self.reset()
 
-    def reset(self, worlds=None) -> None:
+    def reset(self, worlds=None, controls=None, observed=None, rows=None) -> None:
         """The controls in force at reset, in every slot of the ring (``worlds``: a bool mask
-        of the worlds to reset; None: all)."""
+        of the worlds to reset; None: all). ``controls`` / ``observed``: ``(k, n)`` rows of
+        the worlds ``rows`` (indices; the same worlds as the mask) in place of the reset's given
+        at construction (``observed`` None: ``controls``)."""
         if worlds is None:
             self.ring[:] = self._reset
             self.applied[:] = self._observed
             self._next = 0
-        else:
+        elif controls is None:
             self.ring[:, worlds] = self._reset
             self.applied[worlds] = self._observed
+        else:
+            t, dev = self._torch, self.low.device
+            c = t.as_tensor(np.asarray(controls, np.float32), device=dev)
+            o = c if observed is None else t.as_tensor(np.asarray(observed, np.float32),
+                                                       device=dev)
+            self.ring[:, rows] = c
+            self.applied[rows] = o
 
     def check(self, u):
-        """``u`` as a float32 tensor ``(nworld, n)`` on the device; a ValueError naming the agent
-        for a wrong shape or NaN/inf."""
+        """``u`` as a float32 tensor ``(nworld, n)`` on the device; a ValueError naming the agent,
+        the field (its motors), the value and what is allowed for a wrong shape or dtype or
+        NaN/inf."""
         t = self._torch
-        u = t.as_tensor(u, device=self.low.device)
+        try:
+            u = t.as_tensor(u, device=self.low.device)
+        except (TypeError, ValueError, RuntimeError) as e:
+            raise ValueError(f"{self.agent}: motors {type(u).__name__} not allowed ({e}); "
+                             f"allowed: a ({self.nworld}, {self.n}) array of real numbers "
+                             f"(torch or numpy)") from None
         if tuple(u.shape) != (self.nworld, self.n):
-            raise ValueError(f"{self.agent}: actions of shape {tuple(u.shape)}; expected "
+            raise ValueError(f"{self.agent}: motors of shape {tuple(u.shape)}; expected "
                              f"({self.nworld}, {self.n}): one row of {self.n} motor values per "
                              f"world")
         if u.dtype.is_complex or u.dtype == t.bool or not u.dtype.is_floating_point and \
                 u.dtype not in (t.int8, t.int16, t.int32, t.int64, t.uint8):
-            raise ValueError(f"{self.agent}: actions of dtype {u.dtype}; expected real numbers")
+            raise ValueError(f"{self.agent}: motors of dtype {u.dtype}; expected real numbers "
+                             f"(a float or integer dtype)")
         u = u.to(t.float32)
         if not bool(t.isfinite(u).all()):
-            raise ValueError(f"{self.agent}: actions hold NaN/inf; values must be finite")
+            raise ValueError(f"{self.agent}: motors hold NaN/inf; values must be finite, in "
+                             f"[{float(self.low.min()):g}, {float(self.high.max()):g}]")
         return u
 
     def step(self, u, ctrl) -> None:
