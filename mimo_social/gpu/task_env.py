@@ -1,0 +1,193 @@
+"""A batched env with its task: N worlds of a task's env on MuJoCo Warp that return rewards,
+terminations, truncations and the task's infos, and reset finished worlds by themselves.
+
+:class:`BatchedTaskEnv` takes a CPU env of the catalogue: a ParallelEnv (every agent learns)
+or its one-learner form with scripted partners (``high_five_v0.scripted_env()``: the partners
+act on the device, :mod:`mimo_social.gpu.partners`). Each step: the partners' commands from
+the current data, the task's per-step hook, the physics (:class:`BatchedEnv`), the senses, the
+task's rewards and terminations (:mod:`mimo_social.gpu.tasks`), truncation at the env's
+``max_steps`` (per world) and, with ``autoreset``, the finished worlds reset in the same step.
+
+**Resets** are the CPU env's: world ``w``'s ``e``-th episode (from 0) is the CPU env reset with
+seed ``seed + w + e * nworld`` (its partners reset as the one-learner env resets them), its
+state and the draws of the task's reset (reach: the ball, the head and eyes on it; high five:
+the arms' start postures; the partner's targets and gains) copied into the world. That is host
+work (a CPU reset per finished world: about 1 to 5 ms each), and the step that resets worlds
+waits for the device to say which; the steps between resets stay on the device.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .batched import BatchedEnv
+from .partners import batched_partner
+from .tasks import batched_task
+
+__all__ = ["BatchedTaskEnv"]
+
+
+class BatchedTaskEnv:
+    """``nworld`` worlds of ``env``'s task on the Warp device ``device`` (None: a GPU when
+    there is one, else the CPU). ``seed``: the first episodes' seeds (see the module); ``nconmax``
+    / ``njmax``: :class:`BatchedEnv`'s. ``learners``: the agents whose actions :meth:`step`
+    takes; ``partners``: the scripted ones (batched)."""
+
+    def __init__(self, env, nworld: int, device: str | None = None, seed: int = 0,
+                 nconmax: int | None = None, njmax: int | None = None):
+        inner = env.unwrapped
+        scripted = dict(getattr(env, "partners", {}) or {})
+        self.env, self.inner = env, inner
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+            raise ValueError(f"seed={seed!r} not allowed; allowed: an integer >= 0")
+        name = inner.task.name
+        from .tasks import TASKS
+        if name not in TASKS:   # before the model goes to the device
+            raise ValueError(f"task {name!r} has no batched task logic on the GPU backend "
+                             f"(rewards, success, resets); allowed: {', '.join(sorted(TASKS))}")
+        env.reset(seed=int(seed))
+        self.batched = BatchedEnv(inner, nworld, device=device, seed=None, nconmax=nconmax,
+                                  njmax=njmax, batch_fields=TASKS[name].batch_fields)
+        self.torch = self.batched.torch
+        self.nworld = self.batched.nworld
+        self.device_name = self.batched.device_name
+        self.task = batched_task(inner, self.batched)
+        self.partners = {a: batched_partner(a, p, inner, self.batched)
+                         for a, p in scripted.items()}
+        self.agents = list(inner.possible_agents)
+        self.learners = [a for a in self.agents if a not in self.partners]
+        self.max_steps = int(inner.max_steps)
+        self.dt = float(inner.dt)
+        dev = self.batched.qpos.device
+        self.steps = self.torch.zeros(self.nworld, dtype=self.torch.int64, device=dev)
+        self._seed = int(seed)
+        self._episode = np.zeros(self.nworld, np.int64)
+        self._was_reset = False
+
+    # -- resets ----------------------------------------------------------------------------------
+    def seed_of(self, world: int) -> int:
+        """The seed of ``world``'s current episode."""
+        return self._seed + int(world) + int(self._episode[world]) * self.nworld
+
+    def reset(self, seed: int | None = None, worlds=None):
+        """Reset the worlds ``worlds`` (indices or a bool mask; None: all) with their seeds'
+        CPU resets. ``seed`` (all worlds only): start the seeds over from it. Returns the
+        observations (learner -> sense -> ``(nworld, size)``; rows of worlds not reset: not
+        meaningful) and infos (the task's info keys, zeros)."""
+        if seed is not None:
+            if worlds is not None:
+                raise ValueError("reset(seed=...) resets every world; give worlds=None")
+            if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+                raise ValueError(f"seed={seed!r} not allowed; allowed: None or an integer >= 0")
+            self._seed = int(seed)
+            self._episode[:] = 0
+        elif self._was_reset and worlds is None:
+            self._episode += 1
+        idx = np.arange(self.nworld) if worlds is None else self._indices(worlds)
+        obs = self._load(idx)
+        self._was_reset = True
+        return self._learner_obs(obs), self._zero_infos()
+
+    def _indices(self, worlds) -> np.ndarray:
+        w = np.asarray(worlds.detach().cpu() if hasattr(worlds, "detach") else worlds)
+        if w.dtype == bool:
+            if w.shape != (self.nworld,):
+                raise ValueError(f"worlds: a bool mask of shape {w.shape}; expected "
+                                 f"({self.nworld},)")
+            return np.flatnonzero(w)
+        w = w.astype(np.int64).reshape(-1)
+        if len(w) and (w.min() < 0 or w.max() >= self.nworld):
+            raise ValueError(f"worlds {w.tolist()} not allowed; allowed: indices from 0 to "
+                             f"{self.nworld - 1}")
+        return w
+
+    def _load(self, idx: np.ndarray) -> dict:
+        """The CPU env reset with each world's seed, copied into the world (host work)."""
+        snaps, task_caps, partner_caps = [], [], {a: [] for a in self.partners}
+        for w in idx.tolist():
+            self.env.reset(seed=self.seed_of(w))
+            snaps.append(self.batched.snapshot(self.inner))
+            task_caps.append(self.task.capture(self.inner))
+            for a, p in self.partners.items():
+                partner_caps[a].append(p.capture(self.inner))
+        obs = self.batched.load(idx, snaps)
+        tidx = self.torch.as_tensor(idx, dtype=self.torch.int64, device=self.steps.device)
+        if len(idx):
+            self.task.load(tidx, task_caps)
+            for a, p in self.partners.items():
+                p.load(tidx, partner_caps[a])
+            self.steps[tidx] = 0
+        return obs
+
+    # -- the loop --------------------------------------------------------------------------------
+    def step(self, actions, autoreset: bool = True):
+        """One control step of every world. ``actions``: learner -> ``(nworld, n_controls)``
+        motor values (torch or numpy). Returns ``(obs, rewards, terminated, truncated,
+        infos)``: obs learner -> sense -> ``(nworld, size)``; rewards learner -> ``(nworld,)``;
+        terminated and truncated ``(nworld,)`` bool (the tasks end every agent together; an
+        unstable world is terminated, ``infos["instability"]``); infos the task's keys ->
+        ``(nworld,)`` (per-agent keys: learner -> ``(nworld,)``). With ``autoreset``, the
+        worlds that finished are reset in this step (Gymnasium's same-step autoreset): their
+        rows of obs are the new episode's first, ``infos["final_obs"]`` holds every world's
+        obs of this step and ``infos["_final_obs"]`` which worlds finished."""
+        if not self._was_reset:
+            raise RuntimeError("step() called before reset(); call reset(seed=...) first")
+        if not hasattr(actions, "keys") or set(actions) != set(self.learners):
+            given = sorted(actions) if hasattr(actions, "keys") else type(actions).__name__
+            extra = [a for a in (actions if hasattr(actions, "keys") else ())
+                     if a in self.partners]
+            why = f"; {extra} act by their scripted partners" if extra else ""
+            raise ValueError(f"actions must be a dict with one (nworld, n_controls) array per "
+                             f"learner of {self.learners}; got {given}{why}")
+        full = dict(actions)
+        for a, p in self.partners.items():
+            full[a] = p.act()
+        self.task.before_physics()
+        obs, unstable = self.batched.step(full, reset_unstable=False)
+        self.steps += 1
+        rewards, terminated, task_infos = self.task.evaluate()
+        terminated = terminated | unstable
+        truncated = (self.steps >= self.max_steps) & ~terminated
+        infos = self._infos(task_infos)
+        infos["instability"] = unstable.to(self.torch.float32)
+        obs = self._learner_obs(obs)
+        rew = {a: rewards[:, self.agents.index(a)] for a in self.learners}
+        if autoreset:
+            done = terminated | truncated
+            infos["_final_obs"] = done
+            infos["final_obs"] = {a: {k: v.clone() for k, v in o.items()} for a, o in obs.items()}
+            idx = np.flatnonzero(done.detach().cpu().numpy())
+            if len(idx):
+                self._episode[idx] += 1
+                fresh = self._learner_obs(self._load(idx))
+                rows = done
+                for a in obs:
+                    for k in obs[a]:
+                        obs[a][k][rows] = fresh[a][k][rows]
+        return obs, rew, terminated, truncated, infos
+
+    def _learner_obs(self, obs: dict) -> dict:
+        return {a: obs[a] for a in self.learners}
+
+    def _infos(self, task_infos: dict) -> dict:
+        t = self.torch
+        out = {}
+        for k, v in task_infos.items():
+            v = v.to(t.float32)
+            if k in self.task.per_agent_infos:
+                out[k] = {a: v[:, self.agents.index(a)] for a in self.learners}
+            else:
+                out[k] = v
+        return out
+
+    def _zero_infos(self) -> dict:
+        t = self.torch
+        z = t.zeros(self.nworld, dtype=t.float32, device=self.steps.device)
+        out = {k: ({a: z.clone() for a in self.learners} if k in self.task.per_agent_infos
+                   else z.clone()) for k in self.task.info_keys}
+        out["instability"] = z.clone()
+        return out
+
+    def n_controls(self, agent: str) -> int:
+        """The number of motor values in ``agent``'s actions."""
+        return self.batched.n_controls(agent)

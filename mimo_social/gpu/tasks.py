@@ -1,0 +1,208 @@
+"""Task logic for every world at once: rewards, success, terminations and the task's infos,
+computed from the batched device data (torch tensors) as the CPU task computes them from
+``MjData``, with the task's per-step state (a hold timer) as a per-world tensor.
+
+One small class per task, in :data:`TASKS` by task name; :func:`batched_task` makes the one of a
+CPU env's task, or raises a ValueError naming the task and those that run on the device.
+
+Each class is made from the CPU env (``env``, the task bound to its world: the index tables
+are read from it) and the :class:`~mimo_social.gpu.batched.BatchedEnv` made of it, and has:
+
+* ``batch_fields``: the model fields its reset changes per world (reach: the ball's
+  ``body_pos``), batched per world on the device;
+* ``capture(env)``: what the task's reset drew on the CPU env just reset (host work at resets);
+* ``load(idx, captured)``: that put into the worlds ``idx``, the per-world state reset;
+* ``before_physics()``: the task's per-step hook (reach: head and eyes on the ball);
+* ``evaluate()``: ``(rewards (nworld, n_agents), terminated (nworld,), infos)``, infos a dict
+  of the CPU task's info keys to ``(nworld,)`` tensors (``(nworld, n_agents)`` for per-agent
+  ones), reading the step's data (positions and contacts of the last physics step's start, as
+  the CPU task reads ``MjData`` after ``mj_step``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.kinematics import hand_geoms
+from ..tasks.common import right_hand_parts
+from ..tasks.high_five.task import PALM_COS
+
+__all__ = ["TASKS", "BatchedReach", "BatchedHighFive", "batched_task"]
+
+
+class BatchedReach:
+    """Reach (:class:`mimo_social.tasks.reach.Reach`): ``+success_reward`` on the step a
+    geom of the right hand touches the ball (``dist <= 0``), else minus the right fingertips'
+    distance to the ball's centre; success ends the episode. The reset's ball (the model's
+    ``body_pos`` of the ball, per world) and head and eye angles (set by the task every control
+    step, with their speeds zeroed: the ball is held in place, so the angles of the reset)
+    come from the CPU env reset with the world's seed."""
+
+    name = "reach"
+    batch_fields = ("body_pos",)
+    info_keys = ("is_success", "distance")
+    per_agent_infos = ()
+
+    def __init__(self, env, batched):
+        torch = batched.torch
+        w = env.world
+        m = w.model
+        a = w.agents[0]
+        self.batched = batched
+        self.contacts = batched.contacts
+        self.success_reward = float(env.task.options.success_reward)
+        self.hand = self.contacts.mask(hand_geoms(w, 0))
+        self.ball_geom = self.contacts.mask([m.geom("ball").id])
+        self.ball_body = int(w.prop_bodies["ball"])
+        self.tip = int(a.fingertip_sites[0])
+        dev = batched.qpos.device
+        self.gaze_qpos = torch.as_tensor(a.qpos_adr[a.gaze_idx].astype(np.int64), device=dev)
+        self.gaze_dof = torch.as_tensor(a.dof_adr[a.gaze_idx].astype(np.int64), device=dev)
+        self._gaze_np = a.qpos_adr[a.gaze_idx]
+        self.gaze = torch.zeros((batched.nworld, len(self._gaze_np)), dtype=torch.float32,
+                                device=dev)
+
+    def capture(self, env) -> dict:
+        return {"gaze": env.world.data.qpos[self._gaze_np].copy()}
+
+    def load(self, idx, captured) -> None:
+        t = self.batched.torch
+        self.gaze[idx] = t.as_tensor(np.stack([c["gaze"] for c in captured]),
+                                     dtype=t.float32, device=self.gaze.device)
+
+    def before_physics(self) -> None:
+        data = self.batched.tensors
+        data["qpos"][:, self.gaze_qpos] = self.gaze.to(data["qpos"].dtype)
+        data["qvel"][:, self.gaze_dof] = 0.0
+
+    def evaluate(self):
+        t = self.batched.torch
+        data = self.batched.tensors
+        touched = self.contacts.per_world(self.contacts.between(self.hand, self.ball_geom))
+        dist = t.linalg.vector_norm(data["site_xpos"][:, self.tip]
+                                    - data["xpos"][:, self.ball_body], dim=1)
+        reward = t.where(touched, t.full_like(dist, self.success_reward), -dist)
+        return reward[:, None], touched, {"is_success": touched, "distance": dist}
+
+
+class BatchedHighFive:
+    """High five (:class:`mimo_social.tasks.high_five.HighFive`), ``success="palms"`` or
+    ``"touch"``: each step, both right hands feel the other agent (a contact of the other's
+    geoms with the hand, ``dist <= 0``, and one of a skinned right-hand part with a geom of the
+    other agent pushing with a positive normal force: the skin's rule), the two right hands
+    touch, and (``"palms"``) one contact between them has its normal within 60 deg of each
+    hand's palm normal; ``hold_time`` of it in a row (a per-world step count) is the success.
+    Reward (both agents): ``-distance(right palms)`` with ``shaping``, plus ``touch_bonus`` on a
+    step of success; success ends the episode when ``end_on_touch``. ``assisted_gaze`` (the
+    head turned to the partner's hand every step) is not batched: refused."""
+
+    name = "high_five"
+    batch_fields = ()
+    info_keys = ("is_success", "hands_touching", "hand_feels_partner", "hand_distance",
+                 "palm_contact", "palm_contact_time")
+    per_agent_infos = ("hand_feels_partner",)
+
+    def __init__(self, env, batched):
+        torch = batched.torch
+        opts = env.task.options
+        if opts.assisted_gaze:
+            raise ValueError("high_five: task option assisted_gaze=True does not run on the GPU "
+                             "backend (the head and eyes follow the partner's hand by inverse "
+                             "kinematics on the CPU); allowed: assisted_gaze=False")
+        w = env.world
+        m = w.model
+        c = batched.contacts
+        self.batched, self.contacts = batched, c
+        self.touch_bonus = float(opts.touch_bonus)
+        self.end_on_touch = bool(opts.end_on_touch)
+        self.shaping = bool(opts.shaping)
+        self.touch_rule = opts.success == "touch"
+        self.dt = float(env.dt)
+        self.hold_steps = max(1, int(round(opts.hold_time / env.dt)))
+        dev = batched.qpos.device
+        hands = [hand_geoms(w, i) for i in range(2)]
+        self.hands = [c.mask(h) for h in hands]
+        geom_agent = np.asarray(w.geom_agent)
+        self.agent_geoms = [c.mask(np.flatnonzero(geom_agent == i)) for i in range(2)]
+        touch = env.systems.get("touch")
+        part = np.asarray(touch.geom_part[:m.ngeom])
+        skinned = []
+        for i in range(2):
+            parts = set(right_hand_parts(w.tables[i]))
+            keep = [g for g in range(m.ngeom) if part[g] >= 0
+                    and int(touch.part_agent[part[g]]) == i
+                    and touch.part_names[part[g]] in parts]
+            skinned.append(c.mask(keep))
+        self.skinned = skinned
+        hand_of = np.full(m.ngeom, -1, np.int64)
+        for i in range(2):
+            hand_of[hands[i]] = i
+        self.hand_of = torch.as_tensor(hand_of, device=dev)
+        palms = [int(w.agents[i].palm_sites[0]) for i in range(2)]
+        self.palms = torch.as_tensor(palms, device=dev)
+        self.hand_bodies = torch.as_tensor([int(m.site_bodyid[p]) for p in palms], device=dev)
+        self.held = torch.zeros(batched.nworld, dtype=torch.int64, device=dev)
+
+    def capture(self, env) -> dict:
+        return {}
+
+    def load(self, idx, captured) -> None:
+        self.held[idx] = 0
+
+    def before_physics(self) -> None:
+        return None
+
+    def _feels(self, i: int, normal):
+        """Whether agent i's right hand feels the other agent, per world."""
+        c = self.contacts
+        j = 1 - i
+        probe = c.per_world(c.between(self.hands[i], self.agent_geoms[j]))
+        skin = c.between(self.skinned[i], self.agent_geoms[j], touching=False) & (normal > 0.0)
+        return probe & c.per_world(skin)
+
+    def _palms_meet(self):
+        t = self.batched.torch
+        c = self.contacts
+        g0, g1 = c.sides()
+        o0, o1 = self.hand_of[g0], self.hand_of[g1]
+        keep = c.valid() & (o0 >= 0) & (o1 >= 0) & (o0 != o1) & (c.dist <= 0.0)
+        # each contact's normal from infant_0's hand into infant_1's
+        normal = c.frame[:, 0, :] * t.where(o0 == 0, 1.0, -1.0)[:, None]
+        palms = -self.batched.tensors["xmat"][:, self.hand_bodies, :, 1]   # (nworld, 2, 3)
+        p = c.in_world(palms)
+        hit = keep & ((normal * p[:, 0]).sum(-1) >= PALM_COS) \
+            & ((normal * p[:, 1]).sum(-1) <= -PALM_COS)
+        return c.per_world(hit)
+
+    def evaluate(self):
+        t = self.batched.torch
+        data = self.batched.tensors
+        p = data["site_xpos"][:, self.palms]
+        dist = t.linalg.vector_norm(p[:, 0] - p[:, 1], dim=1)
+        normal = self.contacts.normal_forces()
+        felt = t.stack([self._feels(0, normal), self._feels(1, normal)], dim=1)
+        meet = felt[:, 0] & felt[:, 1] & self.contacts.per_world(
+            self.contacts.between(self.hands[0], self.hands[1]))
+        palm_contact = meet & self._palms_meet()
+        self.held = t.where(palm_contact, self.held + 1, t.zeros_like(self.held))
+        touching = meet if self.touch_rule else self.held >= self.hold_steps
+        r = (-dist if self.shaping else t.zeros_like(dist)) + self.touch_bonus * touching
+        terminated = touching & self.end_on_touch
+        infos = {"is_success": touching, "hands_touching": touching,
+                 "hand_feels_partner": felt, "hand_distance": dist,
+                 "palm_contact": palm_contact, "palm_contact_time": self.held * self.dt}
+        return t.stack([r, r], dim=1), terminated, infos
+
+
+#: the batched task logic by task name
+TASKS = {"reach": BatchedReach, "high_five": BatchedHighFive}
+
+
+def batched_task(env, batched):
+    """The batched logic of ``env``'s task (:data:`TASKS`), or a ValueError naming the task
+    and the tasks that run on the device."""
+    name = env.task.name
+    if name not in TASKS:
+        raise ValueError(f"task {name!r} has no batched task logic on the GPU backend (rewards, "
+                         f"success, resets); allowed: {', '.join(sorted(TASKS))}")
+    return TASKS[name](env, batched)

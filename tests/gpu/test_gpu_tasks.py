@@ -1,0 +1,186 @@
+"""Batched task logic (issue 34) against the CPU env, on Warp's CPU device: the rewards, success
+and terminations of reach and high five on the catalogue's scripted episodes, the high five's
+scripted partner on the device, and the errors for what the device does not run.
+
+Each world of a :class:`BatchedTaskEnv` and one CPU env reset with the world's seed get the
+same actions (the scripted controller's, and for high five the default partner's, computed on
+the CPU env). Reach has no gravity and no friction-loss stick-slip on its path: the worlds
+follow their CPU envs free running (rewards within 1e-5 measured). High five's bodies stand
+under gravity with friction loss at every joint, so float32 physics parts from the CPU's
+slowly (docs/gpu.md): free running, rewards agree within 2e-3 and success on the same step;
+with each world's state copied from its CPU env before every step (the task's hold timer
+kept), what is compared is the task logic over one step of physics: 1e-4 (the hands pressing
+together: the contact solver's float32 over one step).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco_warp", reason="mujoco_warp cannot be imported: the gpu extra "
+                                          "(pip install -e '.[gpu]') is not installed")
+
+from mimo_social.envs import free_play_v0, high_five_v0, reach_v0  # noqa: E402
+from mimo_social.envs.catalog import entry  # noqa: E402
+from mimo_social.gpu import BatchedTaskEnv  # noqa: E402
+from mimo_social.partners import Still  # noqa: E402
+from mimo_social.tasks.high_five import HighFiveController, default_partner  # noqa: E402
+
+SEEDS = (0, 1)
+
+
+def _motors(a):
+    return a["motors"] if isinstance(a, dict) else np.asarray(a, np.float32)
+
+
+def _cpu_action(env, agent, u):
+    space = env.action_space(agent)
+    return {"motors": u, "expression": 0} if hasattr(space, "spaces") else u
+
+
+def run_pair(tenv, make_cpu, policies, force=False, steps=500):
+    """Scripted episodes side by side: CPU env ``w`` reset with world ``w``'s seed, each
+    agent of ``policies`` (agent -> Partner class) acting on it; the same actions given to the
+    world (``force``: the CPU env's state copied into the world before each step). Returns
+    per world the lists of (device reward, CPU reward, device success, CPU success, device
+    terminated, CPU terminated, largest difference of the controls applied) of the CPU
+    episode's steps."""
+    tenv.reset(seed=SEEDS[0])
+    cpus, pols, obs = [], [], []
+    for w in range(tenv.nworld):
+        c = make_cpu()
+        o, _ = c.reset(seed=tenv.seed_of(w))
+        p = {a: cls() for a, cls in policies.items()}
+        for a, pol in p.items():
+            pol.reset(c.unwrapped, a, np.random.default_rng(w))
+        cpus.append(c), pols.append(p), obs.append(o)
+    live = [True] * tenv.nworld
+    records = [[] for _ in cpus]
+    learner = tenv.learners[0]
+    for _ in range(steps):
+        acts = {a: np.zeros((tenv.nworld, tenv.n_controls(a)), np.float32)
+                for a in tenv.learners}
+        given = [None] * tenv.nworld
+        for w, (c, p) in enumerate(zip(cpus, pols)):
+            if live[w]:
+                given[w] = {a: _motors(pol.act(c.unwrapped, a, obs[w].get(a)))
+                            for a, pol in p.items()}
+                for a in tenv.learners:
+                    acts[a][w] = given[w][a]
+        if force:
+            worlds = [w for w in range(tenv.nworld) if live[w]]
+            tenv.batched.load(worlds, [tenv.batched.snapshot(cpus[w].unwrapped) for w in worlds])
+        _, rew, term, _, infos = tenv.step(acts, autoreset=False)
+        for w, c in enumerate(cpus):
+            if not live[w]:
+                continue
+            lone = {a: _cpu_action(c, a, given[w][a]) for a in c.possible_agents}
+            obs[w], r, te, tr, inf = c.step(lone)
+            records[w].append((float(rew[learner][w]), r[learner],
+                               float(infos["is_success"][w]), float(inf[learner]["is_success"]),
+                               bool(term[w]), te[learner],
+                               np.abs(tenv.batched.tensors["ctrl"][w].numpy()
+                                      - c.unwrapped.world.data.ctrl).max()))
+            live[w] = not (te[learner] or tr[learner])
+        if not any(live):
+            break
+    return [np.array(r) for r in records], cpus
+
+
+def check(records, tol):
+    print("largest reward difference per world:",
+          [float(np.abs(r[:, 0] - r[:, 1]).max()) for r in records],
+          "steps:", [len(r) for r in records])
+    for w, rec in enumerate(records):
+        assert rec[-1, 3] == 1.0, f"world {w}: the scripted episode did not succeed on the CPU"
+        err = np.abs(rec[:, 0] - rec[:, 1]).max()
+        assert err < tol, (w, err)
+        assert (rec[:, 2] == rec[:, 3]).all(), (w, np.flatnonzero(rec[:, 2] != rec[:, 3]))
+        assert (rec[:, 4] == rec[:, 5]).all(), (w, np.flatnonzero(rec[:, 4] != rec[:, 5]))
+
+
+@pytest.fixture(scope="module")
+def reach():
+    return BatchedTaskEnv(reach_v0.parallel_env(), len(SEEDS), device="cpu", seed=SEEDS[0])
+
+
+@pytest.fixture(scope="module")
+def high_five():
+    return BatchedTaskEnv(high_five_v0.parallel_env(), len(SEEDS), device="cpu", seed=SEEDS[0])
+
+
+@pytest.fixture(scope="module")
+def high_five_scripted():
+    return BatchedTaskEnv(high_five_v0.scripted_env(), len(SEEDS), device="cpu",
+                          seed=SEEDS[0])
+
+
+def test_gpu_reach_rewards_and_success_are_the_cpu_envs(reach):
+    """Free running; each world's ball is its own seed's (the model's body_pos per world)."""
+    records, cpus = run_pair(reach, reach_v0.parallel_env, {"infant_0": entry("reach").controller})
+    check(records, 1e-4)
+    balls = reach.batched.model_tensors["body_pos"]
+    assert not np.allclose(balls[0].numpy(), balls[1].numpy())
+
+
+def test_gpu_high_five_rewards_and_success_are_the_cpu_envs(high_five):
+    """Both infants act as learners on the device, the CPU's scripted learner and default
+    partner computing the actions; free running."""
+    records, _ = run_pair(high_five, high_five_v0.parallel_env,
+                          {"infant_0": HighFiveController, "infant_1": default_partner})
+    check(records, 2e-3)
+    assert all(r[-1, 2] == 1.0 for r in records)
+
+
+def test_gpu_high_five_task_logic_over_one_step_is_the_cpus(high_five):
+    """Each world's state copied from its CPU env before every step: the palms' distance,
+    the skins feeling the partner, the palm-to-palm rule and the hold timer over one step."""
+    records, _ = run_pair(high_five, high_five_v0.parallel_env,
+                          {"infant_0": HighFiveController, "infant_1": default_partner},
+                          force=True)
+    check(records, 1e-4)
+
+
+def test_gpu_high_five_partner_on_the_device_is_the_cpus(high_five_scripted):
+    """One learner (the scripted controller's actions); the default partner (HandOffer)
+    acting on the device from its CPU plan and the batched data."""
+    tenv = high_five_scripted
+    assert tenv.learners == ["infant_0"] and list(tenv.partners) == ["infant_1"]
+    records, cpus = run_pair(tenv, high_five_v0.scripted_env, {"infant_0": HighFiveController})
+    check(records, 2e-3)
+    # every agent's controls (the partner's from the device's law, the learner's given)
+    print("largest control difference, first 50 steps, all:",
+          [(r[:50, 6].max(), r[:, 6].max()) for r in records])
+    assert all(r[:50, 6].max() < 1e-5 and r[:, 6].max() < 0.1 for r in records)
+
+
+def test_gpu_task_env_refuses_what_the_device_does_not_run():
+    with pytest.raises(ValueError, match=r"task 'free_play' has no batched task logic .*"
+                                         r"allowed: high_five, reach"):
+        BatchedTaskEnv(free_play_v0.parallel_env(n_agents=1), 1, device="cpu")
+    with pytest.raises(ValueError, match=r"high_five: task option assisted_gaze=True does not "
+                                         r"run .* allowed: assisted_gaze=False"):
+        BatchedTaskEnv(high_five_v0.parallel_env(task_options={"assisted_gaze": True}), 1,
+                       device="cpu")
+    with pytest.raises(ValueError, match=r"infant_1: scripted partner Still\(\) has no batched "
+                                         r"form .* allowed: HandOffer\(grip=False, "
+                                         r"release=None\)"):
+        BatchedTaskEnv(high_five_v0.scripted_env(partner=Still()), 1, device="cpu")
+
+
+def test_gpu_task_env_names_the_agent_and_field_of_a_bad_action(high_five_scripted):
+    tenv = high_five_scripted
+    tenv.reset(seed=0)
+    n = tenv.n_controls("infant_0")
+    with pytest.raises(ValueError, match=r"infant_0: motors of shape \(2, 3\); expected "
+                                         r"\(2, %d\)" % n):
+        tenv.step({"infant_0": np.zeros((2, 3), np.float32)})
+    with pytest.raises(ValueError, match=r"infant_0: motors of dtype torch.bool; expected real"):
+        tenv.step({"infant_0": np.zeros((2, n), bool)})
+    with pytest.raises(ValueError, match=r"\['infant_1'\] act by their scripted partners"):
+        tenv.step({"infant_0": np.zeros((2, n), np.float32),
+                   "infant_1": np.zeros((2, n), np.float32)})
+    with pytest.raises(ValueError, match=r"worlds \[5\] not allowed; allowed: indices from 0 "
+                                         r"to 1"):
+        tenv.reset(worlds=[5])
