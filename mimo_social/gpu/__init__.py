@@ -1,11 +1,31 @@
 """A GPU-batched backend on MuJoCo Warp: N worlds of one scene stepped together
 (:class:`~mimo_social.gpu.batched.BatchedEnv`), on a GPU when Warp sees one, else on Warp's CPU
-device. Needs the ``gpu`` extra; what runs on the device and what does not: docs/gpu.md."""
+device; with a task's logic, partners and autoreset
+(:class:`~mimo_social.gpu.task_env.BatchedTaskEnv`), as a Gymnasium vector env
+(:class:`~mimo_social.gpu.vector.GymVectorEnv`) or a TorchRL env
+(:class:`~mimo_social.gpu.torchrl_env.TorchRLEnv`, imported on first use: it needs torchrl).
+Needs the ``gpu`` extra; what runs on the device and what does not: docs/gpu.md."""
 
-from .batched import STATE_FIELDS, BatchedEnv
+from .batched import DERIVED_FIELDS, STATE_FIELDS, BatchedEnv
+from .contacts import BatchedContacts
 from .controls import SUPPORTED, AgentControls, check_actuation
 from .device import describe, has_gpu, pick_device, require
+from .partners import BatchedHandOffer, batched_partner
 from .proprioception import BatchedProprioception
+from .task_env import BatchedTaskEnv
+from .tasks import TASKS, BatchedHighFive, BatchedReach, batched_task
+from .vector import GymVectorEnv, device_spaces
+from .vestibular import BatchedVestibular
 
-__all__ = ["BatchedEnv", "AgentControls", "BatchedProprioception", "STATE_FIELDS", "SUPPORTED",
-           "check_actuation", "describe", "has_gpu", "pick_device", "require"]
+__all__ = ["BatchedEnv", "BatchedTaskEnv", "GymVectorEnv", "TorchRLEnv", "AgentControls",
+           "BatchedContacts", "BatchedHandOffer", "BatchedHighFive", "BatchedProprioception",
+           "BatchedReach", "BatchedVestibular", "DERIVED_FIELDS", "STATE_FIELDS", "SUPPORTED",
+           "TASKS", "batched_partner", "batched_task", "check_actuation", "describe",
+           "device_spaces", "has_gpu", "pick_device", "require"]
+
+
+def __getattr__(name):
+    if name == "TorchRLEnv":   # torchrl is imported only when asked for
+        from .torchrl_env import TorchRLEnv
+        return TorchRLEnv
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
