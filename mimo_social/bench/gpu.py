@@ -7,9 +7,11 @@ infants, the task's defaults), reset, stepped ``warmup`` control steps (kernel l
 GPU the capture of the CUDA graph), then ``steps`` control steps are timed on the wall clock
 with the device synchronised at both ends. Each step draws every agent's actions uniformly in
 [-1, 1] on the device, maps them to controls, advances ``frame_skip`` physics steps and reads
-every agent's proprioception: what a learner on the device pays per step, the task's rewards
-aside (they are not on the device yet, docs/gpu.md). Agent-steps per second: worlds x agents x
-steps / seconds.
+every agent's proprioception and vestibular sense: what a learner on the device pays per step.
+With ``with_task=True`` (Python only: ``measure(..., with_task=True)``) the worlds are a
+:class:`~mimo_social.gpu.BatchedTaskEnv`: the task's rewards, success and terminations on the
+device too, and the finished worlds reset from their seeds' CPU resets (host work, counted in
+the time; ``resets``: how many). Agent-steps per second: worlds x agents x steps / seconds.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import time
 
 from ..bench.machine import machine_info
 from ..envs import high_five_v0
-from ..gpu import BatchedEnv, describe, pick_device, require
+from ..gpu import BatchedEnv, BatchedTaskEnv, describe, pick_device, require
 
 __all__ = ["WORLDS", "measure", "measure_one", "format_results"]
 
@@ -27,22 +29,32 @@ WORLDS = (1, 64, 1024, 4096)
 
 
 def measure_one(nworld: int, steps: int, warmup: int = 2, device: str | None = None,
-                make_env=None) -> dict:
+                make_env=None, with_task: bool = False) -> dict:
     """One number of worlds: build, warm up, time ``steps`` control steps (see the module)."""
     _, _, torch = require()
     t0 = time.perf_counter()
     env = (make_env or high_five_v0.parallel_env)()
-    batched = BatchedEnv(env, nworld, device=device, seed=0)
-    batched.reset()
+    if with_task:
+        tenv = BatchedTaskEnv(env, nworld, device=device, seed=0)
+        tenv.reset()
+        batched = tenv.batched
+    else:
+        batched = BatchedEnv(env, nworld, device=device, seed=0)
+        batched.reset()
     build = time.perf_counter() - t0
     dev = batched.tensors["qpos"].device
     sizes = {a: batched.n_controls(a) for a in batched.agents}
     gen = torch.Generator(device=dev).manual_seed(0)
+    resets = [0]
 
     def one_step():
         acts = {a: torch.rand((nworld, n), generator=gen, device=dev) * 2.0 - 1.0
                 for a, n in sizes.items()}
-        return batched.step(acts)
+        if not with_task:
+            return batched.step(acts)
+        obs, _, term, trunc, infos = tenv.step(acts)
+        resets[0] += int((term | trunc).sum())
+        return obs, infos["instability"] > 0
 
     t1 = time.perf_counter()
     for _ in range(warmup):
@@ -63,20 +75,23 @@ def measure_one(nworld: int, steps: int, warmup: int = 2, device: str | None = N
             "world_steps_per_s": nworld * steps / seconds,
             "physics_steps_per_s": nworld * steps * batched.frame_skip / seconds,
             "build_s": build, "warmup_s": warm, "warmup_steps": warmup,
-            "unstable_resets": unstable}
+            "unstable_resets": unstable, "task": bool(with_task), "resets": resets[0]}
 
 
 def measure(worlds=WORLDS, steps: int = 100, warmup: int = 2, device: str | None = None,
-            progress=None) -> dict:
+            progress=None, with_task: bool = False) -> dict:
     """Every number of worlds in ``worlds`` (:func:`measure_one`), with the device and the
-    machine; ``progress``: called with each result as it comes."""
+    machine; ``progress``: called with each result as it comes; ``with_task``: the task's
+    logic and autoresets in each step too."""
     dev = pick_device(device)
     results = []
     for n in worlds:
-        results.append(measure_one(int(n), steps, warmup, dev))
+        results.append(measure_one(int(n), steps, warmup, dev, with_task=with_task))
         if progress is not None:
             progress(results[-1])
-    return {"device": dev, "device_name": describe(dev), "task": "high_five_v0, 2 infants",
+    task = "high_five_v0, 2 infants" + (", with the task's logic and resets" if with_task
+                                        else "")
+    return {"device": dev, "device_name": describe(dev), "task": task,
             "machine": machine_info(), "results": results}
 
 
