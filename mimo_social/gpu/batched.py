@@ -5,16 +5,19 @@
 Warp device and makes ``nworld`` copies of its reset state there. Each :meth:`BatchedEnv.step`
 maps every agent's batched motor actions to controls as the CPU env does
 (:mod:`mimo_social.gpu.controls`), advances every world by the env's ``frame_skip`` physics
-steps of its ``timestep`` and reads every agent's proprioception in the CPU sense's layout
-(:mod:`mimo_social.gpu.proprioception`). Actions and observations are torch tensors on the
-device (``wp.to_torch``: no copy); numpy actions are taken too. On a GPU, Warp works on torch's
-current stream and the physics steps of a control step are one CUDA graph (this path has not
-run on a GPU yet: no GPU was lent when it was written, docs/gpu.md).
+steps of its ``timestep`` and reads every agent's proprioception and vestibular sense in the
+CPU senses' layouts (:mod:`mimo_social.gpu.proprioception`, :mod:`mimo_social.gpu.vestibular`).
+Actions and observations are torch tensors on the device (``wp.to_torch``: no copy); numpy
+actions are taken too. On a GPU, Warp works on torch's current stream and the physics steps of
+a control step are one CUDA graph (this path has not run on a GPU yet: no GPU was lent when it
+was written, docs/gpu.md). :meth:`BatchedEnv.snapshot` and :meth:`BatchedEnv.load` put the
+state of the CPU env, reset with another seed, into chosen worlds (the task env's resets:
+:mod:`mimo_social.gpu.task_env`).
 
-What stays on the CPU (docs/gpu.md): the other senses (vestibular, touch, vision, audition),
-muscles, expressions and voice (visual and auditory only: the batched actions are the motors),
-and the task's logic (rewards, success, terminations, its per-step hooks and its resets: every
-world restarts from the one reset state of the CPU env).
+What stays on the CPU (docs/gpu.md): the other senses (touch, vision, audition), muscles,
+expressions and voice (visual and auditory only: the batched actions are the motors). The
+task's logic is not here: :class:`~mimo_social.gpu.task_env.BatchedTaskEnv` adds it (reach,
+high five); a plain :class:`BatchedEnv` restarts every world from the one reset state.
 """
 
 from __future__ import annotations
