@@ -124,6 +124,24 @@ def test_gpu_reach_rewards_and_success_are_the_cpu_envs(reach):
     assert not np.allclose(balls[0].numpy(), balls[1].numpy())
 
 
+def test_gpu_reach_with_developmental_delays_is_the_cpu_envs():
+    """Motor and proprioceptive delays of 2 control steps (18 months) on both sides."""
+    make = lambda: reach_v0.parallel_env(delays="developmental")  # noqa: E731
+    tenv = BatchedTaskEnv(make(), len(SEEDS), device="cpu", seed=SEEDS[0])
+    assert tenv.inner.delay_steps("infant_0")["motor"] == 2
+    records, _ = run_pair(tenv, make, {"infant_0": entry("reach").controller})
+    check(records, 1e-4)
+
+
+def test_gpu_high_five_touch_rule_is_the_cpus():
+    """``success="touch"`` (the first versions' rule): any touch both skins feel, one step."""
+    make = lambda: high_five_v0.parallel_env(task_options={"success": "touch"})  # noqa: E731
+    tenv = BatchedTaskEnv(make(), len(SEEDS), device="cpu", seed=SEEDS[0])
+    records, _ = run_pair(tenv, make, {"infant_0": HighFiveController,
+                                       "infant_1": default_partner})
+    check(records, 2e-3)
+
+
 def test_gpu_high_five_rewards_and_success_are_the_cpu_envs(high_five):
     """Both infants act as learners on the device, the CPU's scripted learner and default
     partner computing the actions; free running."""
