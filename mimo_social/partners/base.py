@@ -21,7 +21,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop",
            "pd_gains", "motor_action", "torque_controls", "follow_waypoints", "check_angles",
-           "check_variants"]
+           "check_variants", "TorqueMotors", "torque_motors", "push_torques"]
 
 
 def zero_action(space: spaces.Space):
@@ -133,6 +133,41 @@ def follow_waypoints(data, waypoints, state: list, hold_steps: int, tolerance: f
     tau = kp * (state[2] - q) - kd * data.qvel[dof_adr]
     tau += data.qfrc_bias[dof_adr] - data.qfrc_spring[dof_adr]
     return np.clip(np.where(tau >= 0, tau / torque_pos, tau / torque_neg), -1.0, 1.0)
+
+
+class TorqueMotors:
+    """An agent's torque motors as a whole-body PD controller reads them: the actuation model
+    ``act``, the motors' joint ``names``, their ``qpos_adr`` / ``dof_adr`` and joint limits
+    ``lo`` / ``hi`` (rad)."""
+
+    def __init__(self, act, names, qpos_adr, dof_adr, lo, hi):
+        self.act, self.names = act, list(names)
+        self.qpos_adr, self.dof_adr, self.lo, self.hi = qpos_adr, dof_adr, lo, hi
+
+
+def torque_motors(who: str, env, agent: str) -> TorqueMotors:
+    """``agent``'s torque motors (:class:`TorqueMotors`) for scripted controller ``who``; a
+    ValueError naming both for an agent on muscles (its controls are not torques)."""
+    i = agent_index(env, agent)
+    a = env.world.agents[i]
+    act = env.actuation[i]
+    if act.name == "muscle":
+        raise ValueError(f"{who}: {agent} has actuation='muscle'; allowed: 'spring_damper' (it "
+                         "drives torque motors)")
+    jk = a.actuated_joint_idx
+    return TorqueMotors(act, a.actuated_names, a.qpos_adr[jk], a.dof_adr[jk],
+                        a.joint_range[jk, 0], a.joint_range[jk, 1])
+
+
+def push_torques(model, data, jac: np.ndarray, dof_adr, pushes) -> np.ndarray:
+    """The joint torques that make each body of ``pushes`` (``(body id, world force (3,))``)
+    push with that force, ``J^T f`` over the ``dof_adr`` joints (``jac``: a (3, nv) scratch)."""
+    import mujoco
+    tau = np.zeros(len(dof_adr))
+    for body, force in pushes:
+        mujoco.mj_jacBody(model, data, jac, None, body)
+        tau += jac[:, dof_adr].T @ force
+    return tau
 
 
 class Partner:

@@ -41,11 +41,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-import mujoco
 import numpy as np
 
 from ...partners.base import (Partner, agent_index, check_angles, motor_action, pd_gains,
-                              torque_controls)
+                              push_torques, torque_controls, torque_motors)
 from ...util.checks import ConfigError, check_number, check_numbers, show
 
 __all__ = ["RollOverController", "SUPINE_PLAN", "PRONE_PLAN", "PRESSING", "check_plan"]
@@ -176,16 +175,10 @@ class RollOverController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = agent_index(env, agent)
-        a = w.agents[i]
-        self._act = env.actuation[i]
-        if self._act.name == "muscle":
-            raise ValueError(f"RollOverController: {agent} has actuation='muscle'; allowed: "
-                             "'spring_damper' (it drives torque motors)")
-        names = list(a.actuated_names)
-        jk = a.actuated_joint_idx
-        self._qadr, self._dadr = a.qpos_adr[jk], a.dof_adr[jk]
-        lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]
+        a = w.agents[agent_index(env, agent)]
+        motors = torque_motors("RollOverController", env, agent)
+        self._act, names = motors.act, motors.names
+        self._qadr, self._dadr, lo, hi = motors.qpos_adr, motors.dof_adr, motors.lo, motors.hi
         q0 = d.qpos[self._qadr].copy()
         chest = m.body(f"{a.name}/upper_body").id
         self.start = "supine" if d.xmat[chest, 6] >= 0.0 else "prone"
@@ -214,8 +207,7 @@ class RollOverController(Partner):
         tau = self._kp * (goal - q) - self._kd * qd
         tau += d.qfrc_bias[self._dadr] - d.qfrc_spring[self._dadr]
         left = d.xmat[self._root].reshape(3, 3)[:, 1]
-        for body, down, side in pushes:
-            mujoco.mj_jacBody(m, d, self._jac, None, body)
-            tau += self._jac[:, self._dadr].T @ (side * left - (0.0, 0.0, down))
+        tau += push_torques(m, d, self._jac, self._dadr,
+                            [(body, side * left - (0.0, 0.0, down)) for body, down, side in pushes])
         u = torque_controls(self._act, q, tau).astype(np.float32)
         return motor_action(env.action_space(agent), u)

@@ -32,7 +32,8 @@ import mujoco
 import numpy as np
 
 from ...util.checks import check_number, check_numbers
-from ...partners.base import Partner, agent_index, check_angles, motor_action
+from ...partners.base import (Partner, agent_index, check_angles, motor_action,
+                              push_torques, torque_motors)
 
 __all__ = ["STAND_DEG", "StandupController"]
 
@@ -74,16 +75,10 @@ class StandupController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = agent_index(env, agent)
-        a = w.agents[i]
-        self._act = env.actuation[i]
-        if self._act.name == "muscle":
-            raise ValueError(f"StandupController: {agent} has actuation='muscle'; allowed: "
-                             "'spring_damper' (it drives torque motors)")
-        names = list(a.actuated_names)
-        jk = a.actuated_joint_idx
-        self._qadr, self._dadr = a.qpos_adr[jk], a.dof_adr[jk]
-        lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]
+        a = w.agents[agent_index(env, agent)]
+        motors = torque_motors("StandupController", env, agent)
+        self._act, names = motors.act, motors.names
+        self._qadr, self._dadr, lo, hi = motors.qpos_adr, motors.dof_adr, motors.lo, motors.hi
         self._q0 = d.qpos[self._qadr].copy()
         goal = [np.deg2rad(self.posture_deg[n]) if n in self.posture_deg else self._q0[k]
                 for k, n in enumerate(names)]
@@ -104,9 +99,7 @@ class StandupController(Partner):
         q, qd = d.qpos[self._qadr], d.qvel[self._dadr]
         tau = self._kp * (self.target_angles - q) - self._kd * qd
         tau += d.qfrc_bias[self._dadr] - d.qfrc_spring[self._dadr]
-        for body, force in self._pushers:
-            mujoco.mj_jacBody(m, d, self._jac, None, body)
-            tau += self._jac[:, self._dadr].T @ force
+        tau += push_torques(m, d, self._jac, self._dadr, self._pushers)
         u = np.clip(np.where(tau >= 0, tau / self._act.torque_pos, tau / self._act.torque_neg),
                     -1.0, 1.0).astype(np.float32)
         return motor_action(env.action_space(agent), u)
