@@ -228,7 +228,7 @@ class BatchedEnv:
 
     def _physics(self) -> None:
         """``frame_skip`` physics steps of every world; on a GPU replayed as one CUDA graph."""
-        wp, mjw = self._wp, self._mjw
+        wp = self._wp
         with self._on_device() as stream:
             if stream is None:
                 self._steps()

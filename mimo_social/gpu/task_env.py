@@ -22,7 +22,7 @@ import numpy as np
 
 from .batched import BatchedEnv
 from .partners import batched_partner
-from .tasks import batched_task
+from .tasks import TASKS, batched_task
 
 __all__ = ["BatchedTaskEnv"]
 
@@ -41,7 +41,6 @@ class BatchedTaskEnv:
         if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
             raise ValueError(f"seed={seed!r} not allowed; allowed: an integer >= 0")
         name = inner.task.name
-        from .tasks import TASKS
         if name not in TASKS:   # before the model goes to the device
             raise ValueError(f"task {name!r} has no batched task logic on the GPU backend "
                              f"(rewards, success, resets); allowed: {', '.join(sorted(TASKS))}")
