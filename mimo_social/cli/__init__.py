@@ -14,12 +14,12 @@ import os
 import sys
 
 from . import (baselines, bench, calibrate, compliance, demo, docs, fig8, figure, paradigm,
-               recipe, replay, train, view)
+               recipe, replay, train, train_gpu, view)
 
 #: the modules of the top-level commands (the measurements are under ``bench``:
 #: :data:`.bench.MEASUREMENTS`)
 SUBCOMMANDS = (demo, bench, calibrate, compliance, replay, train, figure, docs, baselines,
-               paradigm, recipe, fig8, view)
+               paradigm, recipe, fig8, view, train_gpu)
 
 
 class UsageError(SystemExit):

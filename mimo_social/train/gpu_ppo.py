@@ -1,0 +1,367 @@
+"""PPO on the device: a learner that collects and learns from batched MuJoCo Warp worlds without
+pulling every step back to the host (issue 34; ``mimo-social train-gpu``; docs/gpu.md).
+
+The worlds are a :class:`~mimo_social.gpu.GymVectorEnv` (torch tensors on Warp's device: a GPU
+when there is one, else the CPU) of reach or of the high five's one-learner form (``infant_0``
+learns, the scripted partner ``HandOffer`` acts on the device). The learner is built from
+TorchRL's PPO pieces: a :class:`~torchrl.modules.ProbabilisticActor` with a tanh-normal
+distribution over the motors' Box (an MLP for the mean, a learnt state-independent log std), a
+:class:`~torchrl.modules.ValueOperator` critic MLP, :class:`~torchrl.objectives.value.GAE` and
+:class:`~torchrl.objectives.ClipPPOLoss`. Both networks start with the same running
+normalisation of the observations (:class:`RunningObsNorm`: the senses the device computes,
+concatenated; its statistics are buffers of the policy, saved with it).
+
+Each iteration: ``rollout`` control steps of every world on the device (the policy samples,
+the env steps and resets finished worlds in the same step; a finished world's bootstrap value
+is taken from its final observation, ``infos["final_obs"]``, and cut only where it
+terminated), GAE over the rollout, ``epochs`` passes over it in shuffled minibatches of
+``minibatch`` samples, then the normaliser takes the rollout's observations. The episode
+figures are summed on the device and read once per iteration: one row of ``progress.csv``
+(:data:`PROGRESS_COLUMNS`). The run writes ``config.json``, ``progress.csv`` and ``policy.pt``
+(the actor's state_dict, the normaliser's statistics included) to ``out``.
+
+Determinism: under one ``seed`` two runs on Warp's CPU device give the same progress (torch's
+generator is seeded from it, the worlds' resets are the CPU env's with seeds from it; torch
+is set to one thread unless the device is ``"cuda"``). On a GPU, atomics in the physics may
+reorder sums: close, not bit-identical.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+import torch
+from tensordict import TensorDict
+from tensordict.nn import TensorDictModule
+from torch import nn
+from torchrl.modules import MLP, ProbabilisticActor, TanhNormal, ValueOperator
+from torchrl.objectives import ClipPPOLoss
+from torchrl.objectives.value import GAE
+
+from ..envs import high_five_v0, reach_v0
+from ..gpu import GymVectorEnv
+
+__all__ = ["TASKS", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObsNorm", "make_env",
+           "build_networks", "train_gpu_ppo", "read_progress"]
+
+#: the tasks the on-device PPO trains: name -> the CPU env with one learner
+TASKS = {"reach": reach_v0.parallel_env, "high_five": high_five_v0.scripted_env}
+DEVICES = (None, "cpu", "cuda")
+
+#: the columns of ``progress.csv``, one row per iteration; the episode columns are over the
+#: episodes that finished in the iteration (empty when none did)
+PROGRESS_COLUMNS = ("iteration", "timesteps", "wall_time_s", "episode_return_mean",
+                    "success_rate", "episodes", "episode_length_mean", "loss_policy",
+                    "loss_critic", "loss_entropy", "steps_per_s")
+
+
+@dataclass(frozen=True)
+class GpuPPOConfig:
+    """The run's settings. ``steps``: world-steps in all (one world-step is one step of the
+    learner; rounded up to whole iterations of ``worlds * rollout``); ``rollout``: control
+    steps per world per iteration; ``minibatch``: samples per gradient step (at most
+    ``worlds * rollout``); ``device``: Warp's and torch's (None: a GPU when Warp sees one, else
+    the CPU); ``reward_scale``: the rewards' factor for the critic and the advantages (the
+    progress reports unscaled returns); ``max_steps``: the episodes' length (None: the
+    task's); ``hidden``: the width of both MLPs' two hidden layers."""
+
+    task: str = "reach"
+    worlds: int = 64
+    steps: int = 100_000
+    seed: int = 0
+    learning_rate: float = 3e-4
+    epochs: int = 10
+    minibatch: int = 512
+    rollout: int = 32
+    device: str | None = None
+    gamma: float = 0.99
+    gae_lambda: float = 0.95
+    clip_epsilon: float = 0.2
+    entropy_coeff: float = 0.0
+    critic_coeff: float = 0.5
+    max_grad_norm: float = 0.5
+    reward_scale: float = 0.1
+    init_log_std: float = 0.0
+    hidden: int = 64
+    max_steps: int | None = None
+
+    def __post_init__(self):
+        if self.task not in TASKS:
+            _bad("task", self.task, f"one of {', '.join(TASKS)}")
+        for name in ("worlds", "steps", "epochs", "minibatch", "rollout", "hidden"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                _bad(name, value, "a positive integer")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            _bad("seed", self.seed, "an integer >= 0")
+        if self.max_steps is not None and (isinstance(self.max_steps, bool) or not isinstance(
+                self.max_steps, int) or self.max_steps < 1):
+            _bad("max_steps", self.max_steps, "None or a positive integer")
+        if self.device not in DEVICES:
+            _bad("device", self.device, "None (a GPU when there is one, else the CPU), "
+                                        "'cpu' or 'cuda'")
+        for name, lo, hi in (("learning_rate", 0.0, None), ("gamma", 0.0, 1.0),
+                             ("gae_lambda", 0.0, 1.0), ("clip_epsilon", 0.0, None),
+                             ("reward_scale", 0.0, None), ("max_grad_norm", 0.0, None)):
+            value = getattr(self, name)
+            if not _number(value) or value <= lo or (hi is not None and value > hi):
+                _bad(name, value, f"a number > {lo:g}" + (f" and <= {hi:g}" if hi else ""))
+        for name in ("entropy_coeff", "critic_coeff"):
+            value = getattr(self, name)
+            if not _number(value) or value < 0:
+                _bad(name, value, "a number >= 0")
+        if not _number(self.init_log_std):
+            _bad("init_log_std", self.init_log_std, "a finite number")
+        if self.minibatch > self.worlds * self.rollout:
+            _bad("minibatch", self.minibatch, f"at most worlds * rollout = {self.worlds} * "
+                                              f"{self.rollout} = {self.worlds * self.rollout}")
+
+    @property
+    def batch(self) -> int:
+        """Samples per iteration."""
+        return self.worlds * self.rollout
+
+    @property
+    def iterations(self) -> int:
+        return max(1, math.ceil(self.steps / self.batch))
+
+
+def _number(value) -> bool:
+    return (not isinstance(value, bool) and isinstance(value, (int, float))
+            and math.isfinite(value))
+
+
+def _bad(name, value, allowed):
+    raise ValueError(f"{name}={value!r} not allowed; allowed: {allowed}")
+
+
+class RunningObsNorm(nn.Module):
+    """Observations shifted and scaled by running estimates of their mean and variance
+    (clipped to +-``clip``); the estimates are buffers (``mean``, ``var``, ``count``), changed
+    only by :meth:`update`, never by the forward pass."""
+
+    def __init__(self, size: int, clip: float = 10.0, eps: float = 1e-8):
+        super().__init__()
+        self.clip, self.eps = float(clip), float(eps)
+        self.register_buffer("mean", torch.zeros(size))
+        self.register_buffer("var", torch.ones(size))
+        self.register_buffer("count", torch.zeros(()))
+
+    @torch.no_grad()
+    def update(self, x: torch.Tensor) -> None:
+        """Merge a batch ``(..., size)`` into the estimates (Chan et al.'s parallel rule)."""
+        x = x.reshape(-1, self.mean.shape[0]).to(self.mean.dtype)
+        n = float(x.shape[0])
+        if n == 0:
+            return
+        mean, var = x.mean(0), x.var(0, unbiased=False)
+        total = self.count + n
+        delta = mean - self.mean
+        m2 = self.var * self.count + var * n + delta.square() * self.count * n / total
+        self.mean += delta * n / total
+        self.var.copy_(m2 / total)
+        self.count.copy_(total)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        z = (x - self.mean) / torch.sqrt(self.var + self.eps)
+        return z.clamp(-self.clip, self.clip)
+
+
+class _Gaussian(nn.Module):
+    """Normalised observation -> (loc, scale): an MLP for the mean, a learnt log std."""
+
+    def __init__(self, norm: RunningObsNorm, n_obs: int, n_act: int, hidden: int,
+                 init_log_std: float):
+        super().__init__()
+        self.norm = norm
+        self.mlp = MLP(in_features=n_obs, out_features=n_act, num_cells=[hidden, hidden],
+                       activation_class=nn.Tanh)
+        self.log_std = nn.Parameter(torch.full((n_act,), float(init_log_std)))
+
+    def forward(self, obs):
+        loc = self.mlp(self.norm(obs))
+        return loc, self.log_std.exp().expand_as(loc)
+
+
+class _Value(nn.Module):
+    def __init__(self, norm: RunningObsNorm, n_obs: int, hidden: int):
+        super().__init__()
+        self.norm = norm
+        self.mlp = MLP(in_features=n_obs, out_features=1, num_cells=[hidden, hidden],
+                       activation_class=nn.Tanh)
+
+    def forward(self, obs):
+        return self.mlp(self.norm(obs))
+
+
+def make_env(config: GpuPPOConfig) -> GymVectorEnv:
+    """The batched worlds of ``config.task`` as a Gymnasium vector env of torch tensors."""
+    kw = {} if config.max_steps is None else {"max_steps": config.max_steps}
+    return GymVectorEnv(TASKS[config.task](**kw), config.worlds, device=config.device,
+                        seed=config.seed)
+
+
+def build_networks(n_obs: int, low: torch.Tensor, high: torch.Tensor, config: GpuPPOConfig):
+    """The actor (a :class:`ProbabilisticActor`: ``"observation"`` -> ``"action"`` in
+    ``[low, high]`` and its log-probability) and the critic (``"observation"`` ->
+    ``"state_value"``), sharing one :class:`RunningObsNorm`; returns ``(actor, critic,
+    norm)``."""
+    norm = RunningObsNorm(n_obs).to(low.device)
+    n_act = int(low.shape[-1])
+    gauss = _Gaussian(norm, n_obs, n_act, config.hidden, config.init_log_std).to(low.device)
+    actor = ProbabilisticActor(
+        TensorDictModule(gauss, in_keys=["observation"], out_keys=["loc", "scale"]),
+        in_keys=["loc", "scale"], distribution_class=TanhNormal,
+        distribution_kwargs={"low": low, "high": high}, return_log_prob=True)
+    critic = ValueOperator(_Value(norm, n_obs, config.hidden).to(low.device),
+                           in_keys=["observation"])
+    return actor, critic, norm
+
+
+def _flat(obs: dict) -> torch.Tensor:
+    """The senses of one observation Dict, concatenated in their order, ``(n, size)``."""
+    return torch.cat([obs[k].to(torch.float32) for k in obs], dim=-1)
+
+
+def train_gpu_ppo(config: GpuPPOConfig, out, progress=None) -> dict:
+    """Train (see the module) and write ``config.json``, ``progress.csv`` and ``policy.pt`` to
+    ``out``; ``progress``: called with each row (a dict) as it is written. Returns a summary:
+    the last row, the iterations, the device and the build time."""
+    if not isinstance(config, GpuPPOConfig):
+        raise TypeError(f"config: a GpuPPOConfig, not {type(config).__name__}")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    torch.manual_seed(config.seed)
+    if config.device != "cuda":
+        torch.set_num_threads(1)   # the same sums every run (and Warp's CPU device beside it)
+    t0 = time.perf_counter()
+    venv = make_env(config)
+    obs_dict, _ = venv.reset(seed=config.seed)
+    obs = _flat(obs_dict)
+    dev = obs.device
+    space = venv.single_action_space
+    low = torch.as_tensor(space.low, dtype=torch.float32, device=dev)
+    high = torch.as_tensor(space.high, dtype=torch.float32, device=dev)
+    actor, critic, norm = build_networks(int(obs.shape[-1]), low, high, config)
+    norm.update(obs)
+    loss_fn = ClipPPOLoss(actor, critic, clip_epsilon=config.clip_epsilon,
+                          entropy_bonus=config.entropy_coeff > 0,
+                          entropy_coeff=config.entropy_coeff or None,
+                          critic_coeff=config.critic_coeff, loss_critic_type="l2",
+                          normalize_advantage=True)
+    gae = GAE(gamma=config.gamma, lmbda=config.gae_lambda, value_network=critic,
+              average_gae=False)
+    optim = torch.optim.Adam(loss_fn.parameters(), lr=config.learning_rate)
+    gen = torch.Generator(device="cpu").manual_seed(config.seed)
+    build_s = time.perf_counter() - t0
+    meta = {"config": asdict(config), "device": str(dev), "device_name": venv.device_name,
+            "observation_size": int(obs.shape[-1]), "action_size": int(low.shape[-1]),
+            "build_s": build_s}
+    (out / "config.json").write_text(json.dumps(meta, indent=1))
+    n = config.worlds
+    ep_return = torch.zeros(n, device=dev)
+    ep_length = torch.zeros(n, device=dev)
+    rows = []
+    t_start = time.perf_counter()
+    with open(out / "progress.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=PROGRESS_COLUMNS)
+        writer.writeheader()
+        for it in range(config.iterations):
+            t_it = time.perf_counter()
+            batch, obs, stats = _collect(venv, actor, obs, ep_return, ep_length, config)
+            losses = _learn(batch, actor, gae, loss_fn, optim, gen, config)
+            norm.update(batch["observation"])
+            row = _row(it, (it + 1) * config.batch, time.perf_counter() - t_start, stats,
+                       losses, config.batch / (time.perf_counter() - t_it))
+            writer.writerow(row)
+            f.flush()
+            rows.append(row)
+            if progress is not None:
+                progress(row)
+    torch.save(actor.state_dict(), out / "policy.pt")
+    venv.close()
+    return {"last": rows[-1], "iterations": len(rows), "device": str(dev),
+            "device_name": meta["device_name"], "build_s": build_s}
+
+
+@torch.no_grad()
+def _collect(venv, actor, obs, ep_return, ep_length, config):
+    """``config.rollout`` steps of every world; the batch ``(worlds, rollout)``, the next
+    observation and the iteration's episode sums (one read from the device)."""
+    dev = obs.device
+    steps, sums = [], torch.zeros(4, device=dev)   # episodes, returns, lengths, successes
+    for _ in range(config.rollout):
+        td = actor(TensorDict({"observation": obs}, batch_size=[config.worlds], device=dev))
+        nxt, rew, term, trunc, infos = venv.step(td["action"])
+        rew = rew.to(torch.float32)
+        done = term | trunc
+        final = _flat(infos["final_obs"])
+        ep_return += rew
+        ep_length += 1
+        d = done.to(torch.float32)
+        succ = infos["final_info"]["is_success"].to(torch.float32)
+        sums += torch.stack([d.sum(), (ep_return * d).sum(), (ep_length * d).sum(),
+                             (succ * d).sum()])
+        ep_return *= 1.0 - d
+        ep_length *= 1.0 - d
+        td.set("next", TensorDict({
+            "observation": final, "reward": (rew * config.reward_scale)[:, None],
+            "done": done[:, None], "terminated": term[:, None]},
+            batch_size=[config.worlds], device=dev))
+        steps.append(td)
+        obs = _flat(nxt)
+    batch = torch.stack(steps, dim=1)   # (worlds, rollout): time last, as GAE reads it
+    return batch, obs, sums.tolist()
+
+
+def _learn(batch, actor, gae, loss_fn, optim, gen, config):
+    """GAE over the rollout, then ``epochs`` passes of shuffled minibatches; the mean
+    losses of the last pass."""
+    with torch.no_grad():
+        gae(batch)
+    flat = batch.reshape(-1)
+    size = flat.shape[0]
+    params = list(loss_fn.parameters())
+    for _ in range(config.epochs):
+        perm = torch.randperm(size, generator=gen).to(flat.device)
+        sums, count = torch.zeros(3, device=flat.device), 0
+        for start in range(0, size - config.minibatch + 1, config.minibatch):
+            mb = flat[perm[start:start + config.minibatch]]
+            loss = loss_fn(mb)
+            parts = [loss["loss_objective"], loss["loss_critic"],
+                     loss.get("loss_entropy", torch.zeros((), device=flat.device))]
+            optim.zero_grad()
+            sum(parts).backward()
+            nn.utils.clip_grad_norm_(params, config.max_grad_norm)
+            optim.step()
+            sums += torch.stack([p.detach() for p in parts])
+            count += 1
+    return (sums / max(count, 1)).tolist()
+
+
+def _row(it, timesteps, wall, stats, losses, fps) -> dict:
+    episodes, ret, length, succ = stats
+    k = int(round(episodes))
+    each = (lambda v: f"{v / k:.6g}") if k else (lambda v: "")
+    return {"iteration": it, "timesteps": timesteps, "wall_time_s": f"{wall:.3f}",
+            "episode_return_mean": each(ret), "success_rate": each(succ), "episodes": k,
+            "episode_length_mean": each(length), "loss_policy": f"{losses[0]:.6g}",
+            "loss_critic": f"{losses[1]:.6g}", "loss_entropy": f"{losses[2]:.6g}",
+            "steps_per_s": f"{fps:.1f}"}
+
+
+def read_progress(path) -> list[dict]:
+    """The rows of a ``progress.csv`` this module wrote, numbers as floats (empty: None)."""
+    with open(path, newline="") as f:
+        return [{k: (float(v) if v not in ("", None) else None) for k, v in r.items()}
+                for r in csv.DictReader(f)]
+
+
+def config_fields() -> tuple[str, ...]:
+    """The names of :class:`GpuPPOConfig`'s settings."""
+    return tuple(f.name for f in fields(GpuPPOConfig))
