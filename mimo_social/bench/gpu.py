@@ -8,7 +8,7 @@ GPU the capture of the CUDA graph), then ``steps`` control steps are timed on th
 with the device synchronised at both ends. Each step draws every agent's actions uniformly in
 [-1, 1] on the device, maps them to controls, advances ``frame_skip`` physics steps and reads
 every agent's proprioception and vestibular sense: what a learner on the device pays per step.
-With ``with_task=True`` (Python only: ``measure(..., with_task=True)``) the worlds are a
+With ``with_task=True`` (``mimo-social bench gpu --with-task``) the worlds are a
 :class:`~mimo_social.gpu.BatchedTaskEnv`: the task's rewards, success and terminations on the
 device too, and the finished worlds reset from their seeds' CPU resets (host work, counted in
 the time; ``resets``: how many). Agent-steps per second: worlds x agents x steps / seconds.
@@ -106,10 +106,14 @@ def format_results(out: dict) -> str:
              f"CPU: {out['machine'].get('cpu', 'unknown')}",
              f"{'worlds':>7} {'steps':>6} {'agent-steps/s':>14} {'world-steps/s':>14} "
              f"{'physics steps/s':>16} {'build s':>8} {'warm-up s':>10} {'resets':>7}"]
+    task = any(r.get("task") for r in out["results"])
+    if task:   # the episodes that ended (and were reset) in the timed steps
+        lines[-1] += f" {'episodes ended':>15}"
     for r in out["results"]:
         lines.append(f"{r['worlds']:>7} {r['steps']:>6} {r['agent_steps_per_s']:>14.1f} "
                      f"{r['world_steps_per_s']:>14.1f} {r['physics_steps_per_s']:>16.1f} "
-                     f"{r['build_s']:>8.1f} {r['warmup_s']:>10.1f} {r['unstable_resets']:>7}")
+                     f"{r['build_s']:>8.1f} {r['warmup_s']:>10.1f} {r['unstable_resets']:>7}"
+                     + (f" {r.get('resets', 0):>15}" if task else ""))
     if out["device"] == "cpu":
         lines.append("no GPU: Warp's CPU device; these figures say nothing of a GPU's")
     return "\n".join(lines)

@@ -4,6 +4,7 @@ output names (:mod:`mimo_social.bench.gpu`; docs/gpu.md). Needs the ``gpu`` extr
 
     mimo-social bench gpu                              # 1, 64, 1024, 4096 worlds, 100 steps
     mimo-social bench gpu --worlds 1,64 --steps 20     # what a CPU manages in minutes
+    mimo-social bench gpu --with-task                  # the task's logic and resets too
 """
 
 from __future__ import annotations
@@ -42,9 +43,10 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         name, **kw,
         description="Agent-steps per second of two-infant high five on MuJoCo Warp, N worlds "
-                    "stepped together (random actions, proprioception read each step; the "
-                    "task's rewards are not on the device yet). Runs on a GPU when Warp sees "
-                    "one, else on Warp's CPU device, and says which.")
+                    "stepped together (random actions, proprioception read each step; with "
+                    "--with-task the task's rewards, success, terminations and resets too). "
+                    "Runs on a GPU when Warp sees one, else on Warp's CPU device, and says "
+                    "which.")
     parser.add_argument("--worlds", type=_worlds, default=[1, 64, 1024, 4096],
                         help="numbers of worlds, comma-separated (default 1,64,1024,4096)")
     parser.add_argument("--steps", type=positive_int, default=100,
@@ -53,6 +55,9 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
                         help="control steps before the timing (default 2)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto",
                         help="auto (default): a GPU when Warp sees one, else the CPU")
+    parser.add_argument("--with-task", action="store_true",
+                        help="time the task's logic and the autoresets of finished worlds "
+                             "(BatchedTaskEnv) with the physics")
     parser.add_argument("--json", default=None, type=output_file, help="write all results here")
     parser.set_defaults(func=run)
     return parser
@@ -64,6 +69,7 @@ def run(args: argparse.Namespace) -> int:
     device = None if args.device == "auto" else args.device
     try:
         out = gpu.measure(args.worlds, args.steps, args.warmup, device,
+                          with_task=args.with_task,
                           progress=lambda r: print(f"  {r['worlds']} worlds: "
                                                    f"{r['agent_steps_per_s']:.1f} agent-steps/s",
                                                    flush=True))
