@@ -39,6 +39,7 @@ import torch
 from tensordict import TensorDict
 from tensordict.nn import TensorDictModule
 from torch import nn
+from torchrl.envs.utils import ExplorationType, set_exploration_type
 from torchrl.modules import MLP, ProbabilisticActor, TanhNormal, ValueOperator
 from torchrl.objectives import ClipPPOLoss
 from torchrl.objectives.value import GAE
@@ -47,7 +48,7 @@ from ..envs import high_five_v0, reach_v0
 from ..gpu import GymVectorEnv
 
 __all__ = ["TASKS", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObsNorm", "make_env",
-           "build_networks", "train_gpu_ppo", "read_progress"]
+           "build_networks", "act", "train_gpu_ppo", "read_progress"]
 
 #: the tasks the on-device PPO trains: name -> the CPU env with one learner
 TASKS = {"reach": reach_v0.parallel_env, "high_five": high_five_v0.scripted_env}
@@ -223,6 +224,17 @@ def build_networks(n_obs: int, low: torch.Tensor, high: torch.Tensor, config: Gp
     return actor, critic, norm
 
 
+@torch.no_grad()
+def act(actor, obs: torch.Tensor, explore: bool = True) -> TensorDict:
+    """The actor on ``obs`` ``(n, size)``: the actions sampled from its distribution
+    (``explore``; TorchRL's modules take the distribution's mode unless told to sample) or its
+    deterministic action, with their log-probabilities, as a TensorDict ``(n,)``."""
+    kind = ExplorationType.RANDOM if explore else ExplorationType.DETERMINISTIC
+    with set_exploration_type(kind):
+        return actor(TensorDict({"observation": obs}, batch_size=[obs.shape[0]],
+                                device=obs.device))
+
+
 def _flat(obs: dict) -> torch.Tensor:
     """The senses of one observation Dict, concatenated in their order, ``(n, size)``."""
     return torch.cat([obs[k].to(torch.float32) for k in obs], dim=-1)
@@ -296,7 +308,7 @@ def _collect(venv, actor, obs, ep_return, ep_length, config):
     dev = obs.device
     steps, sums = [], torch.zeros(4, device=dev)   # episodes, returns, lengths, successes
     for _ in range(config.rollout):
-        td = actor(TensorDict({"observation": obs}, batch_size=[config.worlds], device=dev))
+        td = act(actor, obs)
         nxt, rew, term, trunc, infos = venv.step(td["action"])
         rew = rew.to(torch.float32)
         done = term | trunc

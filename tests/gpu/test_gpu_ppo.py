@@ -89,6 +89,20 @@ def test_gpu_ppo_high_five_learns_beside_its_partner_on_the_device(tmp_path):
     assert meta["observation_size"] == 48 + 6    # proprioception and vestibular
 
 
+def test_gpu_ppo_samples_its_actions_while_collecting():
+    """The rollout explores: the same observation gives other actions each time (TorchRL's
+    actor gives its mode unless told to sample), within the Box; without exploring, the mode."""
+    lo, hi = -torch.ones(3), torch.ones(3)
+    actor, _, _ = gpu_ppo.build_networks(5, lo, hi, GpuPPOConfig())
+    obs = torch.zeros(64, 5)
+    sampled = gpu_ppo.act(actor, obs)["action"]
+    assert sampled.shape == (64, 3) and (sampled.abs() <= 1).all()
+    assert sampled.std(0).min() > 0.2        # tanh of a unit normal: about 0.6
+    mode = gpu_ppo.act(actor, obs, explore=False)["action"]
+    assert torch.equal(mode, mode[:1].expand_as(mode))
+    assert torch.isfinite(gpu_ppo.act(actor, obs)["action_log_prob"]).all()
+
+
 def test_gpu_ppo_running_normalisation_is_the_mean_and_variance_of_all_rows():
     rng = np.random.default_rng(0)
     parts = [rng.normal(3.0, 2.0, (n, 4)).astype(np.float32) for n in (5, 1, 17)]
