@@ -3,7 +3,8 @@
 device; with a task's logic, partners and autoreset
 (:class:`~mimo_social.gpu.task_env.BatchedTaskEnv`), as a Gymnasium vector env
 (:class:`~mimo_social.gpu.vector.GymVectorEnv`) or a TorchRL env
-(:class:`~mimo_social.gpu.torchrl_env.TorchRLEnv`, imported on first use: it needs torchrl).
+(:class:`~mimo_social.gpu.torchrl_env.TorchRLEnv`, imported on first use: it needs torchrl);
+touch per body part (:class:`~mimo_social.gpu.touch.BatchedTouch`).
 Needs the ``gpu`` extra; what runs on the device and what does not: docs/gpu.md."""
 
 from .batched import DERIVED_FIELDS, STATE_FIELDS, BatchedEnv
@@ -14,13 +15,14 @@ from .partners import BatchedHandOffer, batched_partner
 from .proprioception import BatchedProprioception
 from .task_env import BatchedTaskEnv
 from .tasks import TASKS, BatchedHighFive, BatchedReach, batched_task
+from .touch import BatchedTouch
 from .vector import GymVectorEnv, device_spaces
 from .vestibular import BatchedVestibular
 
 __all__ = ["BatchedEnv", "BatchedTaskEnv", "GymVectorEnv", "TorchRLEnv", "AgentControls",
            "BatchedContacts", "BatchedHandOffer", "BatchedHighFive", "BatchedProprioception",
-           "BatchedReach", "BatchedVestibular", "DERIVED_FIELDS", "STATE_FIELDS", "SUPPORTED",
-           "TASKS", "batched_partner", "batched_task", "check_actuation", "describe",
+           "BatchedReach", "BatchedTouch", "BatchedVestibular", "DERIVED_FIELDS", "STATE_FIELDS",
+           "SUPPORTED", "TASKS", "batched_partner", "batched_task", "check_actuation", "describe",
            "device_spaces", "has_gpu", "pick_device", "require"]
 
 
