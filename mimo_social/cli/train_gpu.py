@@ -5,7 +5,8 @@ device (:mod:`mimo_social.train.gpu_ppo`; docs/gpu.md). Needs the ``gpu`` extra.
     mimo-social train-gpu --task high_five --worlds 64 --steps 200000 --out runs/hf
 
 Writes ``config.json``, ``progress.csv`` (one row per iteration: timesteps, wall time, mean
-return and success rate of the episodes that finished) and ``policy.pt`` to ``--out``. Runs on
+return and success rate of the episodes that finished), ``policy.pt`` and
+``learning_curve.png`` to ``--out``. Runs on
 a GPU when Warp sees one (``--device auto``), else on Warp's CPU device, and says which.
 """
 
@@ -68,7 +69,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..train.gpu_ppo import GpuPPOConfig, train_gpu_ppo
+    from ..train.gpu_ppo import GpuPPOConfig, plot_progress, train_gpu_ppo
 
     config = GpuPPOConfig(task=args.task, worlds=args.worlds, steps=args.steps, seed=args.seed,
                           learning_rate=args.lr, epochs=args.epochs, minibatch=args.minibatch,
@@ -84,6 +85,12 @@ def run(args: argparse.Namespace) -> int:
               f"steps/s)", flush=True)
 
     out = train_gpu_ppo(config, args.out, progress=show)
+    wrote = "config.json, progress.csv, policy.pt"
+    try:
+        plot_progress(args.out)
+        wrote += ", learning_curve.png"
+    except (ImportError, ValueError) as e:   # no matplotlib, or no episode finished
+        print(f"no learning curve: {e}")
     print(f"device: {out['device']} ({out['device_name']}); {out['iterations']} iterations; "
-          f"wrote {args.out}/config.json, progress.csv, policy.pt")
+          f"wrote {wrote} to {args.out}")
     return 0

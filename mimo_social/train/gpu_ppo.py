@@ -18,7 +18,9 @@ terminated), GAE over the rollout, ``epochs`` passes over it in shuffled minibat
 ``minibatch`` samples, then the normaliser takes the rollout's observations. The episode
 figures are summed on the device and read once per iteration: one row of ``progress.csv``
 (:data:`PROGRESS_COLUMNS`). The run writes ``config.json``, ``progress.csv`` and ``policy.pt``
-(the actor's state_dict, the normaliser's statistics included) to ``out``.
+(the actor's state_dict, the normaliser's statistics included) to ``out``;
+:func:`plot_progress` draws the progress (``mimo-social train-gpu`` does, to
+``learning_curve.png``).
 
 Determinism: under one ``seed`` two runs on Warp's CPU device give the same progress (torch's
 generator is seeded from it, the worlds' resets are the CPU env's with seeds from it; torch
@@ -35,6 +37,7 @@ import time
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
+import numpy as np
 import torch
 from tensordict import TensorDict
 from tensordict.nn import TensorDictModule
@@ -48,7 +51,7 @@ from ..envs import high_five_v0, reach_v0
 from ..gpu import GymVectorEnv
 
 __all__ = ["TASKS", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObsNorm", "make_env",
-           "build_networks", "act", "train_gpu_ppo", "read_progress"]
+           "build_networks", "act", "train_gpu_ppo", "read_progress", "plot_progress"]
 
 #: the tasks the on-device PPO trains: name -> the CPU env with one learner
 TASKS = {"reach": reach_v0.parallel_env, "high_five": high_five_v0.scripted_env}
@@ -377,3 +380,49 @@ def read_progress(path) -> list[dict]:
 def config_fields() -> tuple[str, ...]:
     """The names of :class:`GpuPPOConfig`'s settings."""
     return tuple(f.name for f in fields(GpuPPOConfig))
+
+
+def plot_progress(run, path=None, window: int = 5) -> Path:
+    """The run's ``progress.csv`` drawn: the success rate and the mean return of the episodes
+    that finished in each iteration (dots) and their mean over ``window`` iterations (line),
+    over world-steps, with the wall time on the top axis; to ``path`` (default
+    ``run/learning_curve.png``). Needs matplotlib."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    run = Path(run)
+    rows = [r for r in read_progress(run / "progress.csv") if r["episodes"]]
+    if not rows:
+        raise ValueError(f"{run / 'progress.csv'}: no iteration with finished episodes to draw")
+    meta = json.loads((run / "config.json").read_text())
+    cfg = meta["config"]
+    x = np.array([r["timesteps"] for r in rows])
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+    for ax, key, label in ((axes[0], "success_rate", "success rate"),
+                           (axes[1], "episode_return_mean", "mean episode return")):
+        y = np.array([r[key] for r in rows])
+        w = np.array([r["episodes"] for r in rows], float)
+        k = min(window, len(y))
+        smooth = np.array([np.average(y[max(0, i - k + 1):i + 1], weights=w[max(0, i - k + 1):
+                                                                            i + 1])
+                           for i in range(len(y))])
+        ax.plot(x, y, ".", color="0.7", ms=3, label="per iteration")
+        ax.plot(x, smooth, "-", color="C0", label=f"over {k} iterations")
+        ax.set_xlabel("world-steps")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        if len(x) > 1:   # the wall time on the top axis
+            wall = [r["wall_time_s"] for r in rows]
+            top = ax.secondary_xaxis("top", functions=(lambda s: np.interp(s, x, wall),
+                                                       lambda t: np.interp(t, wall, x)))
+            top.set_xlabel("wall time, s")
+    axes[0].set_ylim(-0.02, 1.02)
+    axes[0].legend(loc="upper left", fontsize=8)
+    fig.suptitle(f"PPO on the device: {cfg['task']}, {cfg['worlds']} worlds, seed {cfg['seed']}"
+                 f" ({meta['device_name']})", fontsize=10)
+    fig.tight_layout()
+    path = Path(path) if path is not None else run / "learning_curve.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -152,6 +152,8 @@ def test_gpu_ppo_command_trains_a_tiny_run(tmp_path, capsys):
             meta["max_steps"], meta["seed"], meta["learning_rate"]) == (2, 8, 4, 8, 1, 3, 1,
                                                                          1e-3)
     assert (out / "policy.pt").is_file() and len(read_progress(out / "progress.csv")) == 1
+    png = (out / "learning_curve.png").read_bytes()
+    assert png.startswith(b"\x89PNG") and len(png) > 10_000
 
 
 @pytest.mark.parametrize("argv, option", [
