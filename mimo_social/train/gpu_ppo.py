@@ -51,7 +51,8 @@ from ..envs import high_five_v0, reach_v0
 from ..gpu import GymVectorEnv
 
 __all__ = ["TASKS", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObsNorm", "make_env",
-           "build_networks", "act", "train_gpu_ppo", "read_progress", "plot_progress"]
+           "build_networks", "act", "train_gpu_ppo", "evaluate_gpu_ppo", "read_progress",
+           "plot_progress"]
 
 #: the tasks the on-device PPO trains: name -> the CPU env with one learner
 TASKS = {"reach": reach_v0.parallel_env, "high_five": high_five_v0.scripted_env}
@@ -368,6 +369,51 @@ def _row(it, timesteps, wall, stats, losses, fps) -> dict:
             "episode_length_mean": each(length), "loss_policy": f"{losses[0]:.6g}",
             "loss_critic": f"{losses[1]:.6g}", "loss_entropy": f"{losses[2]:.6g}",
             "steps_per_s": f"{fps:.1f}"}
+
+
+def evaluate_gpu_ppo(run, worlds: int = 64, seed: int = 1_000_000, explore: bool = False,
+                     device: str | None = None) -> dict:
+    """The first episode of each of ``worlds`` worlds (seeds ``seed + w``: episodes the run did
+    not train on, with the default) under ``run``'s ``policy.pt``: its mode (``explore``
+    False) or sampled actions. Returns the success rate, the mean return and length of those
+    episodes, and what was run."""
+    run = Path(run)
+    meta = json.loads((run / "config.json").read_text())
+    settings = dict(meta["config"], worlds=int(worlds), seed=int(seed), device=device,
+                    minibatch=1)
+    config = GpuPPOConfig(**settings)
+    torch.manual_seed(config.seed)
+    venv = make_env(config)
+    obs_dict, _ = venv.reset(seed=config.seed)
+    obs = _flat(obs_dict)
+    dev = obs.device
+    space = venv.single_action_space
+    low = torch.as_tensor(space.low, dtype=torch.float32, device=dev)
+    high = torch.as_tensor(space.high, dtype=torch.float32, device=dev)
+    actor, _, _ = build_networks(int(obs.shape[-1]), low, high, config)
+    actor.load_state_dict(torch.load(run / "policy.pt", map_location=dev))
+    n = config.worlds
+    ret, length = torch.zeros(n, device=dev), torch.zeros(n, device=dev)
+    first = torch.zeros((3, n), device=dev)     # return, length, success of the first episode
+    finished = torch.zeros(n, dtype=torch.bool, device=dev)
+    for _ in range(venv.tenv.max_steps):
+        nxt, rew, term, trunc, infos = venv.step(act(actor, obs, explore)["action"])
+        ret += rew.to(torch.float32)
+        length += 1
+        new = (term | trunc) & ~finished
+        succ = infos["final_info"]["is_success"].to(torch.float32)
+        first[:, new] = torch.stack([ret, length, succ])[:, new]
+        finished |= term | trunc
+        ret *= ~(term | trunc)
+        length *= ~(term | trunc)
+        obs = _flat(nxt)
+        if bool(finished.all()):
+            break
+    venv.close()
+    r, ln, sc = first.mean(1).tolist()
+    return {"episodes": n, "success_rate": sc, "return_mean": r, "length_mean": ln,
+            "policy": "sampled" if explore else "mode", "seed": config.seed,
+            "task": config.task, "device": str(dev)}
 
 
 def read_progress(path) -> list[dict]:

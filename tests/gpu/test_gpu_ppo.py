@@ -180,3 +180,14 @@ def test_gpu_ppo_command_names_a_setting_refused_while_running(tmp_path, capsys)
     err = capsys.readouterr().err
     assert err.startswith("mimo-social train-gpu: error: minibatch=9 not allowed; allowed: at "
                           "most worlds * rollout = 2 * 4 = 8")
+
+
+def test_gpu_ppo_evaluates_a_run_on_episodes_it_did_not_train_on(reach_run):
+    out, _ = reach_run
+    ev = gpu_ppo.evaluate_gpu_ppo(out, worlds=3, device="cpu")
+    assert ev["episodes"] == 3 and ev["policy"] == "mode" and ev["seed"] == 1_000_000
+    assert ev["length_mean"] == 3.0 and 0 <= ev["success_rate"] <= 1   # episodes of 3 steps
+    assert np.isfinite(ev["return_mean"]) and ev["return_mean"] < 0    # not at the ball yet
+    assert gpu_ppo.evaluate_gpu_ppo(out, worlds=3, device="cpu") == ev
+    sampled = gpu_ppo.evaluate_gpu_ppo(out, worlds=3, device="cpu", explore=True)
+    assert sampled["return_mean"] != ev["return_mean"]
