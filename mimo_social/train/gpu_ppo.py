@@ -436,6 +436,7 @@ def plot_progress(run, path=None, window: int = 5) -> Path:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     run = Path(run)
     rows = [r for r in read_progress(run / "progress.csv") if r["episodes"]]
@@ -462,6 +463,8 @@ def plot_progress(run, path=None, window: int = 5) -> Path:
             wall = [r["wall_time_s"] for r in rows]
             top = ax.secondary_xaxis("top", functions=(lambda s: np.interp(s, x, wall),
                                                        lambda t: np.interp(t, wall, x)))
+            ticks = MaxNLocator(6).tick_values(wall[0], wall[-1])
+            top.set_xticks([t for t in ticks if wall[0] <= t <= wall[-1]])
             top.set_xlabel("wall time, s")
     axes[0].set_ylim(-0.02, 1.02)
     axes[0].legend(loc="upper left", fontsize=8)
