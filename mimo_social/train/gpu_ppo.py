@@ -34,7 +34,7 @@ import csv
 import json
 import math
 import time
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -290,7 +290,7 @@ def train_gpu_ppo(config: GpuPPOConfig, out, progress=None) -> dict:
         for it in range(config.iterations):
             t_it = time.perf_counter()
             batch, obs, stats = _collect(venv, actor, obs, ep_return, ep_length, config)
-            losses = _learn(batch, actor, gae, loss_fn, optim, gen, config)
+            losses = _learn(batch, gae, loss_fn, optim, gen, config)
             norm.update(batch["observation"])
             row = _row(it, (it + 1) * config.batch, time.perf_counter() - t_start, stats,
                        losses, config.batch / (time.perf_counter() - t_it))
@@ -335,7 +335,7 @@ def _collect(venv, actor, obs, ep_return, ep_length, config):
     return batch, obs, sums.tolist()
 
 
-def _learn(batch, actor, gae, loss_fn, optim, gen, config):
+def _learn(batch, gae, loss_fn, optim, gen, config):
     """GAE over the rollout, then ``epochs`` passes of shuffled minibatches; the mean
     losses of the last pass."""
     with torch.no_grad():
@@ -421,11 +421,6 @@ def read_progress(path) -> list[dict]:
     with open(path, newline="") as f:
         return [{k: (float(v) if v not in ("", None) else None) for k, v in r.items()}
                 for r in csv.DictReader(f)]
-
-
-def config_fields() -> tuple[str, ...]:
-    """The names of :class:`GpuPPOConfig`'s settings."""
-    return tuple(f.name for f in fields(GpuPPOConfig))
 
 
 def plot_progress(run, path=None, window: int = 5) -> Path:
