@@ -239,6 +239,18 @@ def act(actor, obs: torch.Tensor, explore: bool = True) -> TensorDict:
                                 device=obs.device))
 
 
+def _start(config: GpuPPOConfig):
+    """The vector env reset with the config's seed, its first observations (flat) and fresh
+    networks sized for them: ``(venv, obs, (actor, critic, norm))``."""
+    venv = make_env(config)
+    obs_dict, _ = venv.reset(seed=config.seed)
+    obs = _flat(obs_dict)
+    space = venv.single_action_space
+    low = torch.as_tensor(space.low, dtype=torch.float32, device=obs.device)
+    high = torch.as_tensor(space.high, dtype=torch.float32, device=obs.device)
+    return venv, obs, build_networks(int(obs.shape[-1]), low, high, config)
+
+
 def _flat(obs: dict) -> torch.Tensor:
     """The senses of one observation Dict, concatenated in their order, ``(n, size)``."""
     return torch.cat([obs[k].to(torch.float32) for k in obs], dim=-1)
@@ -256,14 +268,8 @@ def train_gpu_ppo(config: GpuPPOConfig, out, progress=None) -> dict:
     if config.device != "cuda":
         torch.set_num_threads(1)   # the same sums every run (and Warp's CPU device beside it)
     t0 = time.perf_counter()
-    venv = make_env(config)
-    obs_dict, _ = venv.reset(seed=config.seed)
-    obs = _flat(obs_dict)
+    venv, obs, (actor, critic, norm) = _start(config)
     dev = obs.device
-    space = venv.single_action_space
-    low = torch.as_tensor(space.low, dtype=torch.float32, device=dev)
-    high = torch.as_tensor(space.high, dtype=torch.float32, device=dev)
-    actor, critic, norm = build_networks(int(obs.shape[-1]), low, high, config)
     norm.update(obs)
     loss_fn = ClipPPOLoss(actor, critic, clip_epsilon=config.clip_epsilon,
                           entropy_bonus=config.entropy_coeff > 0,
@@ -276,7 +282,8 @@ def train_gpu_ppo(config: GpuPPOConfig, out, progress=None) -> dict:
     gen = torch.Generator(device="cpu").manual_seed(config.seed)
     build_s = time.perf_counter() - t0
     meta = {"config": asdict(config), "device": str(dev), "device_name": venv.device_name,
-            "observation_size": int(obs.shape[-1]), "action_size": int(low.shape[-1]),
+            "observation_size": int(obs.shape[-1]),
+            "action_size": int(venv.single_action_space.shape[-1]),
             "build_s": build_s}
     (out / "config.json").write_text(json.dumps(meta, indent=1))
     n = config.worlds
@@ -383,14 +390,8 @@ def evaluate_gpu_ppo(run, worlds: int = 64, seed: int = 1_000_000, explore: bool
                     minibatch=1)
     config = GpuPPOConfig(**settings)
     torch.manual_seed(config.seed)
-    venv = make_env(config)
-    obs_dict, _ = venv.reset(seed=config.seed)
-    obs = _flat(obs_dict)
+    venv, obs, (actor, _, _) = _start(config)
     dev = obs.device
-    space = venv.single_action_space
-    low = torch.as_tensor(space.low, dtype=torch.float32, device=dev)
-    high = torch.as_tensor(space.high, dtype=torch.float32, device=dev)
-    actor, _, _ = build_networks(int(obs.shape[-1]), low, high, config)
     actor.load_state_dict(torch.load(run / "policy.pt", map_location=dev))
     n = config.worlds
     ret, length = torch.zeros(n, device=dev), torch.zeros(n, device=dev)
