@@ -20,9 +20,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..util.checks import check_int, check_seed
 from .batched import BatchedEnv
 from .partners import batched_partner
-from .tasks import TASKS, batched_task
+from .tasks import task_class
 
 __all__ = ["BatchedTaskEnv"]
 
@@ -38,19 +39,15 @@ class BatchedTaskEnv:
         inner = env.unwrapped
         scripted = dict(getattr(env, "partners", {}) or {})
         self.env, self.inner = env, inner
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-            raise ValueError(f"seed={seed!r} not allowed; allowed: an integer >= 0")
-        name = inner.task.name
-        if name not in TASKS:   # before the model goes to the device
-            raise ValueError(f"task {name!r} has no batched task logic on the GPU backend "
-                             f"(rewards, success, resets); allowed: {', '.join(sorted(TASKS))}")
-        env.reset(seed=int(seed))
+        seed = check_int("BatchedTaskEnv", "seed", seed, 0)
+        task = task_class(inner.task.name)   # before the model goes to the device
+        env.reset(seed=seed)
         self.batched = BatchedEnv(inner, nworld, device=device, seed=None, nconmax=nconmax,
-                                  njmax=njmax, batch_fields=TASKS[name].batch_fields)
+                                  njmax=njmax, batch_fields=task.batch_fields)
         self.torch = self.batched.torch
         self.nworld = self.batched.nworld
         self.device_name = self.batched.device_name
-        self.task = batched_task(inner, self.batched)
+        self.task = task(inner, self.batched)
         self.partners = {a: batched_partner(a, p, inner, self.batched)
                          for a, p in scripted.items()}
         self.agents = list(inner.possible_agents)
@@ -59,7 +56,7 @@ class BatchedTaskEnv:
         self.dt = float(inner.dt)
         dev = self.batched.qpos.device
         self.steps = self.torch.zeros(self.nworld, dtype=self.torch.int64, device=dev)
-        self._seed = int(seed)
+        self._seed = seed
         self._episode = np.zeros(self.nworld, np.int64)
         self._was_reset = False
 
@@ -76,9 +73,7 @@ class BatchedTaskEnv:
         if seed is not None:
             if worlds is not None:
                 raise ValueError("reset(seed=...) resets every world; give worlds=None")
-            if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-                raise ValueError(f"seed={seed!r} not allowed; allowed: None or an integer >= 0")
-            self._seed = int(seed)
+            self._seed = check_seed(seed, "BatchedTaskEnv.reset")
             self._episode[:] = 0
         elif self._was_reset and worlds is None:
             self._episode += 1

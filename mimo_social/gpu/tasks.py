@@ -27,7 +27,7 @@ from ..core.kinematics import hand_geoms
 from ..tasks.common import right_hand_parts
 from ..tasks.high_five.task import PALM_COS
 
-__all__ = ["TASKS", "BatchedReach", "BatchedHighFive", "batched_task"]
+__all__ = ["TASKS", "BatchedReach", "BatchedHighFive", "batched_task", "task_class"]
 
 
 class BatchedReach:
@@ -198,11 +198,15 @@ class BatchedHighFive:
 TASKS = {"reach": BatchedReach, "high_five": BatchedHighFive}
 
 
-def batched_task(env, batched):
-    """The batched logic of ``env``'s task (:data:`TASKS`), or a ValueError naming the task
-    and the tasks that run on the device."""
-    name = env.task.name
+def task_class(name: str):
+    """The batched logic class of task ``name`` (:data:`TASKS`), or a ValueError naming the
+    task and the tasks that run on the device."""
     if name not in TASKS:
         raise ValueError(f"task {name!r} has no batched task logic on the GPU backend (rewards, "
                          f"success, resets); allowed: {', '.join(sorted(TASKS))}")
-    return TASKS[name](env, batched)
+    return TASKS[name]
+
+
+def batched_task(env, batched):
+    """The batched logic of ``env``'s task (:func:`task_class`), bound to ``batched``."""
+    return task_class(env.task.name)(env, batched)

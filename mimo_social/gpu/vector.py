@@ -53,7 +53,7 @@ class GymVectorEnv(VectorEnv):
 
     def __init__(self, env, num_envs: int, device: str | None = None, seed: int = 0,
                  numpy: bool = False, nconmax: int | None = None, njmax: int | None = None):
-        learners = [a for a in env.possible_agents]
+        learners = list(env.possible_agents)
         if len(learners) != 1:
             raise ValueError(f"GymVectorEnv takes one learner; this env has {learners}: give "
                              f"the task's one-learner form (e.g. high_five_v0.scripted_env()), "
@@ -82,10 +82,11 @@ class GymVectorEnv(VectorEnv):
         obs, rew, term, trunc, infos = self.tenv.step({self.agent: actions})
         final = infos.pop("_final_obs")
         final_obs = infos.pop("final_obs")
-        out = self._info(infos)
+        info = self._info(infos)
+        out = dict(info)
         out["final_obs"] = self._out(final_obs[self.agent])
         out["_final_obs"] = self._out(final)
-        out["final_info"] = dict(self._info(infos))
+        out["final_info"] = info
         out["_final_info"] = self._out(final)
         return (self._out(obs[self.agent]), self._out(rew[self.agent]), self._out(term),
                 self._out(trunc), out)
