@@ -432,7 +432,9 @@ def plot_progress(run, path=None, window: int = 5) -> Path:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import FuncFormatter, MaxNLocator
+    from matplotlib.ticker import MaxNLocator
+
+    from .plots import steps_axis
 
     run = Path(run)
     rows = [r for r in read_progress(run / "progress.csv") if r["episodes"]]
@@ -452,9 +454,7 @@ def plot_progress(run, path=None, window: int = 5) -> Path:
                            for i in range(len(y))])
         ax.plot(x, y, ".", color="0.7", ms=3, label="per iteration")
         ax.plot(x, smooth, "-", color="C0", label=f"over {k} iterations")
-        ax.set_xlabel("world-steps")
-        ax.xaxis.set_major_formatter(FuncFormatter(
-            lambda v, _: f"{v / 1e6:g}M" if abs(v) >= 1e6 else f"{v / 1e3:g}k" if v else "0"))
+        steps_axis(ax, "world-steps")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
         if len(x) > 1:   # the wall time on the top axis

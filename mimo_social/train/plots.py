@@ -22,24 +22,24 @@ import numpy as np
 
 from .progress import PROGRESS_FIELDS, progress_agents, read_progress
 
-__all__ = ["COLORS", "plot_learning_curve", "plot_compare", "plot_fig8", "runs_by_group",
-           "plot_cross_age"]
+__all__ = ["COLORS", "steps_axis", "plot_learning_curve", "plot_compare", "plot_fig8",
+           "runs_by_group", "plot_cross_age"]
 
 COLORS = {"ppo": "tab:red", "sac": "tab:blue", "ppo recipe": "tab:green",
           "sac recipe": "tab:purple"}
 
 
 
-def _steps_axis(ax) -> None:
-    """Label an axis of environment steps, its ticks short (``50k``, ``1.2M``) so that they do
-    not run into each other on long runs."""
+def steps_axis(ax, label: str = "environment steps") -> None:
+    """Label an x axis of steps (``label``), its ticks short (``50k``, ``1.2M``) so that they
+    do not run into each other on long runs."""
     from matplotlib.ticker import FuncFormatter
 
     def short(v, _pos):
         if abs(v) >= 1e6:
             return f"{v / 1e6:g}M"
         return f"{v / 1e3:g}k" if abs(v) >= 1e3 else f"{v:g}"
-    ax.set_xlabel("environment steps")
+    ax.set_xlabel(label)
     ax.xaxis.set_major_formatter(FuncFormatter(short))
 
 def _interrupted(config: dict) -> str:
@@ -79,7 +79,7 @@ def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path
     if sampled:
         ax.plot(t, p["eval_return_mean_stochastic"], "--s", ms=3, color="black", alpha=0.7,
                 label="evaluation, sampled actions (mean)")
-    _steps_axis(ax)
+    steps_axis(ax)
     ax.set_ylabel("episode return")
     ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
                  f"(seed {config.get('seed', '?')})" + _interrupted(config))
@@ -93,7 +93,7 @@ def plot_learning_curve(run: str | Path, path: str | Path | None = None) -> Path
                     alpha=0.7, label="sampled actions")
             ax.legend(loc="best", fontsize=8)
         ax.set_ylim(-5, 105)
-        _steps_axis(ax)
+        steps_axis(ax)
         ax.set_ylabel("evaluation success rate (%)")
         ax.grid(alpha=0.3)
     fig.tight_layout()
@@ -132,7 +132,7 @@ def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> P
         if f"eval_return_mean_{a}_stochastic" in p:
             ax.plot(t, p[f"eval_return_mean_{a}_stochastic"], ls=ls, marker="x", ms=4,
                     color=colors[a], alpha=0.45, label=f"{a} (sampled actions)")
-    _steps_axis(ax)
+    steps_axis(ax)
     ax.set_ylabel("episode return")
     ax.set_title(f"{config.get('task', '?')} - {config.get('algo', '?').upper()} "
                  f"{config.get('mode', '')} (seed {config.get('seed', '?')})"
@@ -149,7 +149,7 @@ def _plot_agents(run: Path, path: Path, p, config: dict, agents: list[str]) -> P
                 ax.plot(t, 100 * p[f"eval_success_rate_{a}_stochastic"], ls=ls, marker="x",
                         ms=4, color=colors[a], alpha=0.45, label=f"{a} (sampled actions)")
         ax.set_ylim(-5, 105)
-        _steps_axis(ax)
+        steps_axis(ax)
         ax.set_ylabel("evaluation success rate (%)")
         ax.legend(loc="best", fontsize=8)
         ax.grid(alpha=0.3)
@@ -279,7 +279,7 @@ def plot_compare(out: str | Path, task: str | None = None) -> Path:
                          if (i, j) == (0, 0) else what, fontsize=9)
             ax.set_xlabel(xlabel)
             if xlabel == "environment steps":
-                _steps_axis(ax)
+                steps_axis(ax)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
             if key == "eval_success_rate":
@@ -331,7 +331,7 @@ def plot_fig8(out: str | Path, tasks, png: str | Path | None = None,
             if log_steps:
                 ax.set_xscale("log")
             if j == 0:
-                _steps_axis(ax)
+                steps_axis(ax)
             ax.set_ylabel("episode return")
             ax.grid(alpha=0.3)
         axes[i, 0].legend(loc="best", fontsize=8)
