@@ -21,6 +21,7 @@ import os
 from pathlib import Path
 
 __all__ = ["positive_int", "non_negative_int", "int_range", "seed", "positive_float",
+           "non_negative_float",
            "float_above", "input_file", "input_dir", "output_file", "output_dir", "json_object",
            "env_kwargs", "comma_choices", "write_file", "draw_to",
            "SEED_MAX"]
@@ -73,6 +74,17 @@ def float_above(lo: float):
 
 
 positive_float = float_above(0.0)
+
+
+def non_negative_float(text: str) -> float:
+    """A finite number >= 0."""
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise Bad(f"{text!r} is not a number; allowed: a finite number >= 0") from None
+    if not math.isfinite(value) or value < 0:
+        raise Bad(f"{text} not allowed; allowed: a finite number >= 0")
+    return value
 
 
 def comma_choices(choices, what: str = "value", as_text: bool = False):

@@ -39,25 +39,13 @@ from pathlib import Path
 from ..train import (ALGOS, ALL_TASKS, MULTI_TASKS, TASKS, TrainInputError, VideoUnavailable,
                      compare, evaluate, train)
 from ..train.comparison import parse_steps_per_algo
-from ._args import (env_kwargs, input_dir, json_object, non_negative_int, output_dir, output_file,
-                    positive_float, positive_int, seed)
+from ._args import (env_kwargs, input_dir, json_object, non_negative_float, non_negative_int,
+                    output_dir, output_file, positive_float, positive_int, seed)
 
 __all__ = ["add_parser"]
 
 
 _json_arg = json_object   # (kept for callers of the old name)
-
-
-def non_negative_float(text: str) -> float:
-    """A finite number >= 0."""
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number; allowed: a finite number "
-                                         ">= 0") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"{text} not allowed; allowed: a finite number >= 0")
-    return value
 
 
 def _common(p, steps_required: bool = True):

@@ -13,25 +13,13 @@ a GPU when Warp sees one (``--device auto``), else on Warp's CPU device, and say
 from __future__ import annotations
 
 import argparse
-import math
 
-from ._args import output_dir, positive_float, positive_int, seed
+from ._args import non_negative_float, output_dir, positive_float, positive_int, seed
 
 __all__ = ["NAME", "add_parser", "run"]
 
 NAME = "train-gpu"
 TASKS = ("reach", "high_five")
-
-
-def _non_negative(text: str) -> float:
-    """A finite number >= 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r} not allowed; allowed: a finite number >= 0")
-    return value
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -60,7 +48,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="control steps of every world per iteration (default 32)")
     parser.add_argument("--max-steps", type=positive_int, default=None,
                         help="episode length (default: the task's)")
-    parser.add_argument("--entropy-coeff", type=_non_negative, default=0.0,
+    parser.add_argument("--entropy-coeff", type=non_negative_float, default=0.0,
                         help="the entropy bonus' weight (default 0)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto",
                         help="auto (default): a GPU when Warp sees one, else the CPU")
