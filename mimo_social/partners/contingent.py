@@ -29,8 +29,13 @@ generator per event, seeded by :class:`~mimo_social.partners.wrapper.ScriptedPar
 ``delay_s`` seconds rounded to control steps (``delay_steps = round(delay_s / dt)``): an event
 first seen in the world's state at the caregiver's step ``n`` (the state the learner's action
 of step ``n - 1`` left) is answered by the caregiver's action of step ``n + delay_steps``
-(``delay_s=0``: the same step). A response lasts ``duration_s`` seconds (rounded to steps, at
-least one); a new response of the same kind replaces a running one. Between responses the face
+(``delay_s=0``: the same step); with ``delay_jitter_s`` each answered event's delay is
+``delay_s`` plus a uniform draw from [0, ``delay_jitter_s``] (one more draw per answered event),
+so that an answer's moment cannot be foretold from the event's. A response lasts ``duration_s``
+seconds (rounded to steps, at least one); a new response of the same kind replaces a running
+one, unless ``refractory``: then an event whose kind has a response pending or running is not
+answered (no draw; logged ``answered=False``, ``ignored=True``): a caregiver does not smile anew
+at every flicker of a face while it is still answering the last smile. Between responses the face
 is ``rest_face`` (neutral) and head and eyes look at the learner's face (its ``head_centre``);
 every other motor holds the pose it had at reset.
 
@@ -131,12 +136,13 @@ def _check_rates(value, cues) -> dict | None:
 class ContingentCaregiver(Partner):
     """A caregiver that answers the learner's cues (see the module docstring).
 
-    Settings: ``cues`` (which cue events count), ``delay_s`` (0-60 s), ``probability`` (0-1
-    per event), ``duration_s`` (0.01-60 s: how long a response lasts), ``face`` (``"smile"``
-    or ``"copy"``), ``rest_face`` (an expression name), ``mode`` (the mode each episode starts
-    in), ``rate_hz`` (None: non-contingent rates measured; a number or a mapping cue -> rate),
-    ``learner`` (None: the other agent of a pair), ``omega`` / ``zeta`` (the spring-damper PD).
-    ``measured_rates`` (responses per second of each cue in the last interactive period that
+    Settings: ``cues`` (which cue events count), ``delay_s`` (0-60 s), ``delay_jitter_s`` (0-60 s:
+    added delay, uniform), ``refractory`` (events of a kind being answered are ignored),
+    ``probability`` (0-1 per event), ``duration_s`` (0.01-60 s: how long a response lasts), ``face``
+    (``"smile"`` or ``"copy"``), ``rest_face`` (an expression name), ``mode`` (the mode each episode
+    starts in), ``rate_hz`` (None: non-contingent rates measured; a number or a mapping cue ->
+    rate), ``learner`` (None: the other agent of a pair), ``omega`` / ``zeta`` (the spring-damper
+    PD). ``measured_rates`` (responses per second of each cue in the last interactive period that
     ended, of this or an earlier episode) is kept across resets, so a non-contingent episode can
     follow a live one.
     """
@@ -144,10 +150,16 @@ class ContingentCaregiver(Partner):
     def __init__(self, cues=CUES, delay_s: float = 0.5, probability: float = 1.0,
                  duration_s: float = 1.0, face: str = "smile", rest_face: str = "neutral",
                  mode: str = "interactive", rate_hz=None, learner: str | None = None,
-                 omega: float = 15.0, zeta: float = 1.0):
+                 omega: float = 15.0, zeta: float = 1.0, delay_jitter_s: float = 0.0,
+                 refractory: bool = False):
         who = "ContingentCaregiver"
         self.cues = _check_cues(cues)
         self.delay_s = check_number(who, "delay_s", delay_s, 0.0, 60.0)
+        self.delay_jitter_s = check_number(who, "delay_jitter_s", delay_jitter_s, 0.0, 60.0)
+        if not isinstance(refractory, (bool, np.bool_)):
+            raise ConfigError(f"{who}: refractory={show(refractory)} not allowed; allowed: True "
+                              "or False")
+        self.refractory = bool(refractory)
         self.probability = check_number(who, "probability", probability, 0.0, 1.0)
         self.duration_s = check_number(who, "duration_s", duration_s, 0.01, 60.0)
         self.face = check_choice(who, "face", face, FACES)
@@ -170,7 +182,8 @@ class ContingentCaregiver(Partner):
         self._faces: list[int] = []
 
     def __repr__(self) -> str:
-        return (f"ContingentCaregiver(cues={self.cues}, delay_s={self.delay_s}, probability="
+        return (f"ContingentCaregiver(cues={self.cues}, delay_s={self.delay_s}, delay_jitter_s="
+                f"{self.delay_jitter_s}, refractory={self.refractory}, probability="
                 f"{self.probability}, duration_s={self.duration_s}, face={self.face!r}, "
                 f"mode={self.mode!r})")
 
@@ -241,6 +254,7 @@ class ContingentCaregiver(Partner):
         self._scratch = mujoco.MjData(m)
         self._dt = float(env.dt)
         self.delay_steps = int(round(self.delay_s / self._dt))
+        self.jitter_steps = int(round(self.delay_jitter_s / self._dt))
         self.duration_steps = max(1, int(round(self.duration_s / self._dt)))
         self._home = w.data.qpos[self._qadr].copy()
         self._env = env
@@ -364,9 +378,14 @@ class ContingentCaregiver(Partner):
         if "touch" in self.cues and now.touching and not prev.touching:
             found.append(("touch", None))
         for cue, content in found:
-            answered = bool(self.rng.random() < self.probability)
+            busy = self.refractory and (self._active.get(cue, (0, n))[1] > n
+                                        or any(p[1] == cue for p in self._pending))
+            answered = not busy and bool(self.rng.random() < self.probability)
             due = n + self.delay_steps
-            self.events.append({"step": n, "cue": cue, "answered": answered, "due": due})
+            if answered and self.jitter_steps:
+                due += int(self.rng.integers(self.jitter_steps + 1))
+            self.events.append({"step": n, "cue": cue, "answered": answered, "due": due,
+                                "ignored": busy})
             if answered:
                 self._pending.append((due, cue, content, n))
 

@@ -151,6 +151,32 @@ def test_smile_back_follows_the_delay_and_the_probability():
                                                       if e["answered"]]
 
 
+def test_jitter_spreads_the_delay_and_refractory_ignores_events_while_answering():
+    """delay_jitter_s: each answered smile shows delay_steps + 1 + a draw of 0..jitter_steps
+    after the learner's, the draws spread over that range; refractory: a smile onset while an
+    answer is pending or shown is logged ignored and not answered (without it, every one is)."""
+    p = ContingentCaregiver(cues=("expression",), delay_s=0.1, delay_jitter_s=0.2,
+                            probability=1.0, duration_s=0.05)
+    faces, _ = run(face_env(p, ADULT_POS), lambda k, lr: lr.face_only(
+        HAPPY if k % 50 < 5 else NEUTRAL), 50 * 40)
+    assert p.jitter_steps == 20 and len(p.responses) == 40
+    latency = np.array([e["due"] - e["step"] for e in p.events])
+    assert latency.min() >= 10 and latency.max() <= 30 and len(np.unique(latency)) > 8
+    smile_on = np.flatnonzero((faces[1:, 1] == HAPPY) & (faces[:-1, 1] != HAPPY)) + 1
+    assert np.array_equal(smile_on - 50 * np.arange(40), latency + 1)
+    counts = {}
+    for refractory in (False, True):
+        p = ContingentCaregiver(cues=("expression",), delay_s=0.1, probability=1.0,
+                                duration_s=0.3, refractory=refractory)
+        run(face_env(p, ADULT_POS), lambda k, lr: lr.face_only(HAPPY if k % 4 < 2 else 0), 400)
+        counts[refractory] = (len(p.events), len(p.responses),
+                              sum(bool(e.get("ignored")) for e in p.events))
+    # without: every onset answered (the last ones' answers due after the run)
+    assert counts[False][0] == 100 and counts[False][1] >= 97 and counts[False][2] == 0
+    events, responses, ignored = counts[True]
+    assert events == 100 and responses + ignored == 100 and responses <= 400 // 40 + 1
+
+
 def test_probability_zero_and_one():
     for prob, expected in ((0.0, 0), (1.0, 10)):
         p = ContingentCaregiver(cues=("expression",), delay_s=0.0, probability=prob,
@@ -379,7 +405,8 @@ def test_non_contingent_timer_ignores_the_learner():
     ({"duration_s": 0}, "duration_s"), ({"face": "frown"}, "face"),
     ({"rest_face": "grumpy"}, "rest_face"), ({"mode": "sleepy"}, "mode"),
     ({"rate_hz": -2}, "rate_hz"), ({"rate_hz": {"smell": 1}}, "rate_hz"),
-    ({"learner": 3}, "learner")])
+    ({"learner": 3}, "learner"), ({"delay_jitter_s": -0.1}, "delay_jitter_s"),
+    ({"refractory": "yes"}, "refractory")])
 def test_bad_settings_are_named(kwargs, words):
     with pytest.raises(ConfigError, match=words):
         ContingentCaregiver(**kwargs)

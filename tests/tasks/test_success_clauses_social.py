@@ -50,13 +50,16 @@ still_face (the engaged steps reach ``success_fraction`` of the interaction and 
   - ``success_fraction`` and "reach" (>=, from that step on): the same share test;
   - no termination: existing (every scripted run lasts its phases).
 
-contingency (the shared-smile steps reach ``success_fraction`` of ``max_steps``):
+contingency (the shared-smile steps reach ``success_fraction`` of ``max_steps`` and at least
+``success_match`` of the learner's smiling steps):
   - a shared step needs the learner's smile (existing: the detector's live run) and the
     caregiver's: ``test_contingency_a_shared_smile_needs_both_faces_happy``;
   - and the learner's gaze on the face (``gaze_free``, the default):
     ``test_contingency_a_shared_smile_needs_the_learners_gaze_on_the_face``;
   - ``success_fraction`` of ``max_steps``, "reach":
     ``test_contingency_success_is_the_shared_share_of_max_steps``;
+  - ``success_match`` of the smiling steps shared:
+    ``test_contingency_success_needs_the_learners_smiles_shared``;
   - no termination: existing. The gaze measure of a learner that looks differs from one that
     does not: test_issue30_paradigms.py (test_contingency_gaze_measure_follows_...).
 
@@ -380,6 +383,15 @@ def test_still_face_success_is_the_engaged_share_of_the_interactive_steps(fracti
 
 
 # -- contingency ----------------------------------------------------------------------------------
+def _returns(env):
+    """A 5-step bid every 2.5 s, else the caregiver's face returned: happy while the
+    caregiver's is (read from the world: a perceiving learner's face)."""
+    inner = env.unwrapped
+    if inner.steps % 250 < 5:
+        return HAPPY
+    return HAPPY if inner.world.expression_of(1) == HAPPY else 0
+
+
 def _dips(env):
     """Happy but for one neutral step every 0.5 s: each dip makes a new smile onset, which the
     live caregiver answers (the reward's optimum, task table)."""
@@ -431,14 +443,15 @@ def test_contingency_a_shared_smile_needs_both_faces_happy():
 
 def test_contingency_a_shared_smile_needs_the_learners_gaze_on_the_face():
     """Clause 'the learner's gaze on the caregiver's face' (``gaze_free``, the default: the
-    learner's own head and eyes): the same smiles, renewed every 0.5 s, looking at the
-    caregiver's face share most steps and succeed; looking at its own hand they share none and
-    fail, though both faces are happy on most steps."""
-    looks = _contingency(Looks("caregiver_0/head_centre", _dips), 300)
-    assert looks[-1][0]["gaze_fraction"] > 0.8 and looks[-1][0]["shared_fraction"] > 0.6
+    learner's own head and eyes): the same bids and returned smiles, looking at the caregiver's
+    face, share most of the smiling steps and succeed; looking at its own hand they share none
+    and fail, though both faces are happy on many steps."""
+    looks = _contingency(Looks("caregiver_0/head_centre", _returns), 500,
+                         response_probability=1.0)
+    assert looks[-1][0]["gaze_fraction"] > 0.8 and looks[-1][0]["matched_fraction"] > 0.85
     assert looks[-1][0]["is_success"]
-    away = _contingency(Looks("infant_0/right_hand", _dips), 300)
-    assert sum(a and b for _, (a, b) in away) > 150
+    away = _contingency(Looks("infant_0/right_hand", _returns), 500, response_probability=1.0)
+    assert sum(a and b for _, (a, b) in away) > 100
     assert away[-1][0]["gaze_fraction"] == 0.0 and away[-1][0]["shared_steps"] == 0
     assert not any(i["is_success"] for i, _ in away)
 
@@ -447,12 +460,43 @@ def test_contingency_a_shared_smile_needs_the_learners_gaze_on_the_face():
 def test_contingency_success_is_the_shared_share_of_max_steps(max_steps, fraction):
     """Clause 'the shared-smile steps reach success_fraction of the episode's max_steps':
     ``is_success`` turns True on the step on which they reach ceil(fraction x max_steps), not
-    one step before."""
-    steps = _contingency(Faces(_dips), max_steps, success_fraction=fraction, **HELD)
+    one step before (the learner's smiles are nearly all shared: the other clause holds)."""
+    steps = _contingency(Faces(_returns), max_steps, success_fraction=fraction,
+                         response_probability=1.0, **HELD)
     need = math.ceil(fraction * max_steps)
     assert steps[-1][0]["shared_steps"] > need + 10
-    for i, _ in steps:
-        assert i["is_success"] == (i["shared_steps"] >= need), (i["shared_steps"], need)
+    assert steps[-1][0]["matched_fraction"] > 0.85
+    first = next(k for k, (i, _) in enumerate(steps) if i["shared_steps"] >= need)
+    for k, (i, _) in enumerate(steps):
+        assert i["is_success"] == (k >= first), (k, first, i["shared_steps"], need)
+
+
+def test_contingency_success_needs_the_learners_smiles_shared():
+    """Clause 'at least success_match of the learner's smiling steps shared': the same bids and
+    returned smiles (about 0.95 of the smiling steps shared) succeed at 0.75 and fail at 0.99;
+    a smile held from each bid until 0.6 s after its answer has ended shares the same steps (but
+    one step an answer: the returned smile starts a step after the caregiver's), but about half its
+    smiling steps are unshared: it fails at 0.75; the verdict is the clause's on every step."""
+    def longer(env):
+        inner = env.unwrapped
+        return HAPPY if inner.steps % 250 < 192 else 0
+    runs = {}
+    for name, face, match in (("returns", _returns, 0.75), ("returns", _returns, 0.99),
+                              ("longer", longer, 0.75)):
+        steps = _contingency(Faces(face), 1000, response_probability=1.0,
+                             response_jitter_s=0.0, success_match=match, **HELD)
+        last = steps[-1][0]
+        runs[name, match] = last
+        for k, (i, _) in enumerate(steps):
+            smiling = round(i["smiling_fraction"] * (k + 1))
+            assert i["is_success"] == (i["shared_steps"] >= 200
+                                       and i["shared_steps"] >= match * smiling), (name, k)
+    assert runs["returns", 0.75]["is_success"] and not runs["returns", 0.99]["is_success"]
+    assert 0.85 < runs["returns", 0.75]["matched_fraction"] < 0.99
+    shared = runs["longer", 0.75]["shared_steps"], runs["returns", 0.75]["shared_steps"]
+    assert min(shared) >= 200 and abs(shared[0] - shared[1]) <= 8, shared  # a step per answer
+    assert runs["longer", 0.75]["matched_fraction"] < 0.75
+    assert not runs["longer", 0.75]["is_success"]
 
 
 # -- imitation ------------------------------------------------------------------------------------

@@ -33,9 +33,12 @@ scene:
 conditions:
     option `condition`, or `env.unwrapped.task.set_condition(name)` from the next reset on.
     **live**: the scripted caregiver answers each of the learner's smiles (its face turning "happy")
-    with probability `response_probability` (0.8) by a smile `response_delay_s` (0.5 s) later, held
-    `response_duration_s` (1 s; a new answer restarts it), else a neutral face
-    (`ContingentCaregiver`, mode "interactive", cue: the expression only). **replay**: the
+    with probability `response_probability` (0.8) by a smile `response_delay_s` (0.3 s) plus a
+    uniform draw up to `response_jitter_s` (1 s) later, held `response_duration_s` (1 s), else a
+    neutral face (`ContingentCaregiver`, mode "interactive", cue: the expression only,
+    `refractory`: a smile that begins while an answer is pending or shown is not answered, so a
+    flickering face does not keep the caregiver smiling; the drawn delay keeps a blind learner
+    from timing its smiles to the answer). **replay**: the
     caregiver's action stream (its faces, step by step) of an earlier live episode is played back
     regardless of the learner (`ReplayCaregiver`): by default the last live episode of this env (run
     one first), or the `stream` given to `scripted_env` (a stream dict, e.g.
@@ -61,20 +64,26 @@ observation:
     expression, mode or stream
 reward:
     +1 on a step of shared smiling: the learner and the caregiver both show "happy" while the
-    learner's gaze is on the caregiver's face (`partners/cues.py`, `learner_cues`), else 0; with
-    `reward_free` (False) 0 on every step, every measure still in the infos (for curiosity,
-    empowerment or contingency-detection signals of one's own). Two learners: each is rewarded when
-    both smile and its own gaze is on the other's face. A learner that smiles at random (1/7 of the
-    steps) shares at most 1/7 of the steps; the zero action (neutral) none
+    learner's gaze is on the caregiver's face (`partners/cues.py`, `learner_cues`); -`unshared_cost`
+    (1) on a step on which the learner smiles and it is not shared (the caregiver's face neutral, or
+    the learner looking elsewhere); else 0. So the reward pays a smile returned to the caregiver's,
+    which the learner sees only through its eyes, and charges smiling into a neutral face: the
+    optimum is a brief bid, then the caregiver's answer returned while it lasts (what the scripted
+    infant does). With `reward_free` (False) 0 on every step, every measure still in the infos (for
+    curiosity, empowerment or contingency-detection signals of one's own). Two learners: each is
+    rewarded when both smile and its own gaze is on the other's face, and charged for its own
+    unshared smiling. The zero action (neutral) earns 0
 success:
-    per episode: `is_success` becomes True on the step at which the shared-smile steps reach
-    `success_fraction` (0.2) of the episode's `max_steps` (2000: 400 steps); the last step's value
-    is the episode's verdict. Meant for the live condition, where the learner's smiles bring the
-    caregiver's: a smile held on (one answer of 1 s) or a copy of the caregiver's face (which never
-    smiles first) fails; a face drawn at random each step is happy on 1/7 of the steps (13.8 %
-    shared with the gaze held on the face, measured; uniform random actions, head and eyes
-    included, share 1.6 %), far from 20 %. In replay and non-contingent it depends on the
-    caregiver's own timing and is reported, not a goal
+    per episode: `is_success` is True on a step at which the shared-smile steps have reached
+    `success_fraction` (0.2) of the episode's `max_steps` (2000: 400 steps) and are at least
+    `success_match` (0.85) of the learner's smiling steps so far (`matched_fraction`); the last
+    step's value is the episode's verdict. Meant for the live condition, where the learner's bids
+    bring the caregiver's smiles and the learner must see them to return them: a smile held on
+    (one answer of 1 s), a copy of the caregiver's face (which never smiles first), flickering
+    faces and faces drawn at random (which keep the caregiver answering, but half their smiling
+    falls on its neutral face) and smiles timed blind to the likeliest moment of an answer all
+    fail (hacks, below). In replay and non-contingent it depends on the caregiver's own timing and
+    is reported, not a goal
 termination:
     none; truncation at 2000 steps (20 s: a contingency needs several smiles and answers to show;
     Murray and Trevarthen's live and replay sessions lasted 30-60 s)
@@ -82,23 +91,29 @@ infos:
     `condition` (0 live, 1 replay, 2 non_contingent), `smiling` (the learner, this step),
     `caregiver_smiling`, `gaze_on_face` (the learner's), `shared` (a shared-smile step),
     `shared_steps`, `learner_smiles` and `caregiver_smiles` (smile onsets so far: the face turning
-    "happy"), `learner_smile_rate` and `caregiver_smile_rate` (onsets per second so far),
-    `smiling_fraction` (of the steps so far), `gaze_fraction`, `shared_fraction`, `response_rate`
-    (the share of the learner's smiles, among those whose window has passed or been answered,
-    followed by a caregiver smile onset within `window_s` (1.5 s)), `baseline_rate` (the share of
-    control windows, `window_s` blocks of the episode holding no learner smile and not within
-    `window_s` after one, in which the caregiver begins to smile), `contingency_index`
-    (`response_rate - baseline_rate`: Watson's conditional-probability difference: about the
-    response probability in live, lower in replay and non-contingent, where the caregiver's smiles
-    follow the learner's only by chance), `is_success`. `gaze_on_face` and `gaze_fraction` are the
-    learner's own gaze (held, `gaze_free=False`: always 1)
+    "happy"), `learner_bids` (the learner's smile onsets while the caregiver's face is neutral: a
+    smile returned to the caregiver's asks for nothing), `learner_smile_rate` and
+    `caregiver_smile_rate` (onsets per second so far), `smiling_fraction` (of the steps so far),
+    `gaze_fraction`, `shared_fraction`, `matched_fraction` (shared steps over the learner's smiling
+    steps; 0 before it smiles), `response_rate` (the share of the learner's bids, among those whose
+    window has passed or been answered, followed by a caregiver smile onset within `window_s` (1.5
+    s)), `baseline_rate` (the share of control windows, `window_s` blocks of the episode holding no
+    learner bid and not within `window_s` after one, in which the caregiver begins to smile),
+    `contingency_index` (`response_rate - baseline_rate`: Watson's conditional-probability
+    difference: about the response probability in live, lower in replay and non-contingent, where
+    the caregiver's smiles follow the learner's only by chance), `is_success`. `gaze_on_face` and
+    `gaze_fraction` are the learner's own gaze (held, `gaze_free=False`: always 1)
 options:
     `condition` ("live", "replay", "non_contingent"; "replay" when the env is made needs
     `scripted_env(stream=...)`, else a ConfigError), `distance` (0.3 m, 0.25 to 2.0),
-    `response_delay_s` (0.5 s, 0 to 5), `response_probability` (0.8, 0 to 1), `response_duration_s`
-    (1.0 s, 0.01 to 10), `timer_rate_hz` (0.5, 0 to 10: the non-contingent rate before any live
-    episode), `window_s` (1.5 s, 0.05 to 10: the contingency index's window; keep it above the
-    delay), `success_fraction` (0.2, 0.01 to 1), `reward_free` (False), `gaze_free` (True: the
+    `response_delay_s` (0.3 s, 0 to 5: the shortest delay), `response_jitter_s` (1.0 s, 0 to 5: the
+    delay's uniform spread; 0: a fixed delay), `response_probability` (0.8, 0 to 1),
+    `response_duration_s` (1.0 s, 0.01 to 10), `timer_rate_hz` (0.5, 0 to 10: the non-contingent
+    rate before any live episode), `window_s` (1.5 s, 0.05 to 10: the contingency index's window;
+    keep it above the longest delay), `unshared_cost` (1.0, 0 to 10: the reward of a smiling step
+    not shared, negated; 0: the reward before issue 30's fix), `success_fraction` (0.2, 0.01 to 1),
+    `success_match` (0.85, 0 to 1; 0: the success before the fix), `reward_free` (False),
+    `gaze_free` (True: the
     learner's head and eyes free; False: held on the caregiver's face, see body),
     `scripted_partner` (False; set by `scripted_env`)
 privileged cues:
@@ -107,20 +122,26 @@ privileged cues:
 baselines:
     live, 20 episodes of 2000 steps, seeds 1000-1019, the learner's eyes rendered (`mimo-social
     baselines contingency --episodes 20 --seed 1000`; free gaze, the default): uniform random
-    actions (face, head and eye motors) 0 / 20 successes, return 31.75 +- 16.5 (its gaze on the
-    face about a tenth of the steps, see effects); zero action (neutral, head at rest, looking
-    below the face) 0 / 20, 0 +- 0; scripted `ContingencyDetectorController` (turns head and eyes
-    to the face) 19 / 20, 665 +- 117, success secured at step 1122 on average. Held
-    (`gaze_free=False`, same command with `--env-kwargs '{"task_options": {"gaze_free":
-    false}}'`): random face each step 0 / 20, 276.8 +- 13.2; zero 0 / 20, 0 +- 0; scripted the same
-    19 / 20, 665 +- 117 (free, it reaches the face in 0.3 s, before any shared smile). Hacks and
-    an upper bound, same seeds (`python tests/tasks/test_contingency.py`; eyes off, no policy
-    reads them; free gaze: each face hack turns head and eyes to the caregiver's face,
-    `GazeAtTarget`): always happy 0 / 20, 90.0 +- 30.0 (one answer); copying the caregiver's face
-    (`MirrorController`) 0 / 20, 0 +- 0 (the caregiver never smiles first); smiling with a one-step
-    neutral dip every 0.5 s (each dip a new smile, answered before the last answer ends) 20 / 20,
-    1851.3 +- 59.1: the reward's optimum uses the contingency, and the detector, which also tests
-    it, reaches a third of it (held: the same figures). No trained learner yet
+    actions (face, head and eye motors) 0 / 20 successes, return -245.9 +- 28.8 (happy on a seventh
+    of the steps, its gaze on the face about a tenth of them, see effects); zero action (neutral,
+    head at rest, looking below the face) 0 / 20, 0 +- 0; scripted `ContingencyDetectorController`
+    (turns head and eyes to the face) 19 / 20, 521.6 +- 72.4, success secured at step 1540 on
+    average. Held (`gaze_free=False`, same command with `--env-kwargs '{"task_options":
+    {"gaze_free": false}}'`): random face each step 0 / 20, 9.6 +- 22.8; zero 0 / 20, 0 +- 0;
+    scripted the same 19 / 20, 521.6 +- 72.4 (free, it reaches the face in 0.3 s, before any shared
+    smile). Hacks, same seeds (`python tests/tasks/test_contingency.py`; eyes off, no policy reads
+    them, none sees the caregiver's face; free gaze: each turns head and eyes to the caregiver's
+    face, `GazeAtTarget`), successes, return, shared and matched fraction: always happy 0 / 20,
+    -1820 +- 60 (one answer), 0.045, 0.045; copying the caregiver's face (`MirrorController`) 0 /
+    20, 0 (the caregiver never smiles first); a one-step neutral dip every 0.5 s 0 / 20, -190 +-
+    131, 0.442, 0.451; a dip every 0.05 s (a flicker) 0 / 20, 102 +- 104, 0.426, 0.532; happy at
+    random on 30 % of the steps 0 / 20, 33 +- 48, 0.158, 0.527, on 70 % 0 / 20, 89 +- 91, 0.372,
+    0.532; blind timed bids (every 2.5 s a 0.05-s bid, then a smile 1.0-1.8 s after it, where an
+    answer is likeliest) 0 / 20, 18 +- 200, 0.175, 0.513 (its best episode: 0.754 matched);
+    the scripted `ContingencyDetectorController` 19 / 20, 522 +- 72, 0.283, 0.928 (its lowest:
+    0.913 matched; its one failure shared 0.197 of the steps). Held (`gaze_free=False`): the same
+    figures. Before the fix (issue 30) the dip every 0.5 s scored 1851 and succeeded in 20 / 20. No
+    trained learner yet
 summary:
     `measures.condition_summary(episodes, seed, controller)` runs blocks of live, replay (of that
     block's live episode) and non-contingent episodes and returns each measure's mean and sd per
@@ -128,39 +149,39 @@ summary:
     seeds 1000-1009 (`condition_summary(episodes=10, seed=1000)`; free gaze, the default; eyes off,
     or `mimo-social paradigm contingency --episodes 10 --seed 1000 --env-kwargs '{"per_agent":
     [{"vision": false}, {}]}'`), mean +- sd live / replay / non-contingent: share of the steps
-    smiling 0.576 +- 0.073 / 0.381 +- 0.136 / 0.364 +- 0.158; smile onsets per second 0.42 / 0.40 /
-    0.38; response rate 0.851 +- 0.124 / 0.438 +- 0.210 / 0.369 +- 0.215; baseline rate 0.000 /
-    0.392 / 0.135; contingency index 0.851 +- 0.124 / 0.046 +- 0.554 / 0.234 +- 0.381; shared
-    smiling 0.344 / 0.173 / 0.152 of the steps; success 9 / 5 / 3 of 10; caregiver smile onsets per
-    second 0.35 / 0.35 (the same stream) / 0.24; gaze on the face 0.989 in each (held: 1.0; every
-    other figure the same). The pattern Murray and Trevarthen report (fewer positive expressions
-    when the same mother is replayed) shows in the share of the steps smiling, not in the smile
-    onsets (the detector keeps bidding briefly)
+    smiling 0.30 +- 0.04 / 0.17 +- 0.11 / 0.14 +- 0.08; smile onsets per second 0.66 / 0.48 / 0.40;
+    response rate 0.81 +- 0.08 / 0.48 +- 0.26 / 0.38 +- 0.17; baseline rate 0.00 / 0.41 / 0.25;
+    contingency index 0.81 +- 0.08 / 0.07 +- 0.45 / 0.12 +- 0.37; shared smiling 0.28 / 0.15 / 0.12
+    of the steps; matched (shared of its smiling) 0.93 / 0.85 / 0.77; success 9 / 4 / 1 of 10;
+    caregiver smile onsets per second 0.28 / 0.28 (the same stream) / 0.21; gaze on the face 0.99
+    in each. The pattern Murray and Trevarthen report (fewer positive expressions when the same
+    mother is replayed) shows in the share of the steps smiling and in the smile onsets. The index
+    describes the contingency a learner meets, not whether it detects it: uniform random actions,
+    bidding 12.8 times a second, find every bid answered within the window in live and in replay
+    (index 1.00 in both; 0.40 non-contingent) and do not change their smiling (effects, below)
 effects:
     `measures.effects(policy, episodes, seed, env_kwargs)` runs any policy as the learner (a
     scripted partner, a function `obs -> action`, or an SB3 model: its observation flattened or its
-    images made channel-first and its flat action decoded as the model needs;
-    `measures.as_learner`) in the blocks of `condition_summary` and returns, per block, the live
-    episode's measure minus the replay's (`live_minus_replay`: Murray and Trevarthen's double
-    video) and minus the non-contingent one's (`live_minus_non_contingent`), mean +- sd over
-    blocks, for `smiling_fraction`, `learner_smile_rate`, `gaze_fraction`, `contingency_index` and
-    `shared_fraction` (`format_effects` prints them). The reward pays shared smiling in every
-    condition: smiling less or looking away in replay earns nothing; the effects measure whether a
-    learner does. Measured, 10 blocks of 2000 steps (seeds 1000-1009, the learner's eyes off: no
-    policy here reads them; free gaze, the default: `mimo-social paradigm contingency --episodes
-    10 --seed 1000 --env-kwargs '{"per_agent": [{"vision": false}, {}]}'`), live minus replay /
-    live minus non-contingent: the scripted `ContingencyDetectorController` smiling +0.195 +- 0.156
-    / +0.212 +- 0.136 of the steps, contingency index +0.81 +- 0.58 / +0.62 +- 0.34, shared
-    smiling +0.170 +- 0.103 / +0.192 +- 0.097, smile onsets per second +0.02 / +0.05, gaze 0 (it
-    looks at the face 0.99 of the steps in every condition: no gaze avoidance; its script has
-    none); uniform random actions smiling +0.001 +- 0.009 / +0.004 +- 0.012, contingency index
-    +0.001 +- 0.008 / +0.029 +- 0.010, shared +0.005 / -0.001 (no effect), gaze on the face 0.12 /
-    0.09 / 0.12 of the steps (live / replay / non-contingent), gaze effect +0.027 +- 0.043 / +0.002
-    +- 0.086, shared smiling 0.02 of the live steps (0 of 10 successes); zero action 0 on every
-    effect (gaze 0 in every condition). Held (`gaze_free=False`, measured before issue 30 with
-    `measures.effects`): the scripted detector the same effects, gaze 0 (1.0 everywhere); a random
-    face each step smiling -0.001 +- 0.009 / 0.000 +- 0.006, contingency index -0.005 +- 0.019 /
-    +0.027 +- 0.024, shared -0.001 / -0.003 (no effect); zero action 0 on every effect
+    images made channel-first and its flat action decoded as the model needs; `measures.as_learner`)
+    in the blocks of `condition_summary` and returns, per block, the live episode's measure minus
+    the replay's (`live_minus_replay`: Murray and Trevarthen's double video) and minus the
+    non-contingent one's (`live_minus_non_contingent`), mean +- sd over blocks, for
+    `smiling_fraction`, `learner_smile_rate`, `gaze_fraction`, `contingency_index` and
+    `shared_fraction` (`format_effects` prints them). The reward pays shared smiling and charges
+    unshared smiling in every condition: a learner that returns every smile it sees earns in replay
+    too; the effects measure whether it smiles less, or looks away, there. Measured, 10 blocks of
+    2000 steps (seeds 1000-1009, the learner's eyes off: no policy here reads them; free gaze, the
+    default: `mimo-social paradigm contingency --episodes 10 --seed 1000 --env-kwargs '{"per_agent":
+    [{"vision": false}, {}]}'`), live minus replay / live minus non-contingent: the scripted
+    `ContingencyDetectorController` smiling +0.130 +- 0.090 / +0.161 +- 0.069 of the steps,
+    contingency index +0.74 +- 0.42 / +0.69 +- 0.39, shared smiling +0.124 +- 0.085 / +0.153 +-
+    0.065, smile onsets per second +0.17 / +0.26, gaze 0 (it looks at the face 0.99 of the steps in
+    every condition: no gaze avoidance; its script has none); uniform random actions smiling +0.001
+    +- 0.009 / +0.004 +- 0.012, contingency index +0.000 / +0.60 +- 0.25 (the caregiver's, see
+    summary), shared +0.002 / +0.001 (no effect), gaze on the face 0.12 / 0.09 / 0.12 of the steps
+    (live / replay / non-contingent), gaze effect +0.027 +- 0.043 / +0.002 +- 0.086, shared smiling
+    0.01 of the live steps (0 of 10 successes); zero action 0 on every effect (gaze 0 in every
+    condition)
 sources:
     not in the MIMo paper: a paradigm of this package after Watson (1972, 1979: infants detect the
     contingency of events on their own behaviour, measured as conditional probabilities; the smile
@@ -169,15 +190,23 @@ sources:
     mothers live versus a replay of the same mother, which brought gaze avoidance and fewer positive
     expressions), Nadel et al. (1999, live-replay-live), Bigelow and Rochat (2006: 2-month-olds
     smile less to a partner whose contingency for smiles differs from their mother's). Response
-    delay 0.5 s: a prompt answer, within the 1-s resolution at which face-to-face interaction is
-    coded (Beebe et al. 2016), and well below the delays of a few seconds that keep young infants
-    from learning a contingency (Millar 1972)
+    delay 0.3-1.3 s: prompt answers, about the 1-s resolution at which face-to-face interaction is
+    coded (Beebe et al. 2016), drawn anew for each answer as a person's are, and well below the
+    delays of a few seconds that keep young infants from learning a contingency (Millar 1972)
 version history:
     v0, issue 19: first version, with `still_face_v0`, `imitation_v0` and the contingent and replay
     caregivers; v0, issue 30: the `gaze_free` option (at first off: the held gaze, spaces and
     numbers unchanged; the gaze measure was 1.0 for every learner), the scripted infant looks at the
     face when its gaze is free, `measures.effects` for any policy; v0, issue 30: `gaze_free` on by
-    default
+    default; v0, issue 30 (the contingency fix): a blind face won (a one-step neutral dip every 0.5
+    s, never looking at the caregiver's face, scored 1851 against the scripted infant's 665, and a
+    face happy at random on 30-70 % of the steps, gaze held, succeeded), so the live caregiver's
+    delay is drawn (0.3-1.3 s, was a fixed 0.5 s) and it is refractory, the reward charges unshared
+    smiling (`unshared_cost`), success needs `success_match` of the learner's smiling shared, the
+    response and baseline rates count bids, and the scripted infant bids briefly and returns the
+    answers it sees (it held each bid up to 0.8 s); `unshared_cost=0`, `success_match=0`,
+    `response_delay_s=0.5`, `response_jitter_s=0` give the old reward and success (the caregiver
+    stays refractory)
 
 The learner's action and the caregiver's face of the same step are compared; a scripted caregiver
 reads the learner's face before the learner's action of a step applies, so its answers come one

@@ -16,14 +16,16 @@ looks:
     is the task's to hold
 acts:
     smiles through its own ``expression`` action. From a neutral face it
-    begins to smile at a rate (per second) of ``base_rate`` (1.5) x exp(``gain`` (5) x (estimate -
-    ``expected`` (0.25))), kept within 0.05-10. A smile lasts while it waits for an answer (up to
-    ``bid_s``, 0.8 s) and, once answered, as long as the other smiles; then a neutral pause drawn
-    from ``pause_s`` (0.05-1 s) and, after an answered smile while its estimate is at least
-    ``expected``, a new smile at once (a run of smiles, each answered anew); but with probability
+    bids, a brief smile of ``bid_s`` (0.05 s), at a rate (per second) of ``base_rate`` (1.5) x
+    exp(``gain`` (5) x (estimate - ``expected`` (0.25))), kept within 0.05-10; then it waits,
+    neutral, up to ``window_s`` for an answer. An answer (the other's smile beginning after the
+    bid began) it returns: it smiles as long as the other smiles (what it sees of the other's face
+    now, so its smile ends a control step after the other's). Then a neutral pause drawn from
+    ``pause_s`` (0.05-1 s) and, after an answered bid while its estimate is at least
+    ``expected``, a new bid at once (a run of bids, each answered anew); but with probability
     ``probe`` (0.3) it stays neutral for a whole window instead (a test: does the other smile
-    anyway?). Unanswered smiles and smiles that come regardless of its own lower its estimate and
-    its smiling
+    anyway?). Smiles of the other that answer no bid it does not return; unanswered bids and
+    smiles that come regardless of its own lower its estimate and its bidding
 why the pause and the probes:
     a replay of a live session is as rhythmic as the live answers; a learner that renewed its smile
     at a fixed moment would lock onto the replayed rhythm and see it as contingent. Random pauses
@@ -61,7 +63,7 @@ RATE_LIMITS = (0.05, 10.0)
 class ContingencyDetectorController(Partner):
     """A contingency-detecting infant (see the module table)."""
 
-    def __init__(self, window_s=1.5, base_rate=1.5, gain=5.0, expected=0.25, bid_s=0.8,
+    def __init__(self, window_s=1.5, base_rate=1.5, gain=5.0, expected=0.25, bid_s=0.05,
                  pause_s=(0.05, 1.0), probe=0.3):
         who = "ContingencyDetectorController"
         self.window_s = check_number(who, "window_s", window_s, 0.05, 10.0)
@@ -109,11 +111,11 @@ class ContingencyDetectorController(Partner):
         self._prev = (False, False)
         self.answered, self.smiles = PRIOR_AFTER
         self.hits, self.blocks = PRIOR_BASE
-        self._open: list[int] = []         # own smile onsets still waiting for an answer
+        self._open: list[int] = []         # own bids still waiting for an answer
         self._last_onset = -10 ** 9
         self._quiet = None                 # the running quiet window: [start, other's onset]
         self._probe_until = -1             # neutral until this step (a probe)
-        self._smiling = False
+        self._in_bout = False
         self._bout_start = 0
         self._answer_at = None          # step of the answer to the current smile
         self._renewing = False          # smile again right after the pause
@@ -138,6 +140,7 @@ class ContingencyDetectorController(Partner):
         theirs = env.world.expression_of(self._other) == HAPPY
         my_on, their_on = mine and not self._prev[0], theirs and not self._prev[1]
         self._prev = (mine, theirs)
+        my_on = my_on and not theirs       # a bid: a smile begun while the other's face is not
         still = []
         for t0 in self._open:
             if their_on and t > t0:
@@ -172,24 +175,35 @@ class ContingencyDetectorController(Partner):
                                "env first")
         theirs, their_on = self._observe(env)
         t = self.t
-        if self._smiling:
-            if their_on and t > self._bout_start and self._answer_at is None:
+        if self._in_bout:
+            answer = their_on and t > self._bout_start and self._answer_at is None
+            if answer and t - self._bout_start <= self._window:
                 self._answer_at = t
-            if (self._answer_at is not None and not theirs) or \
-                    (self._answer_at is None and t - self._bout_start >= self._bid):
-                self._smiling = False
-                self._idle_since = t
-                self._pause = int(round(self.rng.uniform(*self.pause_s) / self._dt))
-                self._renewing = self._answer_at is not None and self.estimate >= self.expected
-                if self._renewing and self.rng.random() < self.probe:
-                    self._renewing = False
-                    self._probe_until = t + self._pause + self._window
+            if self._answer_at is not None:
+                done = not theirs
+            else:   # the bid, then the neutral wait; an answer is returned at once
+                done = t - self._bout_start >= self._window
+            if done:
+                self._end_bout(t)
         elif t - self._idle_since >= self._pause and t >= self._probe_until:
             if self._renewing or self.rng.random() < 1.0 - math.exp(-self.rate * self._dt):
-                self._smiling = True
+                self._in_bout = True
                 self._bout_start = t
                 self._answer_at = None
-        face = HAPPY if self._smiling else NEUTRAL
+        smile = self._in_bout and (self._answer_at is not None
+                                   or t - self._bout_start < self._bid)
+        face = HAPPY if smile else NEUTRAL
         motors = self._action["motors"].copy() if self._gaze is None else \
             self._gaze.act(env, agent, observation)["motors"]
         return {"motors": motors, "expression": np.int64(face)}
+
+    def _end_bout(self, t: int) -> None:
+        """A bid's bout is over (its answer returned, or none came): a neutral pause, then a new
+        bid at once after an answered one while the estimate holds, unless a probe."""
+        self._in_bout = False
+        self._idle_since = t
+        self._pause = int(round(self.rng.uniform(*self.pause_s) / self._dt))
+        self._renewing = self._answer_at is not None and self.estimate >= self.expected
+        if self._renewing and self.rng.random() < self.probe:
+            self._renewing = False
+            self._probe_until = t + self._pause + self._window

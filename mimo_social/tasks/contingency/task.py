@@ -27,26 +27,31 @@ CONDITIONS = ("live", "replay", "non_contingent")
 #: the per-episode measures of the summary (last-step infos)
 MEASURES = ("learner_smile_rate", "smiling_fraction", "gaze_fraction", "response_rate",
             "baseline_rate", "contingency_index", "caregiver_smile_rate", "shared_fraction",
-            "is_success")
+            "matched_fraction", "is_success")
 
 
 @dataclass(frozen=True)
 class ContingencyOptions(TaskOptions):
     """The condition (live, replay, non-contingent), the distance between the faces (m), the
-    scripted caregiver's response delay (s) and probability, the contingency index's window (s),
-    the share of shared-smile steps for success, reward-free mode, whether the learner's head
-    and eyes are free (``gaze_free``, on) and whether the caregiver (``caregiver_0``) is scripted
-    (no eyes, no reward)."""
+    scripted caregiver's response delay (s: at least ``response_delay_s``, plus a uniform draw
+    up to ``response_jitter_s``), probability and duration, the contingency index's window (s),
+    the cost of a smiling step that is not shared, the share of shared-smile steps and the
+    share of the learner's smiling steps that are shared (``success_match``) for success,
+    reward-free mode, whether the learner's head and eyes are free (``gaze_free``, on) and
+    whether the caregiver (``caregiver_0``) is scripted (no eyes, no reward)."""
 
     task = "contingency"
     condition: str = "live"
     distance: float = DISTANCE
-    response_delay_s: float = 0.5
+    response_delay_s: float = 0.3
+    response_jitter_s: float = 1.0
     response_probability: float = 0.8
     response_duration_s: float = 1.0
     timer_rate_hz: float = 0.5
     window_s: float = 1.5
+    unshared_cost: float = 1.0
     success_fraction: float = 0.2
+    success_match: float = 0.85
     reward_free: bool = False
     gaze_free: bool = True
     scripted_partner: bool = False
@@ -55,11 +60,14 @@ class ContingencyOptions(TaskOptions):
         self._choice("condition", CONDITIONS)
         self._number("distance", 0.25, 2.0)   # closer, two infants' toes overlap
         self._number("response_delay_s", 0.0, 5.0)
+        self._number("response_jitter_s", 0.0, 5.0)
         self._number("response_probability", 0.0, 1.0)
         self._number("response_duration_s", 0.01, 10.0)
         self._number("timer_rate_hz", 0.0, 10.0)
         self._number("window_s", 0.05, 10.0)
+        self._number("unshared_cost", 0.0, 10.0)
         self._number("success_fraction", 0.01, 1.0)
+        self._number("success_match", 0.0, 1.0)
         self._bool("reward_free")
         self._bool("gaze_free")
         self._bool("scripted_partner")
@@ -72,14 +80,16 @@ class ContingencyOptions(TaskOptions):
 class ContingencyMeasures:
     """The paradigm's running measures over one episode, fed one step at a time with whether
     the learner smiles, the caregiver smiles and the learner looks at the caregiver's face (see
-    the task table's ``infos`` row); ``window``: the contingency window in steps."""
+    the task table's ``infos`` row); ``window``: the contingency window in steps. A learner's
+    smile onset while the caregiver's face is neutral is a bid: the response and baseline rates
+    count bids (a smile returned to the caregiver's own smile asks for nothing)."""
 
     def __init__(self, window: int, dt: float):
         self.window, self.dt = max(1, int(window)), float(dt)
         self.steps = 0
         self.prev = (False, False)
         self.smiling_steps = self.gaze_steps = self.shared_steps = 0
-        self.learner_onsets = self.caregiver_onsets = 0
+        self.learner_onsets = self.caregiver_onsets = self.bids = 0
         self.open: list[int] = []            # learner onsets whose window is still open
         self.answered = self.resolved = 0
         self.last_onset = -10 ** 9            # step of the learner's last smile onset
@@ -93,6 +103,7 @@ class ContingencyMeasures:
         l_on = learner and not self.prev[0]
         c_on = caregiver and not self.prev[1]
         self.prev = (learner, caregiver)
+        bid = l_on and not caregiver
         self.smiling_steps += learner
         self.gaze_steps += gaze
         self.shared_steps += shared
@@ -108,13 +119,13 @@ class ContingencyMeasures:
             else:
                 still.append(t0)
         self.open = still
-        if l_on:
-            self.learner_onsets += 1
+        self.learner_onsets += l_on
+        if bid:
+            self.bids += 1
             self.open.append(t)
             self.last_onset = t
-        # control blocks: window-long blocks with no learner onset in them or in the window
-        # before them
-        self.block_learner |= l_on
+        # control blocks: window-long blocks with no bid in them or in the window before them
+        self.block_learner |= bid
         self.block_caregiver |= c_on
         if t - self.block_start + 1 >= self.window:
             if not self.block_learner and self.block_start - self.last_onset > self.window:
@@ -128,12 +139,13 @@ class ContingencyMeasures:
         n = max(self.steps, 1)
         response = self.answered / self.resolved if self.resolved else 0.0
         baseline = self.control_hits / self.control if self.control else 0.0
+        matched = self.shared_steps / self.smiling_steps if self.smiling_steps else 0.0
         return {"shared_steps": self.shared_steps, "learner_smiles": self.learner_onsets,
-                "caregiver_smiles": self.caregiver_onsets,
+                "learner_bids": self.bids, "caregiver_smiles": self.caregiver_onsets,
                 "learner_smile_rate": self.learner_onsets / seconds,
                 "caregiver_smile_rate": self.caregiver_onsets / seconds,
                 "smiling_fraction": self.smiling_steps / n, "gaze_fraction": self.gaze_steps / n,
-                "shared_fraction": self.shared_steps / n,
+                "shared_fraction": self.shared_steps / n, "matched_fraction": matched,
                 "response_rate": response, "baseline_rate": baseline,
                 "contingency_index": response - baseline}
 
@@ -176,6 +188,8 @@ class Contingency(FacingPair, Task):
         self._weights = np.zeros(2) if o.reward_free else \
             np.array([1.0, 0.0 if o.scripted_partner else 1.0])
         self._need = max(1, math.ceil(o.success_fraction * env.max_steps - 1e-9))
+        self._match = float(o.success_match)
+        self._cost = float(o.unshared_cost)
         self.measures = ContingencyMeasures(round(o.window_s / env.dt), env.dt)
         self._state = (False, False, False, False)
         self._shared = np.zeros(2, bool)
@@ -194,7 +208,14 @@ class Contingency(FacingPair, Task):
         self._shared = np.array([both and gaze0, both and gaze1])
         self.measures.update(learner, caregiver, gaze0, bool(self._shared[0]))
         self._state = (learner, caregiver, gaze0, bool(self._shared[0]))
-        return self._weights * self._shared
+        unshared = np.array([learner, caregiver]) & ~self._shared
+        return self._weights * (self._shared - self._cost * unshared)
+
+    def succeeded(self) -> bool:
+        """The episode's verdict so far: enough shared-smile steps, and enough of the
+        learner's smiling shared (the task table's success row)."""
+        m = self.measures
+        return m.shared_steps >= self._need and m.shared_steps >= self._match * m.smiling_steps
 
     def plots(self):
         """Reward, each agent smiling (learner, caregiver), the shared smiles (what is
@@ -216,7 +237,7 @@ class Contingency(FacingPair, Task):
         learner, caregiver, gaze, shared = self._state
         common = {"condition": CONDITIONS.index(self.episode_condition), "smiling": learner,
                   "caregiver_smiling": caregiver, "gaze_on_face": gaze, "shared": shared,
-                  **m.infos(), "is_success": m.shared_steps >= self._need}
+                  **m.infos(), "is_success": self.succeeded()}
         return np.zeros(2, bool), [dict(common) for _ in range(2)]
 
 
@@ -290,6 +311,7 @@ class ContingencyCaregiver(Partner):
         if self._live is None:
             self._live = ContingentCaregiver(
                 cues=("expression",), delay_s=o.response_delay_s,
+                delay_jitter_s=o.response_jitter_s, refractory=True,
                 probability=o.response_probability, duration_s=o.response_duration_s)
         if self.condition == "replay":
             stream = self.stream if self.stream is not None else self._recorded
