@@ -342,7 +342,8 @@ FACE = "caregiver_0/head_centre"
 
 def _still_face(learner, caregiver=None, **options):
     env = still_face_v0.scripted_env(caregiver if caregiver is not None else Smiles(),
-                                     task_options={"phases_s": SF_PHASES, **options},
+                                     task_options={"phases_s": SF_PHASES, "phase_jitter": 0.0,
+                                                   **options},
                                      per_agent=NO_EYES)
     return _episode(env, learner)
 
@@ -352,14 +353,15 @@ def test_still_face_engagement_needs_the_gaze_the_smile_and_the_caregivers_smile
     smiles, the caregiver smiles. Against a caregiver that smiles whenever the task lets it: a
     learner that looks at its face and smiles is engaged on most interactive steps and
     succeeds; one that looks without smiling, one that smiles at its own hand, and the looking,
-    smiling one in front of a caregiver that never smiles are never engaged and fail."""
-    both = _still_face(Looks(FACE))
+    smiling one in front of a caregiver that never smiles are never engaged and fail (the
+    clause on the share of the learner's smiling engaged off here: its own test)."""
+    both = _still_face(Looks(FACE), success_match=0.0)
     last = both[-1]
     assert last["interactive_steps"] == 100 and last["engaged_steps"] >= 60 and last["is_success"]
     assert not any(i["engaged"] for i in both if i["phase"] == 1)   # the still face is neutral
-    runs = {"no smile": _still_face(Looks(FACE, face=lambda env: 0)),
-            "looks away": _still_face(Looks("infant_0/right_hand")),
-            "caregiver neutral": _still_face(Looks(FACE), caregiver=Still())}
+    runs = {"no smile": _still_face(Looks(FACE, face=lambda env: 0), success_match=0.0),
+            "looks away": _still_face(Looks("infant_0/right_hand"), success_match=0.0),
+            "caregiver neutral": _still_face(Looks(FACE), caregiver=Still(), success_match=0.0)}
     for name, steps in runs.items():
         last = steps[-1]
         assert last["engaged_steps"] == 0 and not any(i["is_success"] for i in steps), name
@@ -374,12 +376,34 @@ def test_still_face_engagement_needs_the_gaze_the_smile_and_the_caregivers_smile
 def test_still_face_success_is_the_engaged_share_of_the_interactive_steps(fraction):
     """Clause 'the engaged steps reach success_fraction of the interaction and reunion steps'
     (100 here; the 30 still-face steps not counted): ``is_success`` turns True on the step on
-    which the engaged steps reach ceil(fraction x 100), not one step before."""
-    steps = _still_face(Looks(FACE), success_fraction=fraction)
+    which the engaged steps reach ceil(fraction x 100), not one step before (the clause on the
+    share of the learner's smiling engaged off here: its own test)."""
+    steps = _still_face(Looks(FACE), success_fraction=fraction, success_match=0.0)
     need = math.ceil(fraction * 100)
     assert steps[-1]["engaged_steps"] > need + 10
     for i in steps:
         assert i["is_success"] == (i["engaged_steps"] >= need), (i["engaged_steps"], need)
+
+
+def test_still_face_success_needs_the_learners_smiles_engaged():
+    """Clause 'at least success_match of the learner's smiling steps engaged': a learner that
+    looks and smiles through the still face (30 steps smiling at a neutral face) fails at 0.7,
+    one that stops smiling while the face is still (what it would see) succeeds with about the
+    same engaged steps (its smile restarts a step late in reunion); the verdict is both clauses'
+    on every step."""
+    sober = Looks(FACE, face=lambda env: 0 if env.unwrapped.task.phase == 1 else HAPPY)
+    runs = {name: _still_face(learner, success_fraction=0.5, success_match=0.7)
+            for name, learner in (("smiles on", Looks(FACE)), ("sobers", sober))}
+    for name, steps in runs.items():
+        smiling = np.cumsum([bool(i["smiling"]) for i in steps])
+        for i, n in zip(steps, smiling):
+            assert i["is_success"] == (i["engaged_steps"] >= 50
+                                       and i["engaged_steps"] >= 0.7 * n), name
+    on, sober = runs["smiles on"][-1], runs["sobers"][-1]
+    assert abs(on["engaged_steps"] - sober["engaged_steps"]) <= 2 and sober["engaged_steps"] >= 50
+    assert on["smile_still"] == 1.0 and sober["smile_still"] <= 0.05   # a step late
+    assert on["matched_fraction"] < 0.7 <= sober["matched_fraction"]
+    assert sober["is_success"] and not on["is_success"]
 
 
 # -- contingency ----------------------------------------------------------------------------------

@@ -48,18 +48,23 @@ SELF_PARTS = ("head", "upper_body", "lower_body")
 
 @dataclass(frozen=True)
 class StillFaceOptions(TaskOptions):
-    """The phases' lengths (s: interaction, still face, reunion), the standard pair's distance
-    (m), whether the learner's arms are free, head support, the share of interactive steps that
-    must be engaged for success, the reward of a still-phase step with the classic response,
-    reward-free mode and whether the caregiver (``caregiver_0``) is scripted (no eyes, no
-    reward)."""
+    """The phases' lengths (s: interaction, still face, reunion) and the spread of the first two
+    (``phase_jitter``: each drawn at reset within +- that share), the standard pair's distance
+    (m), whether the learner's arms are free, head support, the cost of a smiling step that is
+    not engaged, the share of interactive steps that must be engaged and the share of the
+    learner's smiling steps that must be engaged for success, the reward of a still-phase step
+    with the classic response, reward-free mode and whether the caregiver (``caregiver_0``) is
+    scripted (no eyes, no reward)."""
 
     task = "still_face"
     phases_s: tuple = (5.0, 5.0, 5.0)
+    phase_jitter: float = 0.5
     distance: float = DISTANCE
     arms_free: bool = True
     head_support: bool = True
-    success_fraction: float = 0.5
+    unshared_cost: float = 1.0
+    success_fraction: float = 0.8
+    success_match: float = 0.8
     still_response_reward: float = 0.0
     reward_free: bool = False
     scripted_partner: bool = False
@@ -67,10 +72,13 @@ class StillFaceOptions(TaskOptions):
     def __post_init__(self):
         self._numbers("phases_s", 3, 0.05, 600.0,
                       allowed="(interaction, still, reunion) seconds, each 0.05 to 600")
+        self._number("phase_jitter", 0.0, 0.9)
         self._number("distance", 0.3, 1.5)
         self._bool("arms_free")
         self._bool("head_support")
+        self._number("unshared_cost", 0.0, 10.0)
         self._number("success_fraction", 0.05, 1.0)
+        self._number("success_match", 0.0, 1.0)
         self._number("still_response_reward", 0.0, 10.0)
         self._bool("reward_free")
         self._bool("scripted_partner")
@@ -153,13 +161,31 @@ class StillFace(Task):
 
     # -- phases ---------------------------------------------------------------------------------
     def phase_steps(self, dt: float) -> tuple[int, int, int]:
-        """Control steps of each phase at control step ``dt`` (s)."""
+        """Control steps of each phase at control step ``dt`` (s), as ``phases_s`` says (before
+        ``phase_jitter``: :attr:`episode_phase_steps` are this episode's)."""
         return tuple(max(1, int(round(s / dt))) for s in self.options.phases_s)
 
     def phase_at(self, step: int) -> int:
-        """The phase index of control step ``step`` (0-based; past the last phase: reunion)."""
+        """The phase index of control step ``step`` (0-based; past the last phase: reunion) in
+        this episode (its phase lengths are drawn at reset)."""
         b = self._bounds
         return 0 if step < b[0] else (1 if step < b[1] else 2)
+
+    def _draw_phases(self, env, rng) -> None:
+        """This episode's phase lengths: interaction and still face each ``phases_s`` times a
+        uniform draw within 1 +- ``phase_jitter`` (none at 0), reunion as set; the interactive
+        steps within ``max_steps`` and the engaged steps success needs."""
+        steps = list(self.phase_steps(env.dt))
+        j = self.options.phase_jitter
+        if j > 0:
+            for k in (0, 1):
+                steps[k] = max(1, int(round(steps[k] * rng.uniform(1.0 - j, 1.0 + j))))
+        #: this episode's control steps per phase
+        self.episode_phase_steps = tuple(steps)
+        self._bounds = (steps[0], steps[0] + steps[1])
+        still = max(0, min(env.max_steps, self._bounds[1]) - min(env.max_steps, self._bounds[0]))
+        self._n_inter = env.max_steps - still
+        self._need = max(1, math.ceil(self.options.success_fraction * self._n_inter - 1e-9))
 
     @property
     def phase_name(self) -> str:
@@ -170,7 +196,7 @@ class StillFace(Task):
         """Index tables of this world (once per world: :meth:`Task.bind`)."""
         w = env.world
         m = w.model
-        self._bounds = tuple(np.cumsum(self.phase_steps(env.dt))[:2].tolist())
+        self._bounds = tuple(np.cumsum(self.phase_steps(env.dt))[:2].tolist())   # until reset
         self._head_dofs = np.concatenate([
             a.dof_adr[[k for k in a.actuated_joint_idx if a.joint_names[k] in GAZE_JOINTS]]
             for a in w.agents])
@@ -182,8 +208,6 @@ class StillFace(Task):
         for s in range(2):
             self._hand_mask[s, hands[s]] = True
         self._touch_mask = np.stack(masks)
-        self._n_inter = sum(1 for t in range(env.max_steps) if self.phase_at(t) != 1)
-        self._need = max(1, math.ceil(self.options.success_fraction * self._n_inter - 1e-9))
         scripted = self.options.scripted_partner
         self._weights = np.array([1.0, 0.0 if scripted else 1.0])
 
@@ -191,6 +215,7 @@ class StillFace(Task):
         w = env.world
         m, d = w.model, w.data
         del m
+        self._draw_phases(env, rng)
         self.phase = 0
         self._held_q = None
         self._counts = np.zeros((3, 3), np.int64)     # phase x measure (smile, gaze, touch)
@@ -268,8 +293,18 @@ class StillFace(Task):
         if self.options.reward_free:
             return np.zeros(2)
         out = self._weights * float(engaged)
-        out[0] += self.options.still_response_reward * float(response)   # the infant's own
+        # the infant's own: its smiling into a face that does not smile back (or while looking
+        # away) costs, the classic still-phase response may pay
+        out[0] += self.options.still_response_reward * float(response) \
+            - self.options.unshared_cost * float(smiling and not engaged)
         return out
+
+    def succeeded(self) -> bool:
+        """The verdict so far (the task table's success row): enough interactive steps engaged,
+        and enough of the learner's smiling steps engaged."""
+        engaged = self._engaged_steps
+        return engaged >= self._need and \
+            engaged >= self.options.success_match * int(self._counts[:, 0].sum())
 
     def plots(self):
         """Reward, the phase (0 interaction, 1 still face, 2 reunion), the learner's smile and
@@ -285,7 +320,7 @@ class StillFace(Task):
     def info_spec(self, i):
         """The task's info keys and their kinds (see MimoParallelEnv.info_spec)."""
         keys = ["phase", "smiling", "gaze_on_face", "self_touch", "engaged", "still_response",
-                "engaged_steps", "interactive_steps", "is_success"]
+                "engaged_steps", "interactive_steps", "matched_fraction", "is_success"]
         keys += [f"{k}_{p}" for p in PHASES for k in MEASURES]
         return {k: "number" for k in keys}
 
@@ -295,7 +330,8 @@ class StillFace(Task):
                "self_touch": touch, "engaged": engaged, "still_response": response,
                "engaged_steps": int(self._engaged_steps),
                "interactive_steps": int(self._inter_steps),
-               "is_success": bool(self._engaged_steps >= self._need)}
+               "matched_fraction": self._engaged_steps / max(1, int(self._counts[:, 0].sum())),
+               "is_success": self.succeeded()}
         frac = self._counts / np.maximum(self._steps, 1)[:, None]
         for p, phase in enumerate(PHASES):
             for k, key in enumerate(MEASURES):
