@@ -209,8 +209,8 @@ def test_a_saved_stream_replays_in_a_new_env_and_a_copy_continues_exactly(tmp_pa
                                         task_options={"condition": "replay"}, **FAST)
     faces, info = run(other, Random(), "replay", seed=9)
     assert np.array_equal(faces, live) and info["condition"] == 1
-    # a copy taken mid-episode (replay, then non-contingent) continues as the original
-    for condition in ("replay", "non_contingent"):
+    # a copy taken mid-episode (live, replay, non-contingent) continues as the original
+    for condition in ("live", "replay", "non_contingent"):   # live: drawn delays, refractory
         env.unwrapped.task.set_condition(condition)
         env.reset(seed=4)
         learner = Pulses(70, 20)
