@@ -312,9 +312,9 @@ HACKS = {"always happy": lambda: Pulses(10, 10),
 
 def hack_figures(episodes=20, seed=1000, held=False):
     """Live, seeds ``seed ..``: per policy (successes, return mean, return sd, shared fraction,
-    matched fraction: mean, min, max over the episodes); the learner's eyes off (no policy here reads them). The face hacks
-    (:data:`HACKS`) turn head and eyes to the caregiver's face (the detector does so itself);
-    ``held``: the held variant, every gaze on the face."""
+    matched fraction: mean, min, max over the episodes); the learner's eyes off (no policy here
+    reads them). The face hacks (:data:`HACKS`) turn head and eyes to the caregiver's face (the
+    detector does so itself); ``held``: the held variant, every gaze on the face."""
     looks = (lambda p: p) if held else LooksAtFace
     policies = {name: looks(make()) for name, make in HACKS.items()}
     policies["detector"] = ContingencyDetectorController()
