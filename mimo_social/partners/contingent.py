@@ -84,7 +84,7 @@ from gymnasium import spaces
 from ..body.joint_groups import GAZE_JOINTS, RIGHT_SHOULDER_ELBOW
 from ..core.kinematics import LookAt, reach_sites
 from ..expressions.faces import EXPRESSIONS
-from ..util.checks import ConfigError, check_choice, check_number, show
+from ..util.checks import ConfigError, check_bool, check_choice, check_number, show
 from .base import Partner, agent_index
 from .cues import HAPPY, NEUTRAL, Cues, learner_cues, touching_hands
 
@@ -156,10 +156,7 @@ class ContingentCaregiver(Partner):
         self.cues = _check_cues(cues)
         self.delay_s = check_number(who, "delay_s", delay_s, 0.0, 60.0)
         self.delay_jitter_s = check_number(who, "delay_jitter_s", delay_jitter_s, 0.0, 60.0)
-        if not isinstance(refractory, (bool, np.bool_)):
-            raise ConfigError(f"{who}: refractory={show(refractory)} not allowed; allowed: True "
-                              "or False")
-        self.refractory = bool(refractory)
+        self.refractory = check_bool(who, "refractory", refractory)
         self.probability = check_number(who, "probability", probability, 0.0, 1.0)
         self.duration_s = check_number(who, "duration_s", duration_s, 0.01, 60.0)
         self.face = check_choice(who, "face", face, FACES)
