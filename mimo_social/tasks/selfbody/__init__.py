@@ -53,9 +53,11 @@ scripted controller:
     palm above the target, hand near it, hand 1 cm inside it; or backwards from touching postures
     found from seeded random starts), runs each plan on a scratch copy of the world with its own PD
     law and keeps the first that touches, then PD + gravity compensation through the motors: 20 of
-    20 episodes (seeds 0-19, random targets), mean return 334.4 (65 s on 2 shared cores); for one
-    target at a time (seed 0) it touches 27 of the 28, not right_heel (pressed against the left
-    ankle under the crossed legs)
+    20 episodes (seeds 0-19, random targets), mean return 330.0 (334.4 before the seeded plans;
+    112 s on 2 cores beside two trainings); for one
+    target at a time (seed 0) it touches 28 of the 28, mean return 350.2 (before its plans were
+    seeded from the start, issue 30: 27, not right_heel, pressed against the left ankle under
+    the crossed legs)
 baselines:
     seeds 0-19, one episode each: controller 100 % success, return 334.4; random actions 0 %,
     -485.4; zero action 0 %, -219.4 (the hand drops onto the right thigh and stays); parking hacks
@@ -65,11 +67,12 @@ baselines:
     `selfbody_v0.parallel_env()` reset with seeds 0-19; `pytest -m slow
     tests/tasks/test_selfbody.py` re-measures the controller and the right-thigh parking, 75 s).
     `mimo-social baselines selfbody --episodes 30 --seed 1000 --run <6 runs>` (seeds 1000-1029;
-    docs/baselines.md): scripted 97 % (29/30), return 339 +- 123, 155 steps to the target; random 3
+    docs/baselines.md): scripted 100 % (30/30), return 354 +- 53, 161 steps to the target (97 %,
+    339, before its plans were seeded from the start, issue 30: right_heel failed); random 3
     %, -437; zero 0 %, -218; PPO (SB3 defaults, 100k steps, 3 seeds) 0 / 3 / 3 %, return -118 / -102
     / -104 (its hand rests on a part near the target: wrong touches pay -distance, about -0.2 a
     step, against -1 without touch, a local optimum the paper's reward keeps; success stays the
-    optimum, +339 for the scripted policy); SAC (20k steps, 3 seeds) 7 / 7 / 10 %, -301 / -313 /
+    optimum, +354 for the scripted policy); SAC (20k steps, 3 seeds) 7 / 7 / 10 %, -301 / -313 /
     -326
 differences from the paper:
     (1) targets: 28 primitives, not the published code's 11 skinned bodies (which its 37-long
