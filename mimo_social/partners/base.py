@@ -21,7 +21,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop",
            "pd_gains", "motor_action", "torque_controls", "follow_waypoints", "check_angles",
-           "check_variants", "TorqueMotors", "torque_motors", "push_torques"]
+           "check_variants", "TorqueMotors", "agent_motors", "torque_motors", "push_torques"]
 
 
 def zero_action(space: spaces.Space):
@@ -136,27 +136,36 @@ def follow_waypoints(data, waypoints, state: list, hold_steps: int, tolerance: f
 
 
 class TorqueMotors:
-    """An agent's torque motors as a whole-body PD controller reads them: the actuation model
-    ``act``, the motors' joint ``names``, their ``qpos_adr`` / ``dof_adr`` and joint limits
-    ``lo`` / ``hi`` (rad)."""
+    """An agent's motors as a scripted controller reads them: the agent's ``index`` and world
+    index ``tables``, the actuation model ``act``, the motors' joint ``names``, their
+    ``qpos_adr`` / ``dof_adr`` and joint limits ``lo`` / ``hi`` (rad)."""
 
-    def __init__(self, act, names, qpos_adr, dof_adr, lo, hi):
+    def __init__(self, act, names, qpos_adr, dof_adr, lo, hi, index=None, tables=None):
         self.act, self.names = act, list(names)
         self.qpos_adr, self.dof_adr, self.lo, self.hi = qpos_adr, dof_adr, lo, hi
+        self.index, self.tables = index, tables
+
+
+def agent_motors(who: str, env, agent: str, joints=(), why: str = "") -> TorqueMotors:
+    """``agent``'s motors (:class:`TorqueMotors`) for scripted controller ``who``, after
+    :func:`require_motors` (``joints``, ``why``): a ValueError naming both when a joint it
+    needs has no motor."""
+    i = agent_index(env, agent)
+    a = env.world.agents[i]
+    require_motors(who, agent, a, joints, why)
+    jk = a.actuated_joint_idx
+    return TorqueMotors(env.actuation[i], a.actuated_names, a.qpos_adr[jk], a.dof_adr[jk],
+                        a.joint_range[jk, 0], a.joint_range[jk, 1], i, a)
 
 
 def torque_motors(who: str, env, agent: str) -> TorqueMotors:
     """``agent``'s torque motors (:class:`TorqueMotors`) for scripted controller ``who``; a
     ValueError naming both for an agent on muscles (its controls are not torques)."""
-    i = agent_index(env, agent)
-    a = env.world.agents[i]
-    act = env.actuation[i]
-    if act.name == "muscle":
+    motors = agent_motors(who, env, agent)
+    if motors.act.name == "muscle":
         raise ValueError(f"{who}: {agent} has actuation='muscle'; allowed: 'spring_damper' (it "
                          "drives torque motors)")
-    jk = a.actuated_joint_idx
-    return TorqueMotors(act, a.actuated_names, a.qpos_adr[jk], a.dof_adr[jk],
-                        a.joint_range[jk, 0], a.joint_range[jk, 1])
+    return motors
 
 
 def push_torques(model, data, jac: np.ndarray, dof_adr, pushes) -> np.ndarray:

@@ -85,7 +85,7 @@ from ..body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ..core.kinematics import hand_geoms
 from ..util.checks import (ConfigError, check_bool, check_choice, check_int, check_number,
                            check_numbers, show)
-from .base import (Partner, agent_index, check_angles, motor_action, pd_gains, require_motors,
+from .base import (Partner, agent_motors, check_angles, motor_action, pd_gains,
                    require_prop)
 from .offer_target import REACH_TO, adapts, is_adult, reach_target
 
@@ -311,17 +311,11 @@ class HandOffer(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = agent_index(env, agent)
-        a = w.agents[i]
+        motors = agent_motors("HandOffer", env, agent, ARM, "it needs the right arm's motors "
+                              "(shoulder, elbow, wrist) in its action")
+        i, a, names, lo, hi = motors.index, motors.tables, motors.names, motors.lo, motors.hi
         self._i = i
-        names = list(a.actuated_names)
-        require_motors("HandOffer", agent, a, ARM,
-                       "it needs the right arm's motors (shoulder, elbow, wrist) in its action")
-        jk = a.actuated_joint_idx
-        self._qadr = a.qpos_adr[jk]
-        self._dadr = a.dof_adr[jk]
-        lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]
-        self._act = env.actuation[i]
+        self._qadr, self._dadr, self._act = motors.qpos_adr, motors.dof_adr, motors.act
         self._muscle = self._act.name == "muscle"
         self._flex = finger_flexors(names)
         thumb = np.array(["thumb" in n for n in names])

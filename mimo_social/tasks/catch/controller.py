@@ -39,7 +39,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import ConfigError, check_number, check_numbers, show
-from ...partners.base import (Partner, agent_index, motor_action, pd_gains, require_motors,
+from ...partners.base import (Partner, agent_motors, motor_action, pd_gains,
                                require_prop, torque_controls)
 
 __all__ = ["CatchController", "palm_cup_angles"]
@@ -115,15 +115,11 @@ class CatchController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = agent_index(env, agent)
-        a = w.agents[i]
-        names = list(a.actuated_names)
-        require_motors("CatchController", agent, a, RIGHT_WRIST, "it needs the right wrist's "
-                       "and fingers' motors in its action (the catch task)")
+        motors = agent_motors("CatchController", env, agent, RIGHT_WRIST, "it needs the right "
+                              "wrist's and fingers' motors in its action (the catch task)")
         require_prop("CatchController", w, self.prop)
-        jk = a.actuated_joint_idx
-        self._qadr, self._dadr = a.qpos_adr[jk], a.dof_adr[jk]
-        self._act = env.actuation[i]
+        i, names, self._act = motors.index, motors.names, motors.act
+        self._qadr, self._dadr = motors.qpos_adr, motors.dof_adr
         wrist = np.array([n in RIGHT_WRIST for n in names])
         self._flex = np.array([n not in RIGHT_WRIST and "thumb" not in n
                                and n.split("_")[-1] in FLEXORS for n in names])
@@ -134,8 +130,7 @@ class CatchController(Partner):
         for k, n in enumerate(names):
             if self._flex[k]:
                 target[k] = cup[n.split("_")[-1]]
-        lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]
-        self.target_angles = np.clip(target, lo, hi)
+        self.target_angles = np.clip(target, motors.lo, motors.hi)
         ball = np.zeros(len(self._dadr))
         ball[wrist] = self.ball_mass * 0.05 ** 2
         self._kp, self._kd = pd_gains(m, d, self._dadr, self.frequency, self.damping, ball)

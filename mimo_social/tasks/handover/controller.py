@@ -53,7 +53,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import ConfigError, check_number, check_numbers, show
-from ...partners.base import (Partner, agent_index, motor_action, pd_gains, require_motors,
+from ...partners.base import (Partner, agent_motors, motor_action, pd_gains,
                                require_prop, torque_controls)
 from .task import READY_OFFSET
 
@@ -177,20 +177,16 @@ class ReceiveController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = agent_index(env, agent)
-        a = w.agents[i]
+        motors = agent_motors("ReceiveController", env, agent,
+                              ARM + ("right_index_mcp", "right_thumb_mcp"),
+                              "it needs the right arm's and the five fingers' motors in its "
+                              "action (the handover task)")
+        i, a, names, lo, hi = motors.index, motors.tables, motors.names, motors.lo, motors.hi
         self._i = i
-        names = list(a.actuated_names)
-        require_motors("ReceiveController", agent, a,
-                       ARM + ("right_index_mcp", "right_thumb_mcp"),
-                       "it needs the right arm's and the five fingers' motors in its action "
-                       "(the handover task)")
         body = require_prop("ReceiveController", w, self.prop)
         self._ball_body = body
         self._ball_geom = int(np.flatnonzero(m.geom_bodyid == body)[0])
-        jk = a.actuated_joint_idx
-        self._qadr, self._dadr = a.qpos_adr[jk], a.dof_adr[jk]
-        lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]
+        self._qadr, self._dadr = motors.qpos_adr, motors.dof_adr
         self._arm = np.array([names.index(n) for n in ARM])
         self._flex = np.array([n not in ARM and n.split("_")[-1] in FLEXORS for n in names])
         self._act = env.actuation[i]

@@ -30,7 +30,7 @@ import numpy as np
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import reach_sites
 from ...util.checks import check_number
-from ...partners.base import Partner, agent_index, motor_action, pd_gains, require_motors, require_prop
+from ...partners.base import Partner, agent_motors, motor_action, pd_gains, require_prop
 
 __all__ = ["ReachController"]
 
@@ -60,15 +60,11 @@ class ReachController(Partner):
         super().reset(env, agent, rng)
         w = env.world
         m, d = w.model, w.data
-        i = agent_index(env, agent)
-        a = w.agents[i]
-        names = list(a.actuated_names)
-        require_motors("ReachController", agent, a, ARM,
-                       "it needs the right arm's motors (shoulder, elbow, wrist) in its action")
+        motors = agent_motors("ReachController", env, agent, ARM, "it needs the right arm's "
+                              "motors (shoulder, elbow, wrist) in its action")
         require_prop("ReachController", w, self.prop)
-        jk = a.actuated_joint_idx
-        self._qadr, self._dadr = a.qpos_adr[jk], a.dof_adr[jk]
-        lo, hi = a.joint_range[jk, 0], a.joint_range[jk, 1]
+        i, a, names, lo, hi = motors.index, motors.tables, motors.names, motors.lo, motors.hi
+        self._qadr, self._dadr = motors.qpos_adr, motors.dof_adr
         arm = np.array([names.index(n) for n in ARM])
         # the goal: `depth` inside the ball, on the line from the shoulder to its centre
         body = w.prop_bodies[self.prop]
