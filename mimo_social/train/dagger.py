@@ -58,12 +58,14 @@ def _joined(a: Demonstrations, b: Demonstrations) -> Demonstrations:
 
 
 def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, Any],
-           seed: int) -> tuple[Demonstrations, list[dict]]:
+           seed: int, report=None) -> tuple[Demonstrations, list[dict]]:
     """``settings["dagger_rounds"]`` rounds of DAgger on ``env`` (module docstring), each
     cloning ``settings["epochs"]`` epochs on all the pairs so far, then one more play of the
     last policy (labelled too, not cloned); the policy kept is the one of the play with the
     highest success rate (then return), as DAgger's guarantee is for the best of its policies.
-    Returns the pairs and a record per play (``kept`` marks the policy kept)."""
+    Returns the pairs and a record per play (``kept`` marks the policy kept); ``report`` (a
+    function of a line of text, optional) hears of each play as it ends (a warm start can take
+    most of an hour)."""
     import copy
 
     controller = entry(task).controller
@@ -81,6 +83,12 @@ def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, 
                   "success_rate": measured["success_rate"],
                   "return_mean": measured["return_mean"], "pairs_added": len(played),
                   "pairs": len(demos)}
+        if report is not None:
+            rate = measured["success_rate"]
+            report(f"DAgger play {r + 1} of {int(settings['dagger_rounds']) + 1}: the policy "
+                   + ("" if rate is None else f"{rate:.0%} on its ")
+                   + f"{int(settings['dagger_episodes'])} episodes, return "
+                   f"{measured['return_mean']:.1f}; {len(demos)} pairs")
         if r < int(settings["dagger_rounds"]):
             res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
                         float(settings["lr"]), str(settings["loss"]), int(seed) + r + 1,

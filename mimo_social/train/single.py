@@ -205,7 +205,7 @@ def warm_start_run(model, task: str, env, bc: dict, seed: int, config: dict, out
     b = config["bc"]
     if bc["dagger_rounds"]:
         from .dagger import dagger
-        demos, b["dagger"] = dagger(model, task, env, demos, bc, seed)
+        demos, b["dagger"] = dagger(model, task, env, demos, bc, seed, report=warn)
     rate = "n/a" if b["success_rate"] is None else f"{b['success_rate']:.0%}"
     warn(f"behaviour cloning: {b['episodes']} episodes of {b['controller']} (success {rate}, "
          f"{b['samples']} pairs), {b['epochs']} epochs: {b['loss']} loss {b['loss_before']:.4g}"

@@ -242,9 +242,13 @@ def test_dagger_labels_the_cloned_policy_s_states_with_the_controller_s_actions(
         clone(ppo, demos, 5, seed=0)
         settings = {"dagger_rounds": 2, "dagger_episodes": 2, "epochs": 5, "batch_size": 64,
                     "lr": 1e-3, "loss": "mse", "log_std": None}
-        joined, rounds = dagger(ppo, "reach", env, demos, settings, 7)
+        heard = []
+        joined, rounds = dagger(ppo, "reach", env, demos, settings, 7, report=heard.append)
         # two rounds, then the last policy's play (labelled, not cloned)
         assert [r["round"] for r in rounds] == [1, 2, 3]
+        # each play reported as it ends, with its numbers
+        assert [h.split(":")[0] for h in heard] == [f"DAgger play {k} of 3" for k in (1, 2, 3)]
+        assert all(f"{r['pairs']} pairs" in h for h, r in zip(heard, rounds))
         assert "loss_after" in rounds[1] and "loss_after" not in rounds[2]
         assert rounds[0]["seeds"] == [DAGGER_SEED + 7, DAGGER_SEED + 8]
         assert rounds[1]["seeds"] == [DAGGER_SEED + 1007, DAGGER_SEED + 1008]
