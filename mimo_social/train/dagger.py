@@ -24,8 +24,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..envs.catalog import entry
-from .demonstrations import Demonstrations, Demonstrator, clone, play
+from .demonstrations import Demonstrations, Demonstrator, clone, demonstrator, play
 
 __all__ = ["DAGGER_SEED", "Labeller", "dagger"]
 
@@ -68,7 +67,7 @@ def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, 
     most of an hour)."""
     import copy
 
-    controller = entry(task).controller
+    controller = demonstrator(task, settings)
     rounds, best = [], None
     for r in range(int(settings["dagger_rounds"]) + 1):
         first = DAGGER_SEED + int(seed) + 1000 * r

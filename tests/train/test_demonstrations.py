@@ -145,6 +145,12 @@ def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_pa
     ({"bc_episodes": 2, "normalize_reward": True, "bc_kwargs": {"critic_epochs": 2}},
      ["critic_epochs with --normalize-reward"]),
     ({"bc_episodes": 2, "algo": "recurrent_ppo"}, ["recurrent_ppo", "ppo, sac"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"controller": {"stiffness": 2}}},
+     ["controller={'stiffness': 2}", "stiffness"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"controller": {"frequency": -1.0}}},
+     ["controller={'frequency': -1.0}", "frequency"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"controller": [6.0]}},
+     ["controller=[6.0]", "ReachController's keyword arguments"]),
     ({"bc_episodes": 2, "task": "high_five"}, ["--mode shared", "one learner"]),
 ])
 def test_bad_arguments_are_refused_before_anything_is_written(tmp_path, kwargs, words):
@@ -156,6 +162,25 @@ def test_bad_arguments_are_refused_before_anything_is_written(tmp_path, kwargs, 
     for w in words:
         assert w in str(info.value), (w, str(info.value))
     assert not out.exists()
+
+
+def test_the_demonstrator_takes_the_controller_settings_given():
+    """bc_kwargs controller: the demonstrations are the controller made with them (a stiffer
+    reach: other actions from the same start), and the run records them."""
+    from mimo_social.train.demonstrations import check_bc, demonstrator
+    env = make_env("reach", flat=True, max_steps=40)
+    try:
+        soft = record_demonstrations("reach", env, 1, 20_000)
+        stiff = record_demonstrations("reach", env, 1, 20_000, {"frequency": 8.0})
+        again = record_demonstrations("reach", env, 1, 20_000, {"frequency": 3.0})
+    finally:
+        env.close()
+    assert np.array_equal(soft.obs[0], stiff.obs[0])
+    assert not np.allclose(soft.actions[:5], stiff.actions[:5])
+    assert np.array_equal(soft.actions, again.actions)      # 3 Hz is the default
+    s = check_bc("reach", "ppo", None, 2, 1, {"controller": {"frequency": 8.0}})
+    assert demonstrator("reach", s)().frequency == 8.0
+    assert check_bc("reach", "ppo", None, 2, 1, {})["controller"] is None
 
 
 def test_returns_to_go_stop_at_each_episode_end():
