@@ -27,3 +27,25 @@ def learner_episode(env, policy, seed):
         total += r["infant_0"]
         steps += 1
     return bool(info["infant_0"]["is_success"]), total, steps
+
+
+def pickled_twin_runs(env, learner, seed, before, after=None):
+    """``env`` reset with ``seed``, ``infant_0`` driven by the Partner ``learner`` for ``before``
+    steps, then the env pickled and the learner deep-copied, and both pairs run on, to the end
+    (``after`` None) or ``after`` steps. Returns the copy and each pair's list of (reward,
+    info) of ``infant_0``: a copy that continues identically gives equal lists."""
+    import copy
+    import pickle
+    env.reset(seed=seed)
+    learner.reset(env.unwrapped, "infant_0", np.random.default_rng(seed))
+    for _ in range(before):
+        env.step({"infant_0": learner.act(env.unwrapped, "infant_0", None)})
+    twin, twin_learner = pickle.loads(pickle.dumps(env)), copy.deepcopy(learner)
+    outs = []
+    for e, p in ((env, learner), (twin, twin_learner)):
+        out = []
+        while e.agents and (after is None or len(out) < after):
+            _, r, _, _, info = e.step({"infant_0": p.act(e.unwrapped, "infant_0", None)})
+            out.append((r["infant_0"], info["infant_0"]))
+        outs.append(out)
+    return twin, outs

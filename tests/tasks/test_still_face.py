@@ -123,24 +123,11 @@ def test_phase_lengths_are_drawn_per_episode_and_the_caregiver_follows():
 def test_a_pickled_copy_keeps_its_drawn_phases():
     """A copy taken mid-episode continues as the original: the drawn phase lengths, the
     caregiver's mode switches and every info and reward the same."""
-    import copy
-    import pickle
+    from learner_episodes import pickled_twin_runs
     env = still_face_v0.scripted_env(task_options={"phases_s": (0.4, 0.4, 0.4)},
                                      per_agent=[{"vision": False}, {}])
-    env.reset(seed=11)
-    learner = StillFaceInfantController()
-    learner.reset(env.unwrapped, "infant_0", np.random.default_rng(11))
-    for _ in range(25):
-        env.step({"infant_0": learner.act(env.unwrapped, "infant_0", None)})
-    twin, twin_learner = pickle.loads(pickle.dumps(env)), copy.deepcopy(learner)
+    twin, outs = pickled_twin_runs(env, StillFaceInfantController(), 11, 25)
     assert twin.unwrapped.task.episode_phase_steps == env.unwrapped.task.episode_phase_steps
-    outs = []
-    for e, p in ((env, learner), (twin, twin_learner)):
-        out = []
-        while e.agents:
-            _, r, _, _, info = e.step({"infant_0": p.act(e.unwrapped, "infant_0", None)})
-            out.append((r["infant_0"], info["infant_0"]))
-        outs.append(out)
     assert outs[0] == outs[1] and len(outs[0]) == 95
 
 

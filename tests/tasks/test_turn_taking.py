@@ -215,23 +215,13 @@ def test_noncontingent_and_replay_do_not_depend_on_the_infant():
 
 
 def test_a_pickled_copy_continues_exactly_and_seeds_repeat():
-    import copy
-    import pickle
     env = turn_taking_v0.scripted_env(max_steps=STEPS)
     first = _episode(env, TurnTakingInfantController(), "contingent", seed=2)
     again = _episode(env, TurnTakingInfantController(), "contingent", seed=2)
     assert np.array_equal(first[0], again[0]) and np.array_equal(first[1], again[1])
-    env.reset(seed=4)
-    learner = TurnTakingInfantController()
-    learner.reset(env.unwrapped, "infant_0", np.random.default_rng(4))
-    for _ in range(300):
-        env.step({"infant_0": learner.act(env.unwrapped, "infant_0", None)})
-    twin, twin_learner = pickle.loads(pickle.dumps(env)), copy.deepcopy(learner)
-    outs = []
-    for e, p in ((env, learner), (twin, twin_learner)):
-        outs.append([e.step({"infant_0": p.act(e.unwrapped, "infant_0", None)})[4]["infant_0"]
-                     for _ in range(400)])
-    assert outs[0] == outs[1]
+    from learner_episodes import pickled_twin_runs
+    _, outs = pickled_twin_runs(env, TurnTakingInfantController(), 4, 300, 400)
+    assert outs[0] == outs[1] and len(outs[0]) == 400
 
 
 @pytest.mark.parametrize("options, words", [
