@@ -8,7 +8,12 @@ to open the file elsewhere and exits 0.
 ``--summary`` prints, with no viewer, what :func:`mimo_social.recording.summary.summarize` reads
 from the file: the agents, the simulated duration, the number of steps and of pose rows, the
 entity paths grouped by agent and kind, whether eye images and skin points are there, and the
-contact events between agents.
+contact events between agents. A file whose last frame was cut off mid-write (a run killed while
+Rerun wrote it) is summarised up to its last whole frame, and says so.
+
+``--salvage [OUT]`` writes the whole frames of such a file to ``OUT`` (default
+``FILE.salvaged.rrd``), which Rerun's viewer and reader open; without it, the viewer is not
+started on a torn file (Rerun's reader refuses it), and the command says what to run.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ import sys
 from pathlib import Path
 
 from ..recording.summary import format_summary, summarize
+from ..recording.torn import salvage, whole_length
 
 __all__ = ["add_parser", "run", "viewer_available"]
 
@@ -34,6 +40,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--summary", action="store_true",
                         help="print agents, duration, entities, steps, pose rows, eye images, "
                              "skin points and contact events; no viewer")
+    parser.add_argument("--salvage", nargs="?", const="", default=None, metavar="OUT",
+                        help="write the whole frames of a recording cut off mid-write (a killed "
+                             "run) to OUT (default: FILE.salvaged.rrd)")
     parser.set_defaults(func=run)
     return parser
 
@@ -50,6 +59,15 @@ def run(args: argparse.Namespace) -> int:
     if not path.is_file():
         print(f"mimo-social replay: error: {path}: no such file", file=sys.stderr)
         return 2
+    try:
+        torn = path.stat().st_size - whole_length(path)
+    except ValueError as e:
+        print(f"mimo-social replay: error: cannot read {path} as a Rerun recording: {e}",
+              file=sys.stderr)
+        return 2
+    if args.salvage is not None:
+        return _salvage(path, Path(args.salvage) if args.salvage else
+                        path.with_name(path.stem + ".salvaged.rrd"))
     if args.summary:
         try:
             summary = summarize(path)
@@ -59,6 +77,11 @@ def run(args: argparse.Namespace) -> int:
             return 2
         print(format_summary(summary))
         return 0
+    if torn:
+        print(f"{path}: its last {torn} bytes are a frame cut off mid-write (the run was killed "
+              f"while writing); Rerun does not open it as it is. Write the whole part with:\n"
+              f"  mimo-social replay {path} --salvage")
+        return 1
     exe = viewer_available()
     if exe is not None:
         proc = subprocess.Popen([exe, str(path)], stdin=subprocess.DEVNULL,
@@ -73,4 +96,16 @@ def run(args: argparse.Namespace) -> int:
           f"  rerun {path}\n"
           f"To see what it holds here:\n"
           f"  mimo-social replay {path} --summary")
+    return 0
+
+
+def _salvage(path: Path, out: Path) -> int:
+    try:
+        dropped = salvage(path, out)
+    except (ValueError, OSError) as e:
+        print(f"mimo-social replay: error: --salvage: {e}", file=sys.stderr)
+        return 2
+    what = (f"left out the last {dropped} bytes (a frame cut off mid-write)" if dropped
+            else "nothing was torn: a plain copy")
+    print(f"Wrote {out} ({out.stat().st_size} bytes; {what}).\n  mimo-social replay {out}")
     return 0

@@ -4,7 +4,8 @@
 its docstring); ``episodes``: one episode (:func:`record_episode`) or every k-th episode during
 training (:class:`RecordingParallelEnv`, :func:`recording_env_fn`); ``summary``: what a file
 holds (:func:`summarize`); ``streams``: Rerun file streams that free their threads when closed and
-write errors that name the file and the cause (:class:`RecordingFileError`). The parts of a
+write errors that name the file and the cause (:class:`RecordingFileError`); ``torn``: the whole
+part of a file cut off mid-write by a killed run (:func:`salvage`). The parts of a
 recording: ``geometry`` (geom shapes), ``faces`` (expressions), ``eyes``, ``skin``, ``contacts``,
 ``blueprint`` (viewer layout), ``columns`` (Arrow columns and the row buffer).
 """
@@ -31,6 +32,7 @@ from .skin import (
                    force_radii,
 )
 from .summary import format_summary, read_batches, summarize
+from .torn import salvage, whole_length
 
 __all__ = [
                        "CONTACTS_PATH",
@@ -56,5 +58,7 @@ __all__ = [
                        "read_batches",
                        "record_episode",
                        "recording_env_fn",
+                       "salvage",
                        "summarize",
+                       "whole_length",
 ]

@@ -4,7 +4,8 @@
 the agents, the simulated duration, the number of steps and of pose rows, the entity paths grouped
 by agent and kind, the eye images and skin points per agent, the expression log rows and the
 contact events between agents; :func:`format_summary` puts that as text for people. Files of a
-run that was killed (no footer) are read up to their last flush.
+run that was killed (no footer, perhaps a last frame cut off mid-write: :mod:`.torn`) are read
+up to their last whole flush.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 
 from .columns import SIM_TIME, STEP
 from .contacts import CONTACTS_PATH
+from .torn import readable_copy
 
 __all__ = ["format_summary", "read_batches", "summarize"]
 
@@ -26,22 +28,25 @@ _AGENT_GROUPS = ("world", "agents")
 
 
 def _read_chunks(path: Path):
+    """(stores, chunks, complete, torn bytes): a file killed mid-write is read up to its last
+    whole frame (:mod:`.torn`)."""
     from rerun.chunk import RrdReader
 
-    with warnings.catch_warnings(record=True) as caught:
+    with readable_copy(path) as (readable, torn), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")   # a file of a crashed run has no footer: say so
-        reader = RrdReader(path)
+        reader = RrdReader(readable)
         stores = reader.recordings()
         chunks = reader.stream().to_chunks()
-    complete = not any("footer" in str(w.message) for w in caught)
-    return stores, chunks, complete
+    complete = torn == 0 and not any("footer" in str(w.message) for w in caught)
+    return stores, chunks, complete, torn
 
 
 def read_batches(path: str | Path) -> dict:
     """Entity path -> the Arrow record batches of its chunks (static ones included), read with
     Rerun's own reader: the raw rows, for checks and analyses beyond :func:`summarize`. A file
-    of a run still open or killed (no footer) reads up to its last flush."""
-    _, chunks, _ = _read_chunks(Path(path))
+    of a run still open or killed (no footer, a torn last frame) reads up to its last whole
+    flush."""
+    _, chunks, _, _ = _read_chunks(Path(path))
     out: dict = defaultdict(list)
     for chunk in chunks:
         out[chunk.entity_path].append(chunk.to_record_batch())
@@ -56,7 +61,7 @@ def _non_null(batch, name: str) -> np.ndarray:
 def summarize(path: str | Path) -> dict:
     """What a recording holds (see the module docstring); read with ``RrdReader``."""
     path = Path(path)
-    stores, chunks, complete = _read_chunks(path)
+    stores, chunks, complete, torn = _read_chunks(path)
     entities: set[str] = set()
     steps: set[int] = set()
     t_min, t_max = None, None
@@ -120,6 +125,7 @@ def summarize(path: str | Path) -> dict:
     contacts.sort(key=lambda c: (-1 if c[0] is None else c[0]))
     return {
         "path": str(path), "bytes": path.stat().st_size, "complete": complete,
+        "torn_bytes": torn,
         "recordings": [{"application_id": s.application_id, "recording_id": s.recording_id}
                        for s in stores],
         "agents": agents,
@@ -159,6 +165,9 @@ def format_summary(s: dict, max_contacts: int = 10) -> str:
     if not s["complete"]:
         lines.append("complete: no (no footer: the recording was not closed, e.g. the run was "
                      "killed; everything flushed before is here)")
+    if s.get("torn_bytes"):
+        lines.append(f"torn: the last {s['torn_bytes']} bytes are a frame cut off mid-write "
+                     f"(left out; `mimo-social replay FILE --salvage` writes the whole part)")
     for r in s["recordings"]:
         lines.append(f"recording: {r['application_id']} ({r['recording_id']})")
     lines.append(f"agents: {len(s['agents'])} ({', '.join(s['agents']) or 'none'})")
