@@ -15,9 +15,9 @@ fails here.
   with the cloning kept), its final model by its mean action: before any RL step the clones
   touched in 4/5 and 3/5 evaluation episodes (seeds 0 and 1, issue 30, third session), their
   best DAgger plays 90 % and 92 % of 50; the bar is 50 %;
-* selfbody (the curriculum, not shipped): its first stage as a task of its own (the `targets` option cut to the
-  stage's 4 primitives), 80k steps: 80 % in 60k steps in one run of issue 30, 40 % at 80k in this
-  test's run (return 76; random 3 %): the bar is 30 %;
+* selfbody (the curriculum, not shipped): its first stage as a task of its own (the `targets`
+  option cut to the stage's 4 primitives), 80k steps: 80 % in 60k steps in one run of issue 30,
+  40 % at 80k in this test's run (return 76; random 3 %): the bar is 30 %;
 * turn_taking: the recipe at 10k steps (its warm start, cloned from 20 scripted episodes, then
   five PPO updates with the cloning kept), judged by its sampled actions: the clone alone
   succeeded in 3/3 sampled episodes in issue 33's pilots (the most likely sound is silence: 0 %
