@@ -59,12 +59,6 @@ def run(args: argparse.Namespace) -> int:
     if not path.is_file():
         print(f"mimo-social replay: error: {path}: no such file", file=sys.stderr)
         return 2
-    try:
-        torn = path.stat().st_size - whole_length(path)
-    except ValueError as e:
-        print(f"mimo-social replay: error: cannot read {path} as a Rerun recording: {e}",
-              file=sys.stderr)
-        return 2
     if args.salvage is not None:
         return _salvage(path, Path(args.salvage) if args.salvage else
                         path.with_name(path.stem + ".salvaged.rrd"))
@@ -77,6 +71,12 @@ def run(args: argparse.Namespace) -> int:
             return 2
         print(format_summary(summary))
         return 0
+    try:
+        torn = path.stat().st_size - whole_length(path)
+    except ValueError as e:
+        print(f"mimo-social replay: error: cannot read {path} as a Rerun recording: {e}",
+              file=sys.stderr)
+        return 2
     if torn:
         print(f"{path}: its last {torn} bytes are a frame cut off mid-write (the run was killed "
               f"while writing); Rerun does not open it as it is. Write the whole part with:\n"

@@ -18,7 +18,6 @@ stream header may follow (files appended to).
 from __future__ import annotations
 
 import contextlib
-import os
 import struct
 import tempfile
 from collections.abc import Iterator
@@ -73,6 +72,24 @@ def whole_length(path: str | Path) -> int:
         return whole
 
 
+def _salvageable(path: Path) -> int:
+    """``whole_length(path)``; ValueError when not even the stream header is whole."""
+    keep = whole_length(path)
+    if keep == 0:
+        raise ValueError(f"{path}: {path.stat().st_size} bytes, fewer than a Rerun stream "
+                         f"header ({_STREAM_HEADER} bytes): nothing to salvage")
+    return keep
+
+
+def _copy_prefix(path: Path, out: Path, keep: int) -> None:
+    with path.open("rb") as src, out.open("wb") as dst:
+        remaining = keep
+        while remaining:
+            block = src.read(min(remaining, 1 << 20))
+            dst.write(block)
+            remaining -= len(block)
+
+
 def salvage(path: str | Path, out: str | Path) -> int:
     """Write the whole frames of ``path`` to ``out`` and return how many bytes of a torn last
     frame were left out (0 when the file was not torn; ``out`` is then a plain copy).
@@ -80,19 +97,11 @@ def salvage(path: str | Path, out: str | Path) -> int:
     Raises ValueError when not even the stream header is whole.
     """
     path, out = Path(path), Path(out)
-    keep = whole_length(path)
-    if keep == 0:
-        raise ValueError(f"{path}: {path.stat().st_size} bytes, fewer than a Rerun stream "
-                         f"header ({_STREAM_HEADER} bytes): nothing to salvage")
+    keep = _salvageable(path)
     if out.resolve() == path.resolve():
         raise ValueError(f"salvage: out={str(out)!r} is the recording itself; allowed: "
                          f"another path (the original stays as it is)")
-    with path.open("rb") as src, out.open("wb") as dst:
-        remaining = keep
-        while remaining:
-            block = src.read(min(remaining, 1 << 20))
-            dst.write(block)
-            remaining -= len(block)
+    _copy_prefix(path, out, keep)
     return path.stat().st_size - keep
 
 
@@ -101,14 +110,12 @@ def readable_copy(path: str | Path) -> Iterator[tuple[Path, int]]:
     """``(file to read, torn bytes left out)``: ``path`` itself when it is not torn, else a
     temporary salvaged copy that lives as long as the ``with`` block."""
     path = Path(path)
-    keep = whole_length(path)
-    torn = path.stat().st_size - keep
+    torn = path.stat().st_size - whole_length(path)
     if torn == 0:
         yield path, 0
         return
+    keep = _salvageable(path)
     with tempfile.TemporaryDirectory(prefix="mimo_rrd_") as tmp:
         out = Path(tmp) / path.name
-        salvage(path, out)
+        _copy_prefix(path, out, keep)
         yield out, torn
-        with contextlib.suppress(OSError):
-            os.remove(out)
