@@ -185,3 +185,68 @@ def test_the_demonstration_reaches_the_learners_eyes():
     for i, a in enumerate(ACTIONS):
         for b in ACTIONS[i + 1:]:
             assert changed(seen[a], seen[b]) > 100, (a, b)
+
+
+class Watched:
+    """The scripted learner's arm angles (its proprioception's first values) at every step of
+    one episode, and its last info."""
+
+    def __init__(self, controller):
+        self.c, self.arms, self.outcomes = controller, [], []
+
+    def reset(self, env, agent, rng):
+        self.c.reset(env, agent, rng)
+
+    def act(self, env, agent, obs):
+        self.arms.append(np.asarray(obs["proprioception"][:16], float).copy())
+        return self.c.act(env, agent, obs)
+
+
+@pytest.mark.parametrize("prepare", [0.3, 0.5, 0.7])
+def test_a_prepared_act_keeps_what_was_seen_in_the_posture(prepare):
+    """``prepare``: the scripted learner goes part of the way to the shown act while it watches
+    (no outcome of its own in the demonstration), holds still before the demonstrator's arm has
+    reached its pose (nothing there tells the acts apart), and still succeeds in its turn; at the
+    turn's first step its posture differs between the acts (what it saw is in its body), and
+    without ``prepare`` it does not."""
+    env = scripted()
+    seeds = seeds_by_action(env)
+    at_turn = {}
+    for shown, seed in seeds.items():
+        for p in (0.0, prepare):
+            w = Watched(ImitationController(prepare=p))
+            [rec] = records(env, w, 1, seed=seed)
+            demo = env.unwrapped.task.demo_steps
+            assert rec["is_success"] and rec["response"] == ACTIONS.index(shown), (p, shown, rec)
+            early = int(round(0.8 / env.unwrapped.dt)) - 1      # prepare_at_s: 0.8
+            assert np.abs(w.arms[early] - w.arms[0]).max() < 0.02, (p, shown)
+            at_turn[shown, p] = w.arms[demo]
+    for p in (0.0, prepare):
+        arms = [at_turn[a, p] for a in ACTIONS]
+        gaps = [np.abs(arms[i] - arms[j]).max() for i in range(4) for j in range(i + 1, 4)]
+        if p == 0.0:
+            assert max(gaps) < 0.02, gaps
+        else:
+            assert min(gaps) > 0.1 * prepare, gaps
+
+
+def test_a_prepared_act_makes_no_outcome_while_the_demonstration_runs():
+    """Every act prepared at 0.7 (the most allowed: at 0.9 the raised palm is already over the
+    head) makes no outcome of the learner's in the demonstration: ``outcomes`` stays 0 until its
+    turn."""
+    env = scripted()
+    for shown, seed in seeds_by_action(env).items():
+        c = ImitationController(prepare=0.7)
+        obs, _ = env.reset(seed=seed)
+        inner = env.unwrapped
+        c.reset(inner, "infant_0", np.random.default_rng(0))
+        while env.agents and not inner.task.turn:
+            obs, rew, term, trunc, info = env.step({"infant_0": c.act(inner, "infant_0", obs)})
+            assert info["infant_0"]["outcomes"] == 0, (shown, inner.task.step_count)
+
+
+@pytest.mark.parametrize("kw", [{"prepare": -0.1}, {"prepare": 0.75}, {"prepare": "half"},
+                                {"prepare_at_s": -1.0}])
+def test_bad_prepare_settings_raise(kw):
+    with pytest.raises(Exception, match="ImitationController"):
+        ImitationController(**kw)
