@@ -396,6 +396,12 @@ class MimoParallelEnv(SceneRendering, ParallelEnv):
         view.flags.writeable = False
         return view
 
+    def mute(self, agent: int) -> None:
+        """Silence agent ``agent`` (its index) for this control step, whatever its action said:
+        for a task's ``before_physics`` that holds an agent still (the still face's caregiver);
+        what others hear this step and ``sounds`` say silence."""
+        self._sounds[int(agent)] = 0.0
+
     def _observe(self, i: int, reset: bool = False) -> dict:
         m, d = self.world.model, self.world.data
         out = {}

@@ -63,6 +63,16 @@ over the servo's stiffness (``q + qfrc_bias / kp``, so a held pose does not sag)
 from the joint's inertia) with gravity, spring and applied-force compensation, as
 :class:`~mimo_social.partners.gaze.GazeAtTarget`. Muscles are not supported.
 
+**Speech**: a caregiver whose action has a voice (``voice=True`` in its settings) talks in the
+``"interactive"`` and ``"non_contingent"`` modes, whatever the learner does, from their first
+step on (an episode's start, a still face's end): utterances of
+``speech`` (5, ``"speech"``) lasting a uniform draw from ``speech_s`` (0.5-1.5 s), each followed
+by a pause drawn from ``pause_s`` (0.3-1.2 s), at ``speech_loudness`` (0.5 of the kind's range;
+draws from the partner's generator, none for a caregiver without a voice); in ``"still"`` it is
+silent (the still face of Tronick et al. 1978 is silent as well as still: the parent stops talking).
+A caregiver's speech does not depend on the learner, so it adds nothing to the contingency; it
+tells a listener whether the caregiver is engaged, also while the listener looks away.
+
 **Stream**: ``stream`` holds the action of every step of the episode (``motors``: (T, n)
 float32, ``expression``: (T,) int64, -1 without expressions, ``dt``); a
 :class:`~mimo_social.partners.replay.ReplayCaregiver` plays it back bit for bit.
@@ -86,6 +96,7 @@ from ..core.kinematics import LookAt, reach_sites
 from ..expressions.faces import EXPRESSIONS
 from ..util.checks import ConfigError, check_bool, check_choice, check_number, show
 from .base import Partner, agent_index
+from ..expressions.voice import SOUNDS
 from .cues import HAPPY, NEUTRAL, Cues, learner_cues, touching_hands
 
 __all__ = ["ContingentCaregiver", "CUES", "MODES", "FACES", "look_at_point"]
@@ -93,6 +104,8 @@ __all__ = ["ContingentCaregiver", "CUES", "MODES", "FACES", "look_at_point"]
 CUES = ("expression", "gaze", "touch")
 MODES = ("interactive", "still", "non_contingent")
 FACES = ("smile", "copy")
+#: the sound kind of the caregiver's talk
+SPEECH = SOUNDS.index("speech")
 #: m: the pat's palm height above the learner's palm before it comes down onto it
 PAT_LIFT = 0.04
 #: m: a pat point counts as reached when the planned palm comes this near it
@@ -117,6 +130,19 @@ def _check_cues(value) -> tuple[str, ...]:
         raise ConfigError(f"ContingentCaregiver: cues={show(value)} not allowed; allowed: "
                           f"{allowed}")
     return tuple(value)
+
+
+def _check_range(who: str, name: str, value, lo: float, hi: float) -> tuple[float, float]:
+    """A (shortest, longest) pair of seconds within [lo, hi], shortest <= longest."""
+    ok = isinstance(value, Sequence) and not isinstance(value, (str, bytes)) and len(value) == 2
+    if ok:
+        a = check_number(who, f"{name}[0]", value[0], lo, hi)
+        b = check_number(who, f"{name}[1]", value[1], lo, hi)
+        ok = a <= b
+    if not ok:
+        raise ConfigError(f"{who}: {name}={show(value)} not allowed; allowed: (shortest, "
+                          f"longest) seconds, each {lo} to {hi}, shortest <= longest")
+    return float(a), float(b)
 
 
 def _check_rates(value, cues) -> dict | None:
@@ -144,14 +170,16 @@ class ContingentCaregiver(Partner):
     rate), ``learner`` (None: the other agent of a pair), ``omega`` / ``zeta`` (the spring-damper
     PD). ``measured_rates`` (responses per second of each cue in the last interactive period that
     ended, of this or an earlier episode) is kept across resets, so a non-contingent episode can
-    follow a live one.
+    follow a live one. ``speech_s``, ``pause_s`` (ranges, s) and ``speech_loudness`` (0-1): its
+    talk, where its action has a voice (see the module docstring).
     """
 
     def __init__(self, cues=CUES, delay_s: float = 0.5, probability: float = 1.0,
                  duration_s: float = 1.0, face: str = "smile", rest_face: str = "neutral",
                  mode: str = "interactive", rate_hz=None, learner: str | None = None,
                  omega: float = 15.0, zeta: float = 1.0, delay_jitter_s: float = 0.0,
-                 refractory: bool = False):
+                 refractory: bool = False, speech_s=(0.5, 1.5), pause_s=(0.3, 1.2),
+                 speech_loudness: float = 0.5):
         who = "ContingentCaregiver"
         self.cues = _check_cues(cues)
         self.delay_s = check_number(who, "delay_s", delay_s, 0.0, 60.0)
@@ -169,6 +197,9 @@ class ContingentCaregiver(Partner):
         self.learner = learner
         self.omega = check_number(who, "omega", omega, 0.01, 1000.0)
         self.zeta = check_number(who, "zeta", zeta, 0.01, 1000.0)
+        self.speech_s = _check_range(who, "speech_s", speech_s, 0.05, 60.0)
+        self.pause_s = _check_range(who, "pause_s", pause_s, 0.0, 60.0)
+        self.speech_loudness = check_number(who, "speech_loudness", speech_loudness, 0.0, 1.0)
         self.mode = self.initial_mode
         self.measured_rates: dict[str, float] | None = None
         self._env = None
@@ -209,6 +240,7 @@ class ContingentCaregiver(Partner):
         self._positional = cfg.actuation == "positional"
         space = env.action_space(agent)
         self._dict = isinstance(space, spaces.Dict) and "expression" in space.spaces
+        self._voice = isinstance(space, spaces.Dict) and "voice" in space.spaces
         if "expression" in self.cues and not self._dict:
             raise ValueError(f"{who}: cue 'expression' answers with the face, but {agent}'s "
                              "action has no expression (build the env with expressions on), "
@@ -260,7 +292,8 @@ class ContingentCaregiver(Partner):
         self._pending: list[tuple[int, str, object, int]] = []
         self._active: dict[str, tuple[int, int, object]] = {}
         self.events, self.responses = [], []
-        self._motors, self._faces = [], []
+        self._motors, self._faces, self._voices = [], [], []
+        self._talk = 0              # steps left of the utterance (> 0) or of the pause (< 0)
         self._period_steps = 0
         self._period_counts = dict.fromkeys(self.cues, 0)
         self._period_content: dict[str, list] = {c: [] for c in self.cues}
@@ -356,9 +389,39 @@ class ContingentCaregiver(Partner):
         self._step += 1
         self._motors.append(u)
         self._faces.append(face if self._dict else -1)
+        if self._voice:
+            kind = self._speech()
+            self._voices.append(kind)
+            out = {"motors": u.copy(), "voice": np.int64(kind),
+                   "loudness": np.array([self.speech_loudness], np.float32)}
+            if self._dict:
+                out["expression"] = np.int64(face)
+            return out
         if self._dict:
             return {"motors": u.copy(), "expression": np.int64(face)}
         return u.copy()
+
+    def _speech(self) -> int:
+        """This step's sound kind (see the module docstring: utterances and pauses drawn from
+        the partner's generator; silent in ``"still"``)."""
+        if self.mode == "still":
+            self._talk = 0
+            return 0
+        if self._talk == 0:      # an episode's start or a still face's end: it talks at once
+            self._talk = self._draw(self.speech_s)
+        if self._talk < 0:
+            self._talk += 1
+            if self._talk == 0:
+                self._talk = self._draw(self.speech_s)
+            return 0
+        self._talk -= 1
+        if self._talk == 0:
+            self._talk = -self._draw(self.pause_s)
+        return SPEECH
+
+    def _draw(self, span: tuple[float, float]) -> int:
+        """A length of at least one step, uniform within ``span`` seconds."""
+        return max(1, int(round(self.rng.uniform(*span) / self._dt)))
 
     def _detect(self, n: int, now: Cues) -> None:
         prev = self._prev

@@ -341,3 +341,121 @@ if __name__ == "__main__":   # the figures of the task table: python tests/tasks
         print(f"== {name}: success {wins}/{n}, return {rets.mean():.1f} +- {rets.std():.1f} "
               f"({time.time() - t:.0f} s)")
         print(format_still_face_summary(summary), flush=True)
+
+
+SPEECH_KIND = 5          # SOUNDS.index("speech")
+MEMORY = {"audition": {"memory_s": 2.0, "memory_bin_s": 0.1}}
+
+
+def speech_episode(seed, phases=(5.0, 5.0, 5.0), **partner):
+    """One episode of the scripted infant with the talking caregiver (``caregiver_speech``):
+    per step the caregiver's sound kind, the phase, and the learner's echoic memory (newest bin
+    first) after the step."""
+    env = still_face_v0.scripted_env(
+        ContingentCaregiver(**partner), per_agent=[{"vision": False, **MEMORY}, {}],
+        task_options={"caregiver_speech": True, "phases_s": phases})
+    obs, _ = env.reset(seed=seed)
+    inner = env.unwrapped
+    infant = StillFaceInfantController()
+    infant.reset(inner, "infant_0", np.random.default_rng(seed))
+    kinds, phases_, memory = [], [], []
+    while env.agents:
+        obs, r, te, tr, info = env.step({"infant_0": infant.act(inner, "infant_0", None)})
+        kinds.append(inner.sounds[1, 0])
+        phases_.append(info["infant_0"]["phase"])
+        memory.append(obs["infant_0"]["audition_memory"][:, 0].copy())
+    return np.array(kinds), np.array(phases_), np.array(memory), info["infant_0"]
+
+
+def runs_of(flags):
+    """Lengths of the runs of True in a bool sequence."""
+    edges = np.diff(np.concatenate([[0], flags.astype(int), [0]]))
+    return np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)
+
+
+def test_the_talking_caregiver_speaks_in_utterances_and_is_silent_in_the_still_face():
+    """``caregiver_speech``: the caregiver has a voice and the learner ears; the scripted
+    caregiver talks from the first step of the interaction and of the reunion, in utterances of
+    0.5-1.5 s with pauses of 0.3-1.2 s, and says nothing in the still face; the scripted infant
+    still succeeds."""
+    for seed in (0, 1):
+        kinds, phase, memory, last = speech_episode(seed)
+        assert last["is_success"]
+        assert set(np.unique(kinds)) == {0, SPEECH_KIND}
+        assert not kinds[phase == 1].any()
+        for p in (0, 2):
+            talk = kinds[phase == p] > 0
+            assert talk[0], (seed, p)                   # it talks at once
+            inner_runs = runs_of(talk)[:-1]              # the last may be cut by the phase
+            assert ((inner_runs >= 50) & (inner_runs <= 150)).all(), inner_runs
+            pauses = runs_of(~talk)[:-1]
+            assert ((pauses >= 30) & (pauses <= 120)).all(), pauses
+
+
+def test_the_learners_echoic_memory_tells_the_still_face_from_the_interaction():
+    """What the learner hears is enough to know the phase without looking: in the interaction
+    and the reunion the caregiver's voice is in the last 1.3 s of its memory at every step (the
+    longest pause is 1.2 s); from 1.3 s into the still face to its end, never."""
+    for seed in (2, 3):
+        kinds, phase, memory, _ = speech_episode(seed)
+        heard = (memory[:, :13] > 0).any(axis=1)
+        assert heard[phase != 1].all(), seed
+        still = np.flatnonzero(phase == 1)
+        assert not heard[still[0] + 130:still[-1] + 1].any(), seed
+        assert heard[still[0]], seed                 # the echo outlasts the voice
+
+
+def test_a_learner_caregiver_is_muted_in_the_still_face_and_heard_else():
+    """Two learners: the caregiver's action says speech at every step; the task mutes it in the
+    still phase (``env.mute``), not in the others."""
+    env = still_face_v0.parallel_env(task_options={"caregiver_speech": True, "phases_s": SHORT,
+                                                   "phase_jitter": 0.0}, vision=False)
+    env.reset(seed=0)
+    inner = env.unwrapped
+    assert "voice" in env.action_space("caregiver_0").spaces
+    assert "audition" in env.observation_space("infant_0").spaces
+    care = zero(env, "caregiver_0")
+    care.update(voice=SPEECH_KIND, loudness=np.array([0.5], np.float32))
+    heard = []
+    for step in range(100):
+        obs, *_ = env.step({"infant_0": zero(env), "caregiver_0": dict(care)})
+        heard.append(inner.sounds[1, 0])
+    heard = np.array(heard)
+    assert (heard[30:70] == 0).all() and (heard[:30] == SPEECH_KIND).all() \
+        and (heard[70:] == SPEECH_KIND).all()
+
+
+def test_without_speech_no_voice_no_ears_and_bad_speech_settings_raise():
+    env = still_face_v0.parallel_env()
+    assert "voice" not in env.action_space("caregiver_0").spaces
+    assert "audition" not in env.observation_space("infant_0").spaces
+    with pytest.raises(Exception, match="caregiver_speech"):
+        still_face_v0.parallel_env(task_options={"caregiver_speech": "yes"})
+    for kw in ({"speech_s": (1.0, 0.5)}, {"pause_s": (-1, 1)}, {"speech_s": 1.0},
+               {"speech_loudness": 2.0}):
+        with pytest.raises(Exception, match="ContingentCaregiver"):
+            ContingentCaregiver(**kw)
+
+
+def test_a_held_gaze_stays_on_the_face_and_the_scripted_infant_still_succeeds():
+    """``gaze_free=False``: the learner's head and eyes are no motors and are held on the
+    caregiver's face (``gaze_on_face`` at every step, a zero action included); with the arms
+    held too its action is its face alone; the scripted infant (no look-at law, no self-touch
+    without arm motors) succeeds, and asking it for a self-touch without arm motors is refused."""
+    env = still_face_v0.scripted_env(per_agent=[{"vision": False}, {}],
+                                     task_options={"gaze_free": False, "arms_free": False})
+    space = env.action_space("infant_0")
+    assert space["motors"].shape == (0,)
+    steps = run(env, zero, 0)
+    assert all(info["gaze_on_face"] for _, info in steps)
+    steps = run(env, StillFaceInfantController(), 1)
+    last = steps[-1][1]
+    assert last["is_success"] and all(info["gaze_on_face"] for _, info in steps)
+    assert not any(info["self_touch"] for _, info in steps)
+    held_arms = still_face_v0.scripted_env(per_agent=[{"vision": False}, {}],
+                                           task_options={"gaze_free": False})
+    assert held_arms.action_space("infant_0")["motors"].shape == (8,)
+    steps = run(held_arms, StillFaceInfantController(), 1)
+    assert steps[-1][1]["is_success"] and steps[-1][1]["self_touch_still"] > 0.5
+    with pytest.raises(ValueError, match="self_touch"):
+        run(env, StillFaceInfantController(self_touch=True), 0)

@@ -10,9 +10,12 @@ body:
     the learner sits (the infant seat of the paradigm), hip fixed in the world, every joint held
     except head and eyes (9 motors) and, with `arms_free` (on), both shoulders and elbows (8
     motors): it can look at or away from the caregiver and bring its hands to its own body
-    (self-directed behaviour); without `arms_free` no self-touch is possible. The caregiver holds
-    its posture (legs, trunk) and moves its head and eyes and its right arm (shoulder, elbow, wrist:
-    7 motors; its fingers held), as `ContingentCaregiver` needs (its gaze response and its pat).
+    (self-directed behaviour); without `arms_free` no self-touch is possible; without
+    `gaze_free` its head and eyes are no motors and are held aimed at the caregiver's face
+    (`gaze_on_face` at every step: the gaze measures are then 1; with both off its action is its
+    face alone). The caregiver holds its posture (legs, trunk) and moves its head and eyes and
+    its right arm (shoulder, elbow, wrist: 7 motors; its fingers held), as `ContingentCaregiver`
+    needs (its gaze response and its pat).
     Both have faces (expressions on). With `head_support` (on) the task cancels gravity on both
     agents' head and eye joints (neck tone: a zero action does not let the head drop)
 scene:
@@ -52,11 +55,13 @@ reset:
     does)
 action:
     learner: `Dict(motors=Box(-1, 1, (17,)), expression=Discrete(7))` (9 head and eye motors, then
-    the 8 arm motors; 9 without `arms_free`); caregiver (two learners): its 16 motors and expression
+    the 8 arm motors; 9 without `arms_free`, 8 without `gaze_free`, 0 without both); caregiver (two
+    learners): its 16 motors and expression (and `voice`, `loudness` with `caregiver_speech`)
 observation:
     `eye_left`, `eye_right` (64x64x3 RGB: the only way the caregiver's face and movements reach the
     learner), `proprioception` (102 floats: its own free joints); a scripted caregiver has no eyes;
-    never the phase, nor the caregiver's expression or mode
+    never the phase, nor the caregiver's expression or mode; with `caregiver_speech`, `audition`
+    (and `audition_memory` where set): the caregiver's voice
 measures:
     per learner step, from `learner_cues` (`partners/cues.py`, the same cues the contingent
     caregiver answers): `smiling` (its face is "happy": positive expression), `gaze_on_face` (its
@@ -119,12 +124,26 @@ infos:
     `self_touch_<phase>`, `is_success` (the learner's measures; the caregiver's infos are the same).
     The caregiver's `expression` info is its action's, also while the task shows its face neutral
 options:
-    `phases_s` ((5, 5, 5) s, each 0.05-600), `phase_jitter` (0.5, 0-0.9: see phases; 0: the fixed
-    phases before issue 30's fix), `distance` (0.6 m, 0.3-1.5: two sitting 18-month-olds' hip
-    distance), `arms_free` (True), `head_support` (True), `unshared_cost` (1.0, 0-10; 0: the reward
-    before the fix), `success_fraction` (0.8, 0.05-1; 0.5 before the fix), `success_match` (0.8,
-    0-1; 0: the success before the fix), `still_response_reward` (0, 0-10: see reward),
+    `phases_s` ((5, 5, 5) s, each 0.05-600), `phase_jitter` (0.5, 0-0.9: see phases; 0: the
+    fixed phases before issue 30's fix), `distance` (0.6 m, 0.3-1.5: two sitting 18-month-olds'
+    hip distance), `gaze_free` (True: see body), `arms_free` (True), `head_support` (True),
+    `unshared_cost` (1.0, 0-10; 0: the reward before the fix), `success_fraction` (0.8, 0.05-1;
+    0.5 before the fix), `success_match` (0.8, 0-1; 0: the success before the fix),
+    `still_response_reward` (0, 0-10: see reward), `caregiver_speech` (False: see speech),
     `reward_free` (False), `scripted_partner` (False)
+speech:
+    with `caregiver_speech` the caregiver has a voice (`voice=True`) and the learner ears
+    (`audition=True`; a learner caregiver too): the parent talks in the interaction and the
+    reunion and falls silent in the still face, as in the paradigm's protocol (Tronick et al. 1978;
+    Mesman et al. 2009). The scripted `ContingentCaregiver` talks whatever the learner does, from
+    the first step of each interactive phase: utterances ("speech") of 0.5-1.5 s with pauses of
+    0.3-1.2 s (its `speech_s`, `pause_s`, `speech_loudness`); the task mutes the caregiver in the
+    still face whoever drives it (`env.mute`). With an echoic memory (`per_agent=[{"audition":
+    {"memory_s": 2.0, "memory_bin_s": 0.1}}, {}]`) the learner's last 1.3 s hold the caregiver's
+    voice at every interactive step and none from 1.3 s into the still face (tested): a policy
+    without memory of its own can tell the phases apart, also while it looks away, which it cannot
+    with the silent caregiver (the still face's neutral face is the interaction's face between two
+    answered smiles). Off by default: v0's spaces and figures are those of the silent caregiver
 privileged cues:
     none: the caregiver's face, head and arm reach the learner only through its eyes; the phase and
     the caregiver's mode are never observed. The reward and the measures read both faces, the gaze
@@ -166,7 +185,8 @@ version history:
     still-face phases are drawn (`phase_jitter`), smiling that is not engaged costs
     (`unshared_cost`), success needs 0.8 of the interactive steps engaged (was 0.5) and 0.8 of the
     learner's smiling engaged (`success_match`); `phase_jitter=0`, `unshared_cost=0`,
-    `success_fraction=0.5`, `success_match=0` give the old task
+    `success_fraction=0.5`, `success_match=0` give the old task; v0, issue 30 (fifth session): the
+    `caregiver_speech` option (default off)
 
 ``parallel_env(task_options={...}, physics={...}, per_agent=[...], **agent_settings)`` returns a
 :class:`~mimo_social.core.env.MimoParallelEnv` with two learners (the infant ``infant_0`` and the

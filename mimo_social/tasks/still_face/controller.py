@@ -12,10 +12,14 @@ interaction and reunion:
     :class:`~mimo_social.partners.gaze.GazeAtTarget`'s PD law on its own head and eye motors (head
     turned fully toward the face, the eyes correcting); its arms held by a PD at the angles they had
     at reset
+held gaze:
+    with the task option ``gaze_free`` off the task holds its head and eyes on the caregiver's
+    face; it then only smiles, sobers and (with free arms) touches itself
 still face:
-    a neutral face (``still_face``), looks away at its own right hand, and with ``self_touch`` (on)
-    brings both hands to its chest, pressed together (self-comforting, Tronick et al. 1978): PD on
-    its shoulder and elbow motors toward angles found at reset by damped least squares (both palm
+    a neutral face (``still_face``), looks away at its own right hand, and with ``self_touch``
+    (None: where its arms have motors, the task's ``arms_free``; True needs them) brings both
+    hands to its chest, pressed together (self-comforting, Tronick et al. 1978): PD on its
+    shoulder and elbow motors toward angles found at reset by damped least squares (both palm
     centres to a point 1.2 chest radii in front of the upper body's centre, i.e. inside the chest,
     so the hands press on it and on each other)
 arm PD:
@@ -37,8 +41,8 @@ import numpy as np
 from ...core.kinematics import reach_sites
 from ...expressions.faces import EXPRESSIONS
 from ...util.checks import ConfigError, check_bool, check_number, show
-from ...partners.base import agent_index, pd_gains
-from ...partners.gaze import GazeAtTarget
+from ...partners.base import agent_index, motor_action, pd_gains
+from ...partners.gaze import NEEDED as GAZE_MOTORS, GazeAtTarget
 from .task import StillFace
 
 __all__ = ["StillFaceInfantController"]
@@ -65,7 +69,7 @@ class StillFaceInfantController(GazeAtTarget):
     frequency (Hz)."""
 
     def __init__(self, caregiver: str | None = None, engaged_face: str = "happy",
-                 still_face: str = "neutral", self_touch: bool = True,
+                 still_face: str = "neutral", self_touch: bool | None = None,
                  bid_every_s: float = 1.0, omega: float = 15.0,
                  zeta: float = 1.0, arm_frequency: float = 3.0):
         super().__init__(targets=None, hold_s=(1.0, 1.0), omega=omega, zeta=zeta,
@@ -77,7 +81,8 @@ class StillFaceInfantController(GazeAtTarget):
         self.caregiver = caregiver
         self.engaged_face = _face(who, "engaged_face", engaged_face)
         self.still_face = _face(who, "still_face", still_face)
-        self.self_touch = check_bool(who, "self_touch", self_touch)
+        self.self_touch = None if self_touch is None else check_bool(who, "self_touch",
+                                                                     self_touch)
         self.arm_frequency = check_number(who, "arm_frequency", arm_frequency, 0.1, 20.0)
         self.bid_every_s = check_number(who, "bid_every_s", bid_every_s, 0.0, 60.0)
 
@@ -105,16 +110,20 @@ class StillFaceInfantController(GazeAtTarget):
             raise ValueError(f"{who}: caregiver={self.caregiver!r}; allowed: "
                              f"{[a for a in agents if a != agent]}")
         # targets: the caregiver's face (0) and the infant's own right hand (1)
-        self.targets = (f"{agents[j]}/head_centre", f"{agent}/right_hand")
-        super().reset(env, agent, rng)
-        self.targets = None
         w = env.world
-        m, d = w.model, w.data
         a = w.agents[i]
         motor_of = {n: k for k, n in enumerate(a.actuated_names)}
+        # a held gaze (task option gaze_free off): the task aims it at the face; no look-at law
+        self._looks = set(GAZE_MOTORS) <= set(motor_of)
+        if self._looks:
+            self.targets = (f"{agents[j]}/head_centre", f"{agent}/right_hand")
+            super().reset(env, agent, rng)
+            self.targets = None
+        m, d = w.model, w.data
         arm = ARM + tuple(n.replace("right", "left") for n in ARM)
         missing = [n for n in arm if n not in motor_of]
-        if self.self_touch and missing:
+        self._touches = not missing if self.self_touch is None else self.self_touch
+        if self._touches and missing:
             raise ValueError(f"{who}: {agent} does not actuate {missing}; the self-touch "
                              "moves its arms (task option arms_free=True), or self_touch=False")
         arm = tuple(n for n in arm if n in motor_of)
@@ -129,7 +138,7 @@ class StillFaceInfantController(GazeAtTarget):
         self._arm_touch = self._arm_rest.copy()
         self._bid = max(1, int(round(self.bid_every_s / env.dt))) if self.bid_every_s else 0
         self._engaged = 0               # interactive steps so far (the bid clock)
-        if self.self_touch and len(k):
+        if self._touches and len(k):
             self._arm_touch = self._hands_to_chest(w, i, a)
 
     def _hands_to_chest(self, w, i, a) -> np.ndarray:
@@ -156,9 +165,11 @@ class StillFaceInfantController(GazeAtTarget):
         still = env.task.phase_at(env.steps) == 1
         self.target = 1 if still else 0
         self._left = 1 << 30            # never switch on its own: the phase decides
-        action = super().act(env, agent, observation)
+        action = super().act(env, agent, observation) if self._looks else \
+            motor_action(env.action_space(agent), np.zeros(len(env.world.agents[
+                agent_index(env, agent)].actuated_names), np.float32))
         d = env.world.data
-        goal = self._arm_touch if still and self.self_touch else self._arm_rest
+        goal = self._arm_touch if still and self._touches else self._arm_rest
         tau = (self._kp * (goal - d.qpos[self._arm_qpos]) - self._kd * d.qvel[self._arm_dof]
                + d.qfrc_bias[self._arm_dof] - d.qfrc_spring[self._arm_dof])
         u = np.clip(tau / np.where(tau >= 0, self._arm_tp, self._arm_tn), -1.0, 1.0)

@@ -50,22 +50,26 @@ SELF_PARTS = ("head", "upper_body", "lower_body")
 class StillFaceOptions(TaskOptions):
     """The phases' lengths (s: interaction, still face, reunion) and the spread of the first two
     (``phase_jitter``: each drawn at reset within +- that share), the standard pair's distance
-    (m), whether the learner's arms are free, head support, the cost of a smiling step that is
+    (m), whether the learner's head and eyes are free (else held on the caregiver's face) and
+    whether its arms are, head support, the cost of a smiling step that is
     not engaged, the share of interactive steps that must be engaged and the share of the
     learner's smiling steps that must be engaged for success, the reward of a still-phase step
-    with the classic response, reward-free mode and whether the caregiver (``caregiver_0``) is
-    scripted (no eyes, no reward)."""
+    with the classic response, whether the caregiver talks (``caregiver_speech``: it has a
+    voice, the learner ears; silent in the still face), reward-free mode and whether the
+    caregiver (``caregiver_0``) is scripted (no eyes, no reward)."""
 
     task = "still_face"
     phases_s: tuple = (5.0, 5.0, 5.0)
     phase_jitter: float = 0.5
     distance: float = DISTANCE
+    gaze_free: bool = True
     arms_free: bool = True
     head_support: bool = True
     unshared_cost: float = 1.0
     success_fraction: float = 0.8
     success_match: float = 0.8
     still_response_reward: float = 0.0
+    caregiver_speech: bool = False
     reward_free: bool = False
     scripted_partner: bool = False
 
@@ -74,12 +78,14 @@ class StillFaceOptions(TaskOptions):
                       allowed="(interaction, still, reunion) seconds, each 0.05 to 600")
         self._number("phase_jitter", 0.0, 0.9)
         self._number("distance", 0.3, 1.5)
+        self._bool("gaze_free")
         self._bool("arms_free")
         self._bool("head_support")
         self._number("unshared_cost", 0.0, 10.0)
         self._number("success_fraction", 0.05, 1.0)
         self._number("success_match", 0.0, 1.0)
         self._number("still_response_reward", 0.0, 10.0)
+        self._bool("caregiver_speech")
         self._bool("reward_free")
         self._bool("scripted_partner")
         if self.still_response_reward > 0 and not self.arms_free:
@@ -134,17 +140,20 @@ class StillFace(Task):
         self._bounds = None
 
     def agent_defaults(self, i, settings):
+        speech = self.options.caregiver_speech
         if i == 0:
             return {"posture": "sitting", "expressions": True, "vestibular": False,
-                    "vision": {"width": EYE_SIZE, "height": EYE_SIZE}}
+                    "vision": {"width": EYE_SIZE, "height": EYE_SIZE}, "audition": speech}
         scripted = self.options.scripted_partner
         return {"body": "adult", "posture": "kneeling", "expressions": True,
-                "vestibular": False,
+                "vestibular": False, "voice": speech,
+                "audition": speech and not scripted,
                 "vision": False if scripted else {"width": EYE_SIZE, "height": EYE_SIZE}}
 
     def _free(self, i, config) -> tuple[str, ...]:
         if i == 0:
-            return GAZE_JOINTS + (LEARNER_ARM_JOINTS if self.options.arms_free else ())
+            return (GAZE_JOINTS if self.options.gaze_free else ()) + \
+                (LEARNER_ARM_JOINTS if self.options.arms_free else ())
         return GAZE_JOINTS + CAREGIVER_ARM_JOINTS
 
     def held_joints(self, i, config):
@@ -153,11 +162,15 @@ class StillFace(Task):
         return held_posture(tables_of(config), keep=self._free(i, config), angles=angles)
 
     def setup(self, i, config):
-        plan = task_plan(self, "sitting", self.options.distance, self.held_joints, ())
+        # a held gaze (gaze_free off): the learner's head and eyes aimed at the caregiver's face
+        look = () if self.options.gaze_free else (0,)
+        plan = task_plan(self, "sitting", self.options.distance, self.held_joints, look)
         pos, facing = face_to_face(i, plan.distance)
         free = self._free(i, config)
+        aimed = {k: v for k, v in plan.gaze[i].items() if k not in free}
         return AgentSetup(config, position=config.position or pos, facing=config.facing or facing,
-                          frozen=self.held_joints(i, config), base="fixed", actuated=free)
+                          frozen={**self.held_joints(i, config), **aimed}, base="fixed",
+                          actuated=free)
 
     # -- phases ---------------------------------------------------------------------------------
     def phase_steps(self, dt: float) -> tuple[int, int, int]:
@@ -246,6 +259,7 @@ class StillFace(Task):
         if self._held_q is None:
             self._held_q = d.qpos[self._care_qpos].copy()
         w.set_expression(1, NEUTRAL)
+        env.mute(1)                           # silent as well as still
         d.qpos[self._care_qpos] = self._held_q
         d.qvel[self._care_dof] = 0.0
         mujoco.mj_forward(m, d)               # gravity and contacts of the held state
