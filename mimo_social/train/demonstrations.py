@@ -53,6 +53,13 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
   from 97 % to 67 % (0.06: 57 %); at 6 Hz 97 % to 83 % (0.06: 80 %). Checked by making the
   controller once (its own error, named).
 
+* ``noise`` (default 0: none): the demonstrations are played with the executed action
+  perturbed and the controller's own action recorded (DART, Laskey et al. 2017): a Box action
+  plus Gaussian noise of that sd (clipped to the space), a ``Discrete`` one replaced by a
+  uniformly drawn choice with that probability (each episode's noise drawn from a generator
+  spawned from its seed). The clone then sees the states just off the controller's path and
+  the way back from them, where a clone of clean episodes has no data (its errors compound).
+
 ``RecurrentPPO`` is refused (its policy needs the LSTM states over whole sequences).
 ``config.json["bc"]`` records the episodes, their seeds, the demonstrations' success rate and
 mean return, the samples, the settings, the loss before and after cloning and the time taken;
@@ -89,7 +96,7 @@ __all__ = ["BC_DEFAULTS", "BC_ALGOS", "DEMO_SEED", "Demonstrations", "Demonstrat
 #: the settings of ``bc_kwargs`` and their defaults (``epochs``: ``bc_epochs``)
 BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None,
                "critic_epochs": 0, "keep_updates": 0, "keep_until": 0.5, "dagger_rounds": 0,
-               "dagger_episodes": 50, "controller": None}
+               "dagger_episodes": 50, "controller": None, "noise": 0.0}
 BC_LOSSES = ("mse", "nll")
 BC_ALGOS = ("ppo", "sac")
 #: the demonstrations' first seed is this plus the run's seed (training: seed + i; the
@@ -150,6 +157,12 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
         raise TrainInputError(f"bc_kwargs: critic_epochs={ce!r}; allowed: an integer >= 0 "
                               "(> 0 with ppo only: epochs fitting its value function to the "
                               "demonstrations' returns)")
+    nz = s["noise"]
+    if isinstance(nz, bool) or not isinstance(nz, (int, float)) or not 0 <= nz <= 1:
+        raise TrainInputError(f"bc_kwargs: noise={nz!r}; allowed: a number in [0, 1] (the sd "
+                              "of the Gaussian noise on a Box action, the chance of a random "
+                              "choice of a Discrete one, while the demonstrations play; 0: none)")
+    s["noise"] = float(nz)
     for key in ("dagger_rounds", "dagger_episodes"):
         v = s[key]
         if isinstance(v, bool) or not isinstance(v, int) or v < (key == "dagger_episodes"):
@@ -223,8 +236,10 @@ class Demonstrator:
     it acts on the core env under ``env`` (looked up at every reset: a curriculum's env may
     change it) and returns its action in the learner's form, recording each pair."""
 
-    def __init__(self, controller_cls, env):
+    def __init__(self, controller_cls, env, noise: float = 0.0):
         self.controller, self.env = controller_cls(), env
+        self.noise = float(noise)
+        self.rng = None
         raw = env.unwrapped.action_space       # the agent's own action space
         self.decoder = ActionDecoder(raw)
         self.space = env.action_space          # the learner's
@@ -239,15 +254,25 @@ class Demonstrator:
 
     def reset(self, env, agent: str, rng) -> None:
         self.core = self.env.unwrapped.parallel.unwrapped
+        if self.noise:      # its own stream: the controller's draws stay as without noise
+            self.rng = rng.spawn(1)[0]
         self.controller.reset(self.core, agent, rng)
 
     def act(self, env, agent: str, obs):
         flat = self.decoder.encode(self.controller.act(self.core, agent, obs))
-        if isinstance(self.space, spaces.Box):
+        box = isinstance(self.space, spaces.Box)
+        if box:
             flat = np.clip(np.asarray(flat, np.float32), self.space.low, self.space.high)
         self.obs.append({k: np.array(v) for k, v in obs.items()} if isinstance(obs, dict)
                         else np.array(obs))
         self.actions.append(flat)
+        if not self.noise:
+            return flat
+        if box:             # DART: the executed action perturbed, the recorded one clean
+            return np.clip(flat + self.rng.normal(0.0, self.noise, flat.shape).astype(
+                np.float32), self.space.low, self.space.high)
+        if self.rng.random() < self.noise:
+            return np.int64(self.space.start + int(self.rng.integers(self.space.n)))
         return flat
 
 
@@ -273,14 +298,16 @@ def play(recorder: Demonstrator, env, first: int, episodes: int) -> Demonstratio
 
 
 def record_demonstrations(task: str, env, episodes: int, seed: int,
-                          controller: Mapping[str, Any] | None = None) -> Demonstrations:
+                          controller: Mapping[str, Any] | None = None,
+                          noise: float = 0.0) -> Demonstrations:
     """``episodes`` episodes of the task's controller (made with the keyword arguments
     ``controller``, if given) on the learner's env ``env`` (seeds ``seed, seed+1, ...``; the
-    controller reset with each episode's seed)."""
+    controller reset with each episode's seed), the executed actions perturbed by ``noise``
+    (``bc_kwargs``, DART) and the controller's own recorded."""
     if entry(task).controller is None:
         raise TrainInputError(f"{task} has no scripted controller")
-    return play(Demonstrator(demonstrator(task, {"controller": controller}), env), env, seed,
-                episodes)
+    return play(Demonstrator(demonstrator(task, {"controller": controller}), env, noise), env,
+                seed, episodes)
 
 
 def returns_to_go(rewards: np.ndarray, ends: np.ndarray, gamma: float) -> np.ndarray:
@@ -465,7 +492,7 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
     config.json records under ``bc``, and the demonstrations."""
     t0 = time.perf_counter()
     demos = record_demonstrations(task, env, int(settings["episodes"]), DEMO_SEED + int(seed),
-                                  settings.get("controller"))
+                                  settings.get("controller"), settings.get("noise", 0.0))
     t1 = time.perf_counter()
     res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
                 float(settings["lr"]), str(settings["loss"]), int(seed), settings["log_std"])
@@ -474,6 +501,7 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
                               int(settings["batch_size"]), float(settings["lr"]), int(seed)))
     return {**demos.summary(), "controller": entry(task).controller.__name__,
             "controller_kwargs": settings.get("controller") or {},
+            "noise": float(settings.get("noise", 0.0)),
             "epochs": int(settings["epochs"]), "batch_size": int(settings["batch_size"]),
             "lr": float(settings["lr"]), "log_std": settings["log_std"],
             "keep_updates": int(settings["keep_updates"]),

@@ -152,6 +152,8 @@ def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_pa
     ({"bc_episodes": 2, "bc_kwargs": {"controller": [6.0]}},
      ["controller=[6.0]", "ReachController's keyword arguments"]),
     ({"bc_episodes": 2, "task": "high_five"}, ["--mode shared", "one learner"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"noise": 1.5}}, ["noise=1.5", "[0, 1]"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"noise": "some"}}, ["noise='some'", "[0, 1]"]),
 ])
 def test_bad_arguments_are_refused_before_anything_is_written(tmp_path, kwargs, words):
     kwargs = dict(kwargs)
@@ -296,3 +298,68 @@ def test_dagger_labels_the_cloned_policy_s_states_with_the_controller_s_actions(
         assert not np.allclose(played, joined.actions[new], atol=1e-3)
     finally:
         env.close()
+
+
+def test_noisy_demonstrations_record_the_controller_s_own_actions_off_its_path():
+    """bc_kwargs noise (DART): the executed actions are perturbed, so the states leave the clean
+    episode's path, and each recorded action is the controller's own for the state it was in
+    (a controller that acts on its state: the reach's PD); the same seed gives the same noisy
+    episode; noise 0 is the clean one."""
+    env = make_env("reach", flat=True, max_steps=40)
+    try:
+        clean = record_demonstrations("reach", env, 1, 20_000)
+        noisy = record_demonstrations("reach", env, 1, 20_000, noise=0.3)
+        again = record_demonstrations("reach", env, 1, 20_000, noise=0.3)
+        zero = record_demonstrations("reach", env, 1, 20_000, noise=0.0)
+    finally:
+        env.close()
+    assert np.array_equal(clean.obs[0], noisy.obs[0])           # the same start
+    assert np.abs(clean.obs[1:] - noisy.obs[1:]).max() > 1e-3   # then off the path
+    assert np.array_equal(noisy.obs, again.obs) and np.array_equal(noisy.actions, again.actions)
+    assert np.array_equal(clean.actions, zero.actions)
+    assert np.abs(noisy.actions).max() <= 1.0
+    # the recorded actions are not the executed (noisy) ones: they are the controller's, which
+    # differ from the clean episode's only because the states do
+    assert not np.allclose(clean.actions[5:], noisy.actions[5:])
+    # the executed actions are the recorded ones plus the noise (sd 0.3, clipped to the Box)
+    from mimo_social.train.demonstrations import Demonstrator, demonstrator, play
+
+    class Executed(Demonstrator):
+        def act(self, env, agent, obs):
+            out = super().act(env, agent, obs)
+            self.executed.append(out)
+            return out
+
+    env = make_env("reach", flat=True, max_steps=40)
+    try:
+        rec = Executed(demonstrator("reach"), env, noise=0.3)
+        rec.executed = []
+        demos = play(rec, env, 20_000, 1)
+    finally:
+        env.close()
+    assert np.array_equal(demos.actions, noisy.actions)
+    gap = np.stack(rec.executed) - demos.actions
+    assert 0.2 < gap.std() < 0.35 and abs(gap.mean()) < 0.05, (gap.std(), gap.mean())
+
+
+def test_noisy_demonstrations_of_a_discrete_choice_replace_it_at_random():
+    """noise on a ``Discrete`` action (mirror's face): that share of the executed choices is
+    drawn at random, the recorded ones are the controller's."""
+    from mimo_social.train.demonstrations import Demonstrator, demonstrator, play
+
+    class Executed(Demonstrator):
+        def act(self, env, agent, obs):
+            out = super().act(env, agent, obs)
+            self.executed.append(int(out))
+            return out
+
+    env = make_env("mirror", flat=True, max_steps=200)
+    try:
+        rec = Executed(demonstrator("mirror"), env, noise=0.5)
+        rec.executed = []
+        demos = play(rec, env, 20_000, 1)
+    finally:
+        env.close()
+    changed = np.mean(np.array(rec.executed) != demos.actions)
+    n = env.action_space.n
+    assert 0.5 * (1 - 1 / n) - 0.12 < changed < 0.5 * (1 - 1 / n) + 0.12, changed
