@@ -300,6 +300,25 @@ def test_dagger_labels_the_cloned_policy_s_states_with_the_controller_s_actions(
         env.close()
 
 
+def played_with_noise(task: str, max_steps: int, noise: float):
+    """One demonstration episode (seed 20000) with ``noise``: the recorded pairs, and the
+    actions the demonstrator executed."""
+    from mimo_social.train.demonstrations import Demonstrator, demonstrator, play
+    executed = []
+
+    class Executed(Demonstrator):
+        def act(self, env, agent, obs):
+            out = super().act(env, agent, obs)
+            executed.append(out)
+            return out
+
+    env = make_env(task, flat=True, max_steps=max_steps)
+    try:
+        return play(Executed(demonstrator(task), env, noise=noise), env, 20_000, 1), executed
+    finally:
+        env.close()
+
+
 def test_noisy_demonstrations_record_the_controller_s_own_actions_off_its_path():
     """bc_kwargs noise (DART): the executed actions are perturbed, so the states leave the clean
     episode's path, and each recorded action is the controller's own for the state it was in
@@ -322,44 +341,16 @@ def test_noisy_demonstrations_record_the_controller_s_own_actions_off_its_path()
     # differ from the clean episode's only because the states do
     assert not np.allclose(clean.actions[5:], noisy.actions[5:])
     # the executed actions are the recorded ones plus the noise (sd 0.3, clipped to the Box)
-    from mimo_social.train.demonstrations import Demonstrator, demonstrator, play
-
-    class Executed(Demonstrator):
-        def act(self, env, agent, obs):
-            out = super().act(env, agent, obs)
-            self.executed.append(out)
-            return out
-
-    env = make_env("reach", flat=True, max_steps=40)
-    try:
-        rec = Executed(demonstrator("reach"), env, noise=0.3)
-        rec.executed = []
-        demos = play(rec, env, 20_000, 1)
-    finally:
-        env.close()
+    demos, executed = played_with_noise("reach", 40, 0.3)
     assert np.array_equal(demos.actions, noisy.actions)
-    gap = np.stack(rec.executed) - demos.actions
+    gap = np.stack(executed) - demos.actions
     assert 0.2 < gap.std() < 0.35 and abs(gap.mean()) < 0.05, (gap.std(), gap.mean())
 
 
 def test_noisy_demonstrations_of_a_discrete_choice_replace_it_at_random():
     """noise on a ``Discrete`` action (mirror's face): that share of the executed choices is
     drawn at random, the recorded ones are the controller's."""
-    from mimo_social.train.demonstrations import Demonstrator, demonstrator, play
-
-    class Executed(Demonstrator):
-        def act(self, env, agent, obs):
-            out = super().act(env, agent, obs)
-            self.executed.append(int(out))
-            return out
-
-    env = make_env("mirror", flat=True, max_steps=200)
-    try:
-        rec = Executed(demonstrator("mirror"), env, noise=0.5)
-        rec.executed = []
-        demos = play(rec, env, 20_000, 1)
-    finally:
-        env.close()
-    changed = np.mean(np.array(rec.executed) != demos.actions)
-    n = env.action_space.n
+    demos, executed = played_with_noise("mirror", 200, 0.5)
+    changed = np.mean(np.array(executed, int) != demos.actions)
+    n = make_env("mirror", flat=True, max_steps=10).action_space.n
     assert 0.5 * (1 - 1 / n) - 0.12 < changed < 0.5 * (1 - 1 / n) + 0.12, changed
