@@ -459,3 +459,31 @@ def test_a_held_gaze_stays_on_the_face_and_the_scripted_infant_still_succeeds():
     assert steps[-1][1]["is_success"] and steps[-1][1]["self_touch_still"] > 0.5
     with pytest.raises(ValueError, match="self_touch"):
         run(env, StillFaceInfantController(self_touch=True), 0)
+
+
+def test_the_talk_is_seeded_and_a_pickled_copy_goes_on_talking_alike():
+    """The caregiver's talk comes from the env's seed (the same seed, the same talk; another,
+    another) and a pickled copy mid-episode goes on with the same talk and the same echoes."""
+    import pickle
+
+    def made(seed):
+        env = still_face_v0.scripted_env(per_agent=[{"vision": False, **MEMORY}, {}],
+                                         task_options={"caregiver_speech": True})
+        env.reset(seed=seed)
+        return env
+
+    act = {"infant_0": {"motors": np.zeros(17, np.float32), "expression": HAPPY}}
+
+    def talk(env, steps=300):
+        out = []
+        for _ in range(steps):
+            obs, *_ = env.step(act)
+            out.append((env.unwrapped.sounds[1, 0], obs["infant_0"]["audition_memory"].copy()))
+        return out
+
+    a, b, c = made(5), made(5), made(6)
+    ta, tb, tc = talk(a, 150), talk(b, 150), talk(c, 150)
+    assert [k for k, _ in ta] == [k for k, _ in tb] != [k for k, _ in tc]
+    copy = pickle.loads(pickle.dumps(a))
+    for (k1, m1), (k2, m2) in zip(talk(a), talk(copy)):
+        assert k1 == k2 and np.array_equal(m1, m2)
