@@ -94,9 +94,9 @@ from gymnasium import spaces
 from ..body.joint_groups import GAZE_JOINTS, RIGHT_SHOULDER_ELBOW
 from ..core.kinematics import LookAt, reach_sites
 from ..expressions.faces import EXPRESSIONS
+from ..expressions.voice import SOUNDS
 from ..util.checks import ConfigError, check_bool, check_choice, check_number, show
 from .base import Partner, agent_index
-from ..expressions.voice import SOUNDS
 from .cues import HAPPY, NEUTRAL, Cues, learner_cues, touching_hands
 
 __all__ = ["ContingentCaregiver", "CUES", "MODES", "FACES", "look_at_point"]
@@ -292,7 +292,7 @@ class ContingentCaregiver(Partner):
         self._pending: list[tuple[int, str, object, int]] = []
         self._active: dict[str, tuple[int, int, object]] = {}
         self.events, self.responses = [], []
-        self._motors, self._faces, self._voices = [], [], []
+        self._motors, self._faces = [], []
         self._talk = 0              # steps left of the utterance (> 0) or of the pause (< 0)
         self._period_steps = 0
         self._period_counts = dict.fromkeys(self.cues, 0)
@@ -389,17 +389,15 @@ class ContingentCaregiver(Partner):
         self._step += 1
         self._motors.append(u)
         self._faces.append(face if self._dict else -1)
-        if self._voice:
-            kind = self._speech()
-            self._voices.append(kind)
-            out = {"motors": u.copy(), "voice": np.int64(kind),
-                   "loudness": np.array([self.speech_loudness], np.float32)}
-            if self._dict:
-                out["expression"] = np.int64(face)
-            return out
+        if not (self._dict or self._voice):
+            return u.copy()
+        out = {"motors": u.copy()}
         if self._dict:
-            return {"motors": u.copy(), "expression": np.int64(face)}
-        return u.copy()
+            out["expression"] = np.int64(face)
+        if self._voice:
+            out["voice"] = np.int64(self._speech())
+            out["loudness"] = np.array([self.speech_loudness], np.float32)
+        return out
 
     def _speech(self) -> int:
         """This step's sound kind (see the module docstring: utterances and pauses drawn from

@@ -115,6 +115,7 @@ class StillFaceInfantController(GazeAtTarget):
         motor_of = {n: k for k, n in enumerate(a.actuated_names)}
         # a held gaze (task option gaze_free off): the task aims it at the face; no look-at law
         self._looks = set(GAZE_MOTORS) <= set(motor_of)
+        self._n_motors = len(motor_of)
         if self._looks:
             self.targets = (f"{agents[j]}/head_centre", f"{agent}/right_hand")
             super().reset(env, agent, rng)
@@ -166,8 +167,7 @@ class StillFaceInfantController(GazeAtTarget):
         self.target = 1 if still else 0
         self._left = 1 << 30            # never switch on its own: the phase decides
         action = super().act(env, agent, observation) if self._looks else \
-            motor_action(env.action_space(agent), np.zeros(len(env.world.agents[
-                agent_index(env, agent)].actuated_names), np.float32))
+            motor_action(env.action_space(agent), np.zeros(self._n_motors, np.float32))
         d = env.world.data
         goal = self._arm_touch if still and self._touches else self._arm_rest
         tau = (self._kp * (goal - d.qpos[self._arm_qpos]) - self._kd * d.qvel[self._arm_dof]
