@@ -150,6 +150,8 @@ def _sb3_train_kwargs(args) -> dict:
         kw["frame_stack"] = args.frame_stack
     if getattr(args, "normalize_reward", False):
         kw["normalize_reward"] = True
+    if getattr(args, "obs_min_std", None) is not None:
+        kw["obs_min_std"] = args.obs_min_std
     for key in ("curriculum", "bc_episodes", "bc_epochs", "bc_kwargs", "growth"):
         if getattr(args, key, None) is not None:
             kw[key] = getattr(args, key)
@@ -406,6 +408,10 @@ def add_parser(subparsers) -> None:
                    "CNN (docs/training_vision.md)")
     p.add_argument("--frame-stack", type=positive_int, default=None, help="frames of each eye "
                    "image the CNN sees at once (default 1): memory of the last k steps")
+    p.add_argument("--obs-min-std", type=float, default=None, metavar="S", help="with "
+                   "--normalize-obs: the running normaliser's scale is at least S (default 0: "
+                   "none), so that inputs which only jitter (held joints) are not scaled up to "
+                   "the size of the ones that move (docs/training.md)")
     p.add_argument("--normalize-reward", action="store_true", help="scale the rewards the "
                    "learner sees by a running estimate of the return's spread (SB3's "
                    "VecNormalize, saved as vecnormalize.pkl next to each model; evaluations "

@@ -64,14 +64,15 @@ class EyesExtractor(BaseFeaturesExtractor):
     ``share_weights``: one encoder for all images of the same shape (the two eyes);
     ``normalize_vector``: the non-image keys go through :class:`~.obs_norm.RunningNorm` first
     (running mean and variance, saved with the policy: ``--normalize-obs`` for a learner with
-    eyes; the pixels are only scaled to [0, 1]).
+    eyes; the pixels are only scaled to [0, 1]); ``norm_min_std``: that normaliser's floor on
+    its scale (``--obs-min-std``; 0: none).
     Images must be channel-first, as :class:`~mimo_social.core.wrappers.DictObservationWrapper`
     gives them (SB3's ``VecTransposeImage`` also makes channel-last images channel-first).
     """
 
     def __init__(self, observation_space: spaces.Dict, image_dim: int = 128,
                  vector_dim: int | None = None, share_weights: bool = True,
-                 normalize_vector: bool = False):
+                 normalize_vector: bool = False, norm_min_std: float = 0.0):
         keys = image_space_keys(observation_space)
         if not keys:
             raise TypeError(f"EyesExtractor needs a Dict observation with an image (a uint8 "
@@ -97,7 +98,8 @@ class EyesExtractor(BaseFeaturesExtractor):
         # a ModuleDict registers a shared encoder once (parameters are deduplicated)
         self.encoders = nn.ModuleDict(encoders)
         self.vector = vector
-        self.norm = (RunningNorm(spaces.Box(-np.inf, np.inf, (n_other,), np.float32))
+        self.norm = (RunningNorm(spaces.Box(-np.inf, np.inf, (n_other,), np.float32),
+                                 min_std=float(norm_min_std))
                      if normalize_vector and n_other > 0 else None)
         self.transpose = {k: _is_channels_last(observation_space[k].shape) for k in keys}
 
@@ -150,24 +152,30 @@ RECURRENT_POLICIES = {"MlpPolicy": "MlpLstmPolicy", "MultiInputPolicy": "MultiIn
 
 
 def policy_for(observation_space: spaces.Space, algo_kwargs: dict,
-               normalize_obs: bool = False, recurrent: bool = False) -> tuple[str, dict]:
+               normalize_obs: bool = False, recurrent: bool = False,
+               min_std: float = 0.0) -> tuple[str, dict]:
     """What the trainers build: the SB3 policy name and the algorithm's keyword arguments for
     an observation space. Images: :func:`policy_spec`'s ``MultiInputPolicy`` with the CNN
     (``normalize_obs``: running statistics over the ``"vector"`` part); otherwise
     ``MlpPolicy`` (``normalize_obs``: :class:`~mimo_social.train.obs_norm.RunningNorm` over the
-    whole input). ``recurrent`` (``--algo recurrent_ppo``): the LSTM policies of sb3-contrib,
-    ``MultiInputLstmPolicy`` (the same CNN in front of the LSTM) and ``MlpLstmPolicy``. The
-    ``policy_kwargs`` of ``algo_kwargs`` (the shipped hyperparameters and the command line's)
+    whole input); ``min_std`` (> 0, with ``normalize_obs``): the normaliser's floor on its
+    scale (``--obs-min-std``). ``recurrent`` (``--algo recurrent_ppo``): the LSTM policies of
+    sb3-contrib, ``MultiInputLstmPolicy`` (the same CNN in front of the LSTM) and
+    ``MlpLstmPolicy``. The ``policy_kwargs`` of ``algo_kwargs`` (the shipped hyperparameters and the command line's)
     are merged over these."""
     kwargs = dict(algo_kwargs)
     own = dict(kwargs.pop("policy_kwargs", None) or {})
     if image_space_keys(observation_space):
+        floor = {"norm_min_std": float(min_std)} if normalize_obs and min_std else {}
         policy, base = policy_spec(observation_space,
-                                   **({"normalize_vector": True} if normalize_obs else {}))
+                                   **({"normalize_vector": True, **floor} if normalize_obs
+                                      else {}))
     else:
         policy, base = policy_spec(observation_space)
         if normalize_obs:
             base = {"features_extractor_class": RunningNorm}
+            if min_std:
+                base["features_extractor_kwargs"] = {"min_std": float(min_std)}
     merged = {**base, **own}
     if merged:
         kwargs["policy_kwargs"] = merged

@@ -15,7 +15,9 @@ training paths. SB3's :class:`~mimo_social.train.encoders.EyesExtractor` (and
     one ``Linear + ReLU`` to ``out_dim`` features. No pooling: where the partner's face is in
     the image is what joint attention needs.
 ``RunningMeanStd(n)``
-    Inputs shifted and scaled by a running mean and variance (clipped to +-10). The statistics
+    Inputs shifted and scaled by a running mean and variance (clipped to +-10); ``min_std`` (0:
+    none) floors the scale, so an input that barely varies (a held joint's jitter of 1e-5 rad)
+    is not blown up to the size of one that matters. The statistics
     are torch buffers (``mean``, ``var``, ``count``: saved with the model) and change only
     through :meth:`RunningMeanStd.update` (a batch of at least 2; Chan et al.'s parallel
     formula), so the caller decides which passes learn them.
@@ -82,13 +84,14 @@ class ImageCNN(nn.Module):
 class RunningMeanStd(nn.Module):
     """Inputs shifted and scaled by a running mean and variance (module docstring).
 
-    Keyword arguments other than ``clip`` and ``eps`` go on to the next class's ``__init__``
-    (cooperative: SB3's :class:`~mimo_social.train.obs_norm.RunningNorm` is this and an SB3
-    features extractor)."""
+    Keyword arguments other than ``clip``, ``eps`` and ``min_std`` go on to the next class's
+    ``__init__`` (cooperative: SB3's :class:`~mimo_social.train.obs_norm.RunningNorm` is this
+    and an SB3 features extractor)."""
 
-    def __init__(self, n: int, clip: float = 10.0, eps: float = 1e-8, **kwargs: Any):
+    def __init__(self, n: int, clip: float = 10.0, eps: float = 1e-8, min_std: float = 0.0,
+                 **kwargs: Any):
         super().__init__(**kwargs)
-        self.clip, self.eps = float(clip), float(eps)
+        self.clip, self.eps, self.min_std = float(clip), float(eps), float(min_std)
         self.register_buffer("mean", torch.zeros(n))
         self.register_buffer("var", torch.ones(n))
         self.register_buffer("count", torch.tensor(1e-4, dtype=torch.float64))
@@ -110,8 +113,10 @@ class RunningMeanStd(nn.Module):
         self.count.copy_(total)
 
     def normalize(self, x: torch.Tensor) -> torch.Tensor:
-        """``x`` shifted and scaled by the running statistics, clipped to +-``clip``."""
-        return ((x - self.mean) / torch.sqrt(self.var + self.eps)).clamp(-self.clip, self.clip)
+        """``x`` shifted and scaled by the running statistics (the scale at least
+        ``min_std``), clipped to +-``clip``."""
+        scale = torch.sqrt(self.var + self.eps).clamp_min(self.min_std)
+        return ((x - self.mean) / scale).clamp(-self.clip, self.clip)
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         return self.normalize(x)

@@ -494,7 +494,8 @@ def train_independent(cls, algo_kwargs, task, env_kwargs, steps, seed, out, eval
         for k, a in enumerate(agents):  # built in order: each seeds the global RNGs (SB3)
             venv = agent_vec_env(hub, a)
             policy, kw = policy_for(venv.observation_space, algo_kwargs, normalize_obs,
-                                    str((config or {}).get("algo")) == "recurrent_ppo")
+                                    str((config or {}).get("algo")) == "recurrent_ppo",
+                                    float((config or {}).get("obs_min_std", 0.0)))
             models[a] = cls(policy, venv, seed=seed + k, device="cpu", verbose=verbose, **kw)
         first = models[agents[0]]
         schedule.first = first_update(first)

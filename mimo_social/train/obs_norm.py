@@ -12,7 +12,8 @@ The statistics and their update are :class:`~mimo_social.train.image_cnn.Running
 ``BaseFeaturesExtractor``, flattening its input and learning in training mode.
 
 ``mimo-social train ... --normalize-obs`` uses it (``policy_kwargs={"features_extractor_class":
-RunningNorm}``).
+RunningNorm}``); ``--obs-min-std S`` floors the scale at S (``features_extractor_kwargs``
+``{"min_std": S}``: an input that only jitters stays small instead of being scaled up to +-10).
 """
 
 from __future__ import annotations
@@ -31,9 +32,11 @@ class RunningNorm(RunningMeanStd, BaseFeaturesExtractor):
     """Running mean/std normalisation of a flattened observation (module docstring); the
     state-dict keys are ``mean``, ``var`` and ``count``."""
 
-    def __init__(self, observation_space: spaces.Box, clip: float = 10.0, eps: float = 1e-8):
+    def __init__(self, observation_space: spaces.Box, clip: float = 10.0, eps: float = 1e-8,
+                 min_std: float = 0.0):
         n = int(np.prod(observation_space.shape))
-        super().__init__(n, clip, eps, observation_space=observation_space, features_dim=n)
+        super().__init__(n, clip, eps, min_std, observation_space=observation_space,
+                         features_dim=n)
 
     def forward(self, observations: torch.Tensor) -> torch.Tensor:
         x = observations.flatten(1).float()

@@ -87,7 +87,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           algo_kwargs: Mapping[str, Any] | None = None, verbose: int = 0,
           mode: str | None = None, n_envs: int | None = None, n_cpus: int | None = None,
           normalize_obs: bool | None = None, flat_obs: bool = False, frame_stack: int = 1,
-          worker_timeout: float = 600.0, normalize_reward: bool = False,
+          obs_min_std: float = 0.0, worker_timeout: float = 600.0, normalize_reward: bool = False,
           curriculum=None, bc_episodes: int = 0, bc_epochs: int = 20, intrinsic=None,
           bc_kwargs: Mapping[str, Any] | None = None, recipe: str | None = None,
           growth=None) -> dict:
@@ -104,7 +104,9 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     (:class:`~mimo_social.train.runlog.Schedule`). ``algo_kwargs`` override the shipped
     hyperparameters (:mod:`mimo_social.train.hyperparams`; every key checked before anything
     runs). ``normalize_obs`` (None: the task's shipped ``[run]`` default) puts running input
-    statistics in front of the policy. A learner with eyes gets the CNN
+    statistics in front of the policy; ``obs_min_std`` (0: none; with ``normalize_obs``) floors
+    their scale, so that inputs which only jitter (held joints) are not scaled up to the size
+    of the ones that move. A learner with eyes gets the CNN
     (:mod:`mimo_social.train.encoders`) unless ``flat_obs``; ``frame_stack`` frames of each
     image. ``worker_timeout``: seconds a worker may take to answer before the run fails.
     ``normalize_reward``: the learner's rewards scaled by SB3's ``VecNormalize`` (a running
@@ -148,6 +150,13 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     resolved, provenance = resolve(task, algo, algo_kwargs, mode=mode, steps=steps)
     if normalize_obs is None:
         normalize_obs = bool(run_options(task, mode).get("normalize_obs", False))
+    if (isinstance(obs_min_std, bool) or not isinstance(obs_min_std, (int, float))
+            or not 0.0 <= float(obs_min_std) <= 10.0):
+        raise TrainInputError(f"obs_min_std={obs_min_std!r}; allowed: a number from 0 (no "
+                              "floor) to 10")
+    if obs_min_std and not normalize_obs:
+        raise TrainInputError(f"obs_min_std={obs_min_std!r} floors the scale of the running "
+                              "observation normaliser: it needs normalize_obs (--normalize-obs)")
     from .workers import default_n_envs, default_workers
     if n_envs is None:
         n_envs = default_n_envs()
@@ -193,6 +202,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     flat = bool(flat_obs) or mode in ("shared", "independent")
     config = {"task": task, "env_id": env_id, "algo": algo, "steps": steps,
               "seed": seed, "normalize_obs": bool(normalize_obs),
+              "obs_min_std": float(obs_min_std),
               "normalize_reward": bool(normalize_reward),
               "observation": {"flat": flat, "frame_stack": int(frame_stack)},
               "env_kwargs": env_kwargs, "algo_kwargs": to_json(resolved),

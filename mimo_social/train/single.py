@@ -125,7 +125,8 @@ def build_model(cls, algo: str, venv, config: dict, algo_kwargs: dict, seed: int
         venv = RNDBonus(venv, config["intrinsic"])
     venv, normalizer = reward_normalizer(venv, config, algo_kwargs)
     policy, kw = policy_for(venv.observation_space, algo_kwargs,
-                            bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS)
+                            bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS,
+                            float(config.get("obs_min_std", 0.0)))
     config["policy"] = policy
     model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
     return venv, model, model_saver(model, normalizer)

@@ -178,6 +178,25 @@ def test_the_vector_can_be_normalised():
         policy_spec(spaces.Box(-1, 1, (3,), np.float32), normalize_vector=True)
 
 
+def test_policy_for_passes_the_normalisers_floor():
+    """``min_std`` (``--obs-min-std``) reaches the normaliser of either policy, only with
+    ``normalize_obs``; a model built from the keywords has it."""
+    from mimo_social.train.encoders import policy_for
+    from mimo_social.train.obs_norm import RunningNorm
+    _, kw = policy_for(_space(32, vector=4), {}, True, min_std=0.02)
+    assert kw["policy_kwargs"]["features_extractor_kwargs"] == {"normalize_vector": True,
+                                                                "norm_min_std": 0.02}
+    ex = EyesExtractor(_space(32, vector=4), **kw["policy_kwargs"]["features_extractor_kwargs"])
+    assert ex.norm.min_std == 0.02
+    _, kw = policy_for(_space(32, vector=4), {}, True)
+    assert kw["policy_kwargs"]["features_extractor_kwargs"] == {"normalize_vector": True}
+    box = spaces.Box(-1, 1, (3,), np.float32)
+    _, kw = policy_for(box, {}, True, min_std=0.05)
+    assert kw["policy_kwargs"]["features_extractor_class"] is RunningNorm
+    assert kw["policy_kwargs"]["features_extractor_kwargs"] == {"min_std": 0.05}
+    assert policy_for(box, {}, False, min_std=0.05) == ("MlpPolicy", {})
+
+
 class Frames(gym.Env):
     """A tiny env whose eye shows the step count (each frame different) and a vector."""
 

@@ -133,6 +133,26 @@ def test_running_norm_learns_in_training_mode_only():
     torch.testing.assert_close(norm.mean, x.flatten(1).mean(0), rtol=1e-4, atol=0)
 
 
+def test_min_std_floors_the_scale_of_an_input_that_only_jitters():
+    # a held joint jitters by 1e-3 rad, a moving one by 0.5: without a floor both come out at
+    # unit size; with min_std 0.01 the jitter stays a tenth of it and the moving joint keeps
+    # its unit scale
+    rng = np.random.default_rng(1)
+    x = torch.from_numpy(np.stack([rng.normal(0.3, 1e-3, 5000), rng.normal(0.0, 0.5, 5000)],
+                                  1).astype(np.float32))
+    plain, floored = RunningMeanStd(2), RunningMeanStd(2, min_std=0.01)
+    plain.update(x)
+    floored.update(x)
+    assert float(plain(x)[:, 0].std()) > 0.9
+    assert 0.08 < float(floored(x)[:, 0].std()) < 0.12
+    np.testing.assert_allclose(float(floored(x)[:, 1].std()), float(plain(x)[:, 1].std()),
+                               rtol=1e-4)
+    # the default is the former normaliser, number for number
+    torch.testing.assert_close(RunningMeanStd(2, min_std=0.0).normalize(x), x.clamp(-10, 10))
+    box = spaces.Box(-np.inf, np.inf, (2,), np.float32)
+    assert obs_norm.RunningNorm(box, min_std=0.05).min_std == 0.05
+
+
 def _saved_policy_keys(path: Path) -> set[str]:
     with zipfile.ZipFile(path) as z:
         return set(torch.load(io.BytesIO(z.read("policy.pth")), weights_only=True))

@@ -129,6 +129,25 @@ def test_a_run_saved_before_the_layout_still_loads_and_runs(tmp_path, capsys):
     assert "reach PPO model.zip: 1 episodes" in capsys.readouterr().out
 
 
+def test_the_observation_normalisers_floor_is_recorded_and_saved_with_the_model(tmp_path):
+    from stable_baselines3 import PPO
+
+    out = tmp_path / "floor"
+    train("reach", "ppo", 64, 0, out, eval_every=64, eval_episodes=1, checkpoint_every=0,
+          progress=False, normalize_obs=True, obs_min_std=0.02, n_envs=1,
+          env_kwargs={"max_steps": 16}, algo_kwargs={"n_steps": 64, "batch_size": 32,
+                                                     "n_epochs": 1})
+    assert json.loads((out / "config.json").read_text())["obs_min_std"] == 0.02
+    norm = PPO.load(str(out / "model.zip"), device="cpu").policy.features_extractor
+    assert norm.min_std == 0.02 and float(norm.count) >= 64
+    for bad, what in ((-0.1, "from 0"), (True, "from 0"), ("0.1", "from 0"),
+                      (0.02, "needs normalize_obs")):
+        with pytest.raises(TrainInputError, match=what):
+            train("reach", "ppo", 64, 0, tmp_path / "never", progress=False,
+                  normalize_obs=what == "from 0", obs_min_std=bad)
+    assert not (tmp_path / "never").exists()
+
+
 def test_a_bad_algo_kwarg_is_refused_before_anything_is_written(tmp_path):
     out = tmp_path / "never"
     with pytest.raises(TrainInputError, match=r"n_step.*did you mean.*n_steps"):

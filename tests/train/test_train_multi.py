@@ -402,6 +402,7 @@ def test_a_face_only_learner_trains_and_evaluates_with_a_discrete_expression(tmp
     norm = PPO.load(str(out / "model.zip"), device="cpu").policy.features_extractor
     assert isinstance(norm, RunningNorm) and float(norm.count) >= 128
     assert float(norm.var.max()) > 0 and float(norm.mean.abs().max()) > 0.1
+    assert norm.min_std == 0.0
     flat = make_scripted_env("mirror", max_steps=16, flat=True)
     assert flat.action_space("infant_0").n == 7
 
