@@ -13,9 +13,10 @@ clone's success, length and its mean action error (the clone's action minus the 
 mean absolute, per 50 steps), and the success rate. docs/training.md cites:
 
     python3 scripts/clone_play.py imitation --controller '{"prepare": 0.5, "move_s": 0.02}' \
-        --noise 0.1 --epochs 20 --obs-min-std 0.01
+        --noise 0.1 --epochs 20 --lr 3e-4 --obs-min-std 0.01
     python3 scripts/clone_play.py imitation --controller '{"prepare": 0.5, "move_s": 0.02}' \
-        --noise 0.1 --epochs 20 --obs-min-std 0
+        --noise 0.1 --epochs 20 --lr 3e-4 --obs-min-std 0
+    python3 scripts/clone_play.py joint_attention --epochs 5 --lr 3e-4 --obs-min-std 0.01 --play 5
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ def main(argv=None) -> int:
     p.add_argument("--episodes", type=int, default=20, help="demonstrations cloned")
     p.add_argument("--noise", type=float, default=0.0, help="DART noise on the demonstrator")
     p.add_argument("--epochs", type=int, default=20)
+    p.add_argument("--lr", type=float, default=1e-3, help="the cloning's learning rate")
     p.add_argument("--normalize-obs", action=argparse.BooleanOptionalAction, default=True)
     p.add_argument("--obs-min-std", type=float, default=0.0)
     p.add_argument("--play", type=int, default=20, help="fresh episodes the clone plays")
@@ -55,9 +57,9 @@ def main(argv=None) -> int:
                             min_std=a.obs_min_std if a.normalize_obs else 0.0)
     model = PPO(policy, venv, seed=0, device="cpu", **kw)
     demos = record_demonstrations(a.task, env, a.episodes, 20_000, a.controller, a.noise)
-    fit = clone(model, demos, a.epochs, seed=0)
+    fit = clone(model, demos, a.epochs, lr=a.lr, seed=0)
     print(f"{a.task}: {len(demos)} pairs from {a.episodes} episodes (noise {a.noise}), "
-          f"{a.epochs} epochs: {fit['loss']} loss {fit['loss_before']:.4g} -> "
+          f"{a.epochs} epochs at lr {a.lr:g}: {fit['loss']} loss {fit['loss_before']:.4g} -> "
           f"{fit['loss_after']:.4g}; normalize_obs {a.normalize_obs}, obs_min_std "
           f"{a.obs_min_std}", flush=True)
     controller = demonstrator(a.task, {"controller": a.controller})

@@ -32,6 +32,11 @@ fails here.
   cloning kept), judged by its sampled actions: the clones succeeded in 2/2 sampled evaluation
   episodes of both seeds before any RL step (issue 30, fifth session; the full recipe, 60k: 93 %
   and 100 % sampled on 30 episodes); the bar is 60 %;
+* imitation: the recipe at 2,048 steps (its warm start: 20 episodes of the preparing scripted
+  imitator, DART noise 0.1, cloned at lr 3e-4 into the CNN policy with the normaliser's scale
+  floored at 0.01, then one PPO update with the cloning kept), judged by its mean action: the
+  clones imitated in 2/2 evaluation episodes of both seeds before any RL step, mean and sampled
+  (issue 30, sixth session); the bar is 70 %;
 * catch: the recipe at 10k steps (its warm start: 100 scripted episodes cloned, 2 DAgger
   rounds, then five PPO updates with the cloning kept), judged by its mean action: the clone
   caught in 5/5 evaluation episodes of both seeds before any RL step (issue 30; the full recipe,
@@ -91,6 +96,11 @@ def test_the_contingency_recipes_warm_start_returns_smiles(tmp_path):
 def test_the_still_face_recipes_warm_start_sobers_at_the_still_face(tmp_path):
     res = check_recipe("still_face", [0], tmp_path, episodes=10, steps=2_048, progress=False)
     assert res["seeds"][0]["success_sampled"] >= 0.6, res["seeds"]
+
+
+def test_the_imitation_recipes_warm_start_imitates(tmp_path):
+    res = check_recipe("imitation", [0], tmp_path, episodes=10, steps=2_048, progress=False)
+    assert res["seeds"][0]["success"] >= 0.7, res["seeds"]
 
 
 def test_the_catch_recipes_warm_start_catches(tmp_path):
