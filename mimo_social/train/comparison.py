@@ -14,6 +14,8 @@ one set for every algorithm or one per algorithm (``{"ppo": {"n_steps": 512}, "s
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
 import time
 from pathlib import Path
@@ -27,11 +29,21 @@ from .tasks import (ALGOS, COMPARED_ALGOS, TrainInputError, check_algo, check_mo
 __all__ = ["compare", "train_all", "finished", "parse_steps_per_algo", "value_per_algo", "kwargs_keyed_by_algo"]
 
 
-def _train_quiet(kwargs):
+def _train_quiet(kwargs, parent: int):
+    """One run of :func:`train_all` in its spawned process; if ``parent`` (the pid of the
+    process that started it) ends, the run saves and stops (:class:`~.interrupt.stop_with_parent`)
+    and the process exits (an idle pool worker of a dead parent would otherwise spin on)."""
     import warnings
+
+    from .interrupt import stop_with_parent
     warnings.filterwarnings("ignore")
     t0 = time.perf_counter()
-    train(**kwargs)
+    with stop_with_parent(parent) as watch:
+        train(**kwargs)
+    if watch.signalled:         # saved; no one is left to hear of it: the process ends here
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(128 + int(signal.SIGTERM))
     return kwargs["out"], time.perf_counter() - t0
 
 
@@ -99,7 +111,8 @@ def finished(run: Mapping[str, Any]) -> bool:
 def train_all(runs: list[dict], jobs: int = 1, desc: str = "train",
               progress: bool = True, skip_finished: bool = False) -> None:
     """Train every run (``train``'s keyword arguments each): one after another with ``jobs=1``,
-    else up to ``jobs`` at a time, each in its own spawned process (one bar over the runs).
+    else up to ``jobs`` at a time, each in its own spawned process (one bar over the runs), which
+    saves its run and stops if this process ends (killed by SIGTERM, say).
     ``skip_finished``: leave out runs already there (:func:`finished`)."""
     if skip_finished:
         runs = [kw for kw in runs if not finished(kw)]
@@ -118,7 +131,7 @@ def train_all(runs: list[dict], jobs: int = 1, desc: str = "train",
     with ProcessPoolExecutor(max_workers=int(jobs), mp_context=mp.get_context("spawn")) as ex, \
             tqdm(total=len(runs), unit="run", desc=desc, disable=not progress,
                  dynamic_ncols=True) as bar:
-        for path, secs in ex.map(_train_quiet, runs):
+        for path, secs in ex.map(_train_quiet, runs, [os.getpid()] * len(runs)):
             bar.write(f"done {path} in {secs:.0f} s")
             bar.update(1)
 

@@ -10,14 +10,21 @@ thread only: installed from another thread, the context manager installs nothing
 cannot be stopped this way).
 
 The command line exits with :func:`exit_code` (130 for SIGINT, 143 for SIGTERM).
+
+:class:`stop_with_parent` is for a run in a spawned process of its own (``--jobs``): if the
+process that started it ends (killed by SIGTERM, SIGKILL or a crash, none of which reach the
+child), the run is sent SIGTERM and saves and stops as above, instead of training on unseen and
+writing into directories its parent's user may have moved or reused.
 """
 
 from __future__ import annotations
 
+import os
 import signal
 import threading
 
-__all__ = ["StopSignals", "Interrupted", "exit_code", "workers_ignore_sigint"]
+__all__ = ["StopSignals", "Interrupted", "exit_code", "workers_ignore_sigint",
+           "stop_with_parent"]
 
 
 class Interrupted(Exception):
@@ -75,3 +82,30 @@ class workers_ignore_sigint:  # noqa: N801 (a context manager used like a functi
     def __exit__(self, *exc) -> None:
         if self.previous is not None:
             signal.signal(signal.SIGINT, self.previous)
+
+
+class stop_with_parent:  # noqa: N801 (a context manager used like a function)
+    """While inside ``with stop_with_parent(parent):``, a daemon thread checks every
+    ``every_s`` seconds whether this process's parent is still ``parent`` (a pid; an orphan is
+    handed to another); once it is not, it sends this process SIGTERM (once), which a
+    :class:`StopSignals` in the main thread turns into a clean stop. ``getppid``: the function
+    that names the parent (``os.getppid``; a test can give another)."""
+
+    def __init__(self, parent: int, every_s: float = 1.0, getppid=os.getppid):
+        self.parent, self.every_s, self.getppid = int(parent), float(every_s), getppid
+        self.done = threading.Event()
+        self.signalled = False
+
+    def _watch(self) -> None:
+        while not self.done.wait(self.every_s):
+            if self.getppid() != self.parent:
+                self.signalled = True
+                os.kill(os.getpid(), signal.SIGTERM)
+                return
+
+    def __enter__(self) -> "stop_with_parent":
+        threading.Thread(target=self._watch, name="stop_with_parent", daemon=True).start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.done.set()
