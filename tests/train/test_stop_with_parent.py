@@ -1,7 +1,7 @@
 """A run in a spawned process of its own (``--jobs``) stops when the process that started it
 ends: ``stop_with_parent`` sends it SIGTERM, which ``StopSignals`` turns into a clean stop
-(issue 30, sixth session: two recipe runs killed through their parent trained on as orphans and
-wrote into the directory a new run was using)."""
+(issue 30, sixth session: two recipe runs killed through their parent trained on as orphans,
+saving by path into a directory a new run had taken over)."""
 
 import os
 import signal
