@@ -108,6 +108,7 @@ def _engine_conflicts(args) -> str | None:
         return (f"{', '.join(bad)}: for --engine sb3; with --engine rllib use --num-env-runners "
                 "and --num-envs-per-runner")
     bad = [f for f, k, d in (("--normalize-reward", "normalize_reward", False),
+                             ("--obs-min-std", "obs_min_std", None),
                              ("--algo recurrent_ppo", "algo", None),
                              ("--curriculum", "curriculum", None),
                              ("--bc-episodes", "bc_episodes", None),

@@ -41,6 +41,7 @@ def _train(tmp_path, *extra):
     (["--num-gpus-per-learner", "1"], "--num-gpus-per-learner: for --engine rllib"),
     (["--engine", "sb3", "--algo", "appo"], "--algo appo: for --engine rllib"),
     (["--engine", "rllib", "--n-envs", "2"], "--n-envs: for --engine sb3"),
+    (["--engine", "rllib", "--obs-min-std", "0.01"], "--obs-min-std: for --engine sb3"),
 ])
 def test_options_of_the_other_engine_are_refused(tmp_path, capsys, extra, says):
     assert _train(tmp_path, *extra) == 2

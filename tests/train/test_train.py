@@ -146,6 +146,11 @@ def test_the_observation_normalisers_floor_is_recorded_and_saved_with_the_model(
             train("reach", "ppo", 64, 0, tmp_path / "never", progress=False,
                   normalize_obs=what == "from 0", obs_min_std=bad)
     assert not (tmp_path / "never").exists()
+    # the command line's flag reaches train() (and its check)
+    assert cli.main(["train", "--task", "reach", "--algo", "ppo", "--steps", "64", "--out",
+                     str(tmp_path / "never"), "--no-progress", "--no-normalize-obs",
+                     "--obs-min-std", "0.02"]) == 2
+    assert not (tmp_path / "never").exists()
 
 
 def test_a_bad_algo_kwarg_is_refused_before_anything_is_written(tmp_path):
