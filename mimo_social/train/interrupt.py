@@ -97,6 +97,10 @@ class stop_with_parent:  # noqa: N801 (a context manager used like a function)
         self.signalled = False
 
     def _watch(self) -> None:
+        # this thread takes SIGTERM even where the main thread blocks it (a library may), so
+        # the signal is not left pending: the main thread's Python handler runs either way
+        if hasattr(signal, "pthread_sigmask"):
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
         while not self.done.wait(self.every_s):
             if self.getppid() != self.parent:
                 self.signalled = True

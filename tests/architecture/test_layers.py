@@ -229,6 +229,10 @@ THIRD_PARTY_PRIVATES = {
     ("mimo_social.train.rllib.evaluation", "filt", "_filters"),
     ("mimo_social.train.rllib.runner", "er", "_env_to_module"),
     ("mimo_social.train.rllib.runner", "algorithm.env_runner", "_env_to_module"),
+    # the standard library: a spawned run whose parent is gone ends its process at once (no
+    # exit handlers: the pool worker's would wait on the dead parent); os._exit is the
+    # documented call for a child process
+    ("mimo_social.train.comparison", "os", "_exit"),
 }
 
 

@@ -40,6 +40,19 @@ def test_the_run_is_signalled_once_its_parent_is_gone():
     assert signal.getsignal(signal.SIGTERM) is not stop.handle
 
 
+def test_the_signal_arrives_where_the_main_thread_blocks_sigterm():
+    # a library may block SIGTERM in the main thread (the full suite met one): the watcher
+    # takes the signal in its own thread and the main thread's handler still runs
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+    try:
+        with StopSignals() as stop, stop_with_parent(os.getppid(), every_s=0.01,
+                                                     getppid=lambda: 1) as w:
+            assert _wait_for(lambda: stop.requested)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+    assert stop.signum == signal.SIGTERM and w.signalled
+
+
 def test_no_signal_while_the_parent_lives_and_none_after_the_block():
     parent = os.getppid()
     with StopSignals() as stop:
