@@ -35,7 +35,7 @@ def _train_quiet(kwargs, parent: int):
     and the process exits (an idle pool worker of a dead parent would otherwise spin on)."""
     import warnings
 
-    from .interrupt import stop_with_parent
+    from .interrupt import exit_code, stop_with_parent
     warnings.filterwarnings("ignore")
     t0 = time.perf_counter()
     with stop_with_parent(parent) as watch:
@@ -43,7 +43,7 @@ def _train_quiet(kwargs, parent: int):
     if watch.signalled:         # saved; no one is left to hear of it: the process ends here
         sys.stdout.flush()
         sys.stderr.flush()
-        os._exit(128 + int(signal.SIGTERM))
+        os._exit(exit_code(signal.SIGTERM))
     return kwargs["out"], time.perf_counter() - t0
 
 
