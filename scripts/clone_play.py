@@ -49,10 +49,12 @@ def main(argv=None) -> int:
     p.add_argument("--obs-min-std", type=float, default=0.0)
     p.add_argument("--play", type=int, default=20, help="fresh episodes the clone plays")
     p.add_argument("--seed", type=int, default=1000)
+    p.add_argument("--env-kwargs", type=json.loads, default={},
+                   help="JSON keyword arguments of the learner's env (a recipe's env_kwargs)")
     a = p.parse_args(argv)
     torch.set_num_threads(1)
-    env = make_env(a.task)
-    venv = DummyVecEnv([lambda: make_env(a.task)])
+    env = make_env(a.task, **a.env_kwargs)
+    venv = DummyVecEnv([lambda: make_env(a.task, **a.env_kwargs)])
     policy, kw = policy_for(venv.observation_space, {}, a.normalize_obs,
                             min_std=a.obs_min_std if a.normalize_obs else 0.0)
     model = PPO(policy, venv, seed=0, device="cpu", **kw)
@@ -67,7 +69,8 @@ def main(argv=None) -> int:
     for seed in range(a.seed, a.seed + a.play):
         lab = Labeller(controller, env, model)
         ep = run_episode(env, lab, seed)
-        obs = {k: np.stack([o[k] for o in lab.obs]) for k in lab.obs[0]}
+        obs = ({k: np.stack([o[k] for o in lab.obs]) for k in lab.obs[0]}
+               if isinstance(lab.obs[0], dict) else np.stack(lab.obs))
         pred, _ = model.predict(obs, deterministic=True)
         err = np.abs(pred - np.stack(lab.actions)).mean(1)
         won = bool(ep.success(next(iter(ep.returns))))

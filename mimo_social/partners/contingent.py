@@ -74,8 +74,10 @@ A caregiver's speech does not depend on the learner, so it adds nothing to the c
 tells a listener whether the caregiver is engaged, also while the listener looks away.
 
 **Stream**: ``stream`` holds the action of every step of the episode (``motors``: (T, n)
-float32, ``expression``: (T,) int64, -1 without expressions, ``dt``); a
-:class:`~mimo_social.partners.replay.ReplayCaregiver` plays it back bit for bit.
+float32, ``expression``: (T,) int64, -1 without expressions, ``voice``: (T,) int64, the sound
+kind, -1 without a voice, ``loudness``: (T,) float32, 0 without a voice, ``dt``); a
+:class:`~mimo_social.partners.replay.ReplayCaregiver` plays it back bit for bit, the voice
+included.
 
 Logs for measures and tests: ``events`` (one dict per cue event: ``step``, ``cue``,
 ``answered``, ``due``) and ``responses`` (one dict per response started: ``step``, ``cue``,
@@ -208,6 +210,7 @@ class ContingentCaregiver(Partner):
         self.modes: list[tuple[int, str]] = []
         self._motors: list[np.ndarray] = []
         self._faces: list[int] = []
+        self._voices: list[int] = []
 
     def __repr__(self) -> str:
         return (f"ContingentCaregiver(cues={self.cues}, delay_s={self.delay_s}, delay_jitter_s="
@@ -292,7 +295,7 @@ class ContingentCaregiver(Partner):
         self._pending: list[tuple[int, str, object, int]] = []
         self._active: dict[str, tuple[int, int, object]] = {}
         self.events, self.responses = [], []
-        self._motors, self._faces = [], []
+        self._motors, self._faces, self._voices = [], [], []
         self._talk = 0              # steps left of the utterance (> 0) or of the pause (< 0)
         self._period_steps = 0
         self._period_counts = dict.fromkeys(self.cues, 0)
@@ -359,11 +362,14 @@ class ContingentCaregiver(Partner):
     @property
     def stream(self) -> dict:
         """This episode's actions: ``motors`` (T, n) float32, ``expression`` (T,) int64 (-1:
-        the agent has no expression action), ``dt`` (s)."""
+        the agent has no expression action), ``voice`` (T,) int64 (the sound kind; -1: the
+        agent has no voice), ``loudness`` (T,) float32 (0 without a voice), ``dt`` (s)."""
         n = getattr(self, "_n", 0)
         motors = np.stack(self._motors) if self._motors else np.zeros((0, n), np.float32)
+        voice = np.asarray(self._voices, np.int64)
+        loud = np.where(voice >= 0, self.speech_loudness, 0.0).astype(np.float32)
         return {"motors": motors, "expression": np.asarray(self._faces, np.int64),
-                "dt": float(getattr(self, "_dt", np.nan))}
+                "voice": voice, "loudness": loud, "dt": float(getattr(self, "_dt", np.nan))}
 
     # -- acting --------------------------------------------------------------------------------
     def act(self, env, agent, observation):
@@ -389,13 +395,15 @@ class ContingentCaregiver(Partner):
         self._step += 1
         self._motors.append(u)
         self._faces.append(face if self._dict else -1)
+        sound = self._speech() if self._voice else -1
+        self._voices.append(sound)
         if not (self._dict or self._voice):
             return u.copy()
         out = {"motors": u.copy()}
         if self._dict:
             out["expression"] = np.int64(face)
         if self._voice:
-            out["voice"] = np.int64(self._speech())
+            out["voice"] = np.int64(sound)
             out["loudness"] = np.array([self.speech_loudness], np.float32)
         return out
 

@@ -487,3 +487,65 @@ def test_the_talk_is_seeded_and_a_pickled_copy_goes_on_talking_alike():
     copy = pickle.loads(pickle.dumps(a))
     for (k1, m1), (k2, m2) in zip(talk(a), talk(copy)):
         assert k1 == k2 and np.array_equal(m1, m2)
+
+
+def test_a_talking_caregiver_is_replayed_with_its_voice(tmp_path):
+    """The stream of a talking caregiver (``caregiver_speech``) holds its voice, each step's
+    sound kind and loudness; saved, loaded and replayed by ``ReplayCaregiver`` against another
+    infant, the caregiver says what it said (speech and pauses, silent in the still face) and
+    moves as it moved, step for step. A voiced caregiver refuses a stream without a voice, and
+    a stream with a voice but no loudness is refused, each naming what is missing."""
+    from mimo_social.partners import ReplayCaregiver, load_stream, save_stream
+    from mimo_social.util.checks import ConfigError
+
+    def episode(partner, infant, seed):
+        env = still_face_v0.scripted_env(partner, per_agent=[{"vision": False}, {}],
+                                         task_options={"caregiver_speech": True,
+                                                       "phases_s": (1.5, 1.0, 1.5)})
+        run(env, infant, seed)
+        inner = env.unwrapped
+        return inner
+
+    heard = []
+
+    class Ear(StillFaceInfantController):
+        def act(self, env, agent, obs):
+            heard.append(int(env.sounds[1, 0]))      # the caregiver's sound of the last step
+            return super().act(env, agent, obs)
+
+    live = ContingentCaregiver()
+    episode(live, Ear(), 7)
+    stream = live.stream
+    t = len(stream["motors"])
+    assert stream["voice"].shape == (t,) and stream["loudness"].dtype == np.float32
+    assert {0, SPEECH_KIND} <= set(stream["voice"].tolist())       # talk and pauses
+    assert np.all(stream["loudness"] == live.speech_loudness)
+    recorded = np.array(heard[1:])
+    np.testing.assert_array_equal(recorded, stream["voice"][:len(recorded)])
+    loaded = load_stream(save_stream(tmp_path / "talking", stream))
+    for key in ("motors", "expression", "voice", "loudness"):
+        np.testing.assert_array_equal(loaded[key], stream[key])
+    heard.clear()
+    got = []
+
+    class Tap(ReplayCaregiver):
+        def act(self, env, agent, observation):
+            a = super().act(env, agent, observation)
+            got.append(a)
+            return a
+
+    def still_infant(env):      # another infant: it neither moves nor smiles
+        heard.append(int(env.unwrapped.sounds[1, 0]))
+        return zero(env)
+
+    episode(Tap(loaded), still_infant, 7)   # the same seed: the same phases (the task's mute)
+    np.testing.assert_array_equal([int(a["voice"]) for a in got], stream["voice"][:len(got)])
+    np.testing.assert_array_equal(np.stack([a["motors"] for a in got]),
+                                  stream["motors"][:len(got)])
+    np.testing.assert_array_equal(np.array(heard[1:]), stream["voice"][:len(heard) - 1])
+    silent = {k: v for k, v in stream.items() if k not in ("voice", "loudness")}
+    with pytest.raises(ConfigError, match="caregiver_0 acts with its voice but the stream has "
+                                          "no voice"):
+        episode(ReplayCaregiver(silent), still_infant, 7)
+    with pytest.raises(ConfigError, match="voice but not loudness"):
+        ReplayCaregiver(dict(silent, voice=stream["voice"]))
