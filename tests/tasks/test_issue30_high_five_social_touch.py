@@ -315,6 +315,73 @@ def test_thirty_episodes_scripted_toucher_from_random_starts():
     assert wins >= 24, wins                                        # measured 29 / 30
 
 
+def _plan(env, controller, seed, partner_arms=None):
+    """The waypoints ``controller`` plans for ``env``'s episode ``seed`` (one-learner env; the
+    touched infant's actuated joints set to ``partner_arms`` first, if given), and the toucher's
+    observation and target."""
+    obs, _ = env.reset(seed=seed)
+    inner = env.unwrapped
+    w = inner.world
+    if partner_arms is not None:
+        b = w.agents[1]
+        w.data.qpos[b.qpos_adr[b.actuated_joint_idx]] = partner_arms
+        mujoco.mj_forward(w.model, w.data)
+    controller.reset(inner, "infant_0", np.random.default_rng(seed))
+    return np.array(controller.waypoints), obs["infant_0"], inner.task.target
+
+
+def test_the_blind_toucher_plans_on_what_it_senses_only():
+    """``twins``: the plan is a function of what the toucher senses and the target. The same
+    episode with the partner's arms moved (the toucher's observation unchanged: it does not
+    sense them): the blind plan is the same, bit for bit, while the plan that sees the partner
+    differs. The distance is sensed (the toucher's eye angles, verging on the partner's face,
+    change with it), so twins keep it. Planning on the twins leaves the episode's world as it
+    was."""
+    env = social_touch_v0.scripted_env()
+    for seed in (1001, 1005):
+        env.reset(seed=seed)
+        b = env.unwrapped.world.agents[1]
+        k = b.actuated_joint_idx
+        lo, hi = b.joint_range[k, 0], b.joint_range[k, 1]
+        moved = lo + (hi - lo) * np.where(np.arange(len(k)) % 2, 0.45, 0.55)
+        blind = [_plan(env, SocialTouchController(twins=3), seed, arms)
+                 for arms in (None, moved)]
+        for key in blind[0][1]:
+            np.testing.assert_array_equal(blind[0][1][key], blind[1][1][key])
+        np.testing.assert_array_equal(blind[0][0], blind[1][0])
+        seeing = [_plan(env, SocialTouchController(), seed, arms)[0] for arms in (None, moved)]
+        assert seeing[0].shape != seeing[1].shape or not np.allclose(seeing[0], seeing[1])
+    near = social_touch_v0.scripted_env(task_options={"distance_spread": 0.0})
+    a, c = (e.reset(seed=1001)[0]["infant_0"]["proprioception"] for e in (env, near))
+    assert env.unwrapped.task.distance != near.unwrapped.task.distance
+    assert not np.array_equal(a, c)                          # the vergence tells the distance
+    inner = env.unwrapped
+    env.reset(seed=7)
+    w = inner.world
+    qpos, hip = w.data.qpos.copy(), w.model.body_pos.copy()
+    c = SocialTouchController(twins=2)
+    c.reset(inner, "infant_0", np.random.default_rng(7))
+    assert c.twin_hits in (0, 1, 2) and "twins=2" in repr(c)
+    np.testing.assert_array_equal(w.data.qpos, qpos)
+    np.testing.assert_array_equal(w.model.body_pos, hip)
+
+
+@pytest.mark.slow
+def test_the_blind_toucher_succeeds_without_seeing_the_partner():
+    """Seeds 1000-1009, six twins: measured 8 / 10 (60 episodes: docs/baselines.md)."""
+    env = social_touch_v0.scripted_env()
+    wins = sum(learner_episode(env, SocialTouchController(twins=6), s)[0]
+               for s in range(1000, 1010))
+    assert wins >= 7, wins
+
+
+def test_bad_twins_say_what_is_allowed():
+    with pytest.raises(ValueError, match="twins=-1"):
+        SocialTouchController(twins=-1)
+    with pytest.raises(ValueError, match="twin_seed=1.5"):
+        SocialTouchController(twins=2, twin_seed=1.5)
+
+
 @pytest.mark.parametrize("options, pattern", [
     ({"start_spread": 1.5}, r"start_spread=1.5 not allowed; allowed: a number from 0 to 1"),
     ({"partner_spread": -0.1}, r"partner_spread=-0.1 not allowed"),

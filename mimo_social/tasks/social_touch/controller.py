@@ -15,6 +15,15 @@ plan:
     world (``mj_step``, the motors' torques) and the first whose first contact with the partner is
     the palm side of the hand on the target within ``good_steps`` is kept (else the fastest that
     does; else the first)
+blind plan (``twins`` K > 0):
+    the toucher senses its own body (the distance too: its eyes verge on the partner's face) and
+    the instruction, not the partner's arms, which the task draws each episode; this plan reads
+    only what it senses. K twin worlds are made from the episode's: everything kept but the
+    partner's arms, drawn again (``env.task.draw_unseen``) from generators seeded
+    ``(twin_seed, k)`` (the same K draws every episode, so the plan is a function of what the
+    toucher senses at the start and the target: a demonstration a clone can follow); one plan
+    is made per twin as above, each plan is rolled out on every twin, and the one that touches
+    the target first on the most twins (ties: the fewest steps) is played
 arm:
     PD control per joint toward the current waypoint, gains from each joint's own inertia (the
     diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping
@@ -25,7 +34,9 @@ fingers:
     held straight by the same PD
 state:
     ``target_part``, ``waypoints``, ``variant`` (the plan kept), ``planned_steps`` (steps to the
-    touch on the scratch world; inf: no plan touched the target first)
+    touch on the scratch world; inf: no plan touched the target first; blind: the mean over the
+    twins it touched first), ``twin_hits`` (blind: on how many twins the kept plan touches the
+    target first)
 
 Hack policies (they ignore the instruction; each scores less than the controller, see
 tests/partners/test_touch_controller.py): :class:`NearestPartToucher` touches, palm first, the
@@ -45,7 +56,7 @@ import numpy as np
 
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
-from ...util.checks import check_number
+from ...util.checks import check_int, check_number
 from ...partners.base import (Partner, agent_index, check_variants, follow_waypoints, motor_action,
                     pd_gains, require_motors)
 
@@ -322,6 +333,14 @@ def reach_posture(world, i: int, j: int, part: str, depth: float = 0.005,
     return best[1], best[2], best[3]
 
 
+class _Twin:
+    """A twin of the episode's world for a blind plan: the model, its own data, the agents'
+    index tables."""
+
+    def __init__(self, model, data, agents):
+        self.model, self.data, self.agents = model, data, agents
+
+
 class SocialTouchController(Partner):
     """Touch the social touch task's target part of the partner with the palm, coming in along
     the part's normal, clear of the partner's other parts (see the module table).
@@ -333,7 +352,9 @@ class SocialTouchController(Partner):
     (m): where variants raise the palm above the part first; ``frequency`` (Hz) and ``damping``
     (ratio): the PD loop; ``tolerance`` (rad) and ``hold_steps``: when a waypoint gives way to the
     next; ``variants``: the plans tried at reset (default :data:`VARIANTS`); ``good_steps``: the
-    first plan that touches the target first within this many steps on the scratch world is kept.
+    first plan that touches the target first within this many steps on the scratch world is kept;
+    ``twins`` (0: the plan sees the partner): plan without seeing the partner, on that many twin
+    worlds; ``twin_seed``: their draws (see the module table, "blind plan").
     """
 
     who = "SocialTouchController"
@@ -341,7 +362,8 @@ class SocialTouchController(Partner):
     def __init__(self, target: str | None = None, standoff: float = 0.05, depth: float = 0.03,
                  lift: float = 0.10, frequency: float = 3.0, damping: float = 1.0,
                  tolerance: float = 0.1, hold_steps: int = 60, variants=None,
-                 good_steps: int = 250, tilt_deg: float = TILT_DEG):
+                 good_steps: int = 250, tilt_deg: float = TILT_DEG, twins: int = 0,
+                 twin_seed: int = 0):
         if target is not None and (not isinstance(target, str) or not target):
             raise ValueError(f"{self.who}: target={target!r}; allowed: None or a body part "
                              "name of the partner")
@@ -356,9 +378,13 @@ class SocialTouchController(Partner):
         self.variants = check_variants(self.who, variants, self._plan, VARIANTS)
         self.good_steps = int(check_number(self.who, "good_steps", good_steps, 1, 100000))
         self.tilt_deg = check_number(self.who, "tilt_deg", tilt_deg, 0.0, 90.0)
+        self.twins = check_int(self.who, "twins", twins, 0, 100)
+        self.twin_seed = check_int(self.who, "twin_seed", twin_seed, 0, 2**31 - 1)
+        self.twin_hits: int | None = None
 
     def __repr__(self):
-        return f"{type(self).__name__}(target={self.target!r})"
+        twins = f", twins={self.twins}, twin_seed={self.twin_seed}" if self.twins else ""
+        return f"{type(self).__name__}(target={self.target!r}{twins})"
 
     # -- set-up shared with the hacks ------------------------------------------------------------
     def bind(self, env, agent):
@@ -407,9 +433,24 @@ class SocialTouchController(Partner):
         self.bind(env, agent)
         self.target_part = self._part(env)
         w = env.world
+        self.twin_hits = None
+        if self.twins:
+            best = self._blind_plan(env)
+        else:
+            self._on(w)
+            best = self._best_plan(w, env)
+        self.planned_steps, _, self.variant = best
+        self.follow(best[1])
+
+    def _on(self, w) -> None:
+        """Plan and roll out on world ``w`` (the episode's or a twin)."""
         self._geo = _Geometry(w, self._i, self._j, self.target_part)
         self._arm_mask[:] = False
         self._arm_mask[self._geo.arm] = True
+
+    def _best_plan(self, w, env) -> tuple[float, list, dict]:
+        """(steps to the touch, waypoints, variant) of the first variant that touches the target
+        first within ``good_steps`` on ``w`` (else the fastest that does; else the first)."""
         best = None
         for variant in self.variants:
             plan = self._plan(w, **variant)
@@ -422,8 +463,41 @@ class SocialTouchController(Partner):
                 break
         if best is None:
             raise ValueError(f"{self.who}: no plan for {self.target_part!r}")
-        self.planned_steps, _, self.variant = best
-        self.follow(best[1])
+        return best
+
+    def _blind_plan(self, env) -> tuple[float, list, dict]:
+        """The plan kept without seeing the partner (module table, "blind plan")."""
+        draw = getattr(env.task, "draw_unseen", None)
+        if not callable(draw):
+            raise ValueError(f"{self.who}: twins={self.twins} needs a task that draws what the "
+                             f"toucher does not sense (env.task.draw_unseen); "
+                             f"{type(env.task).__name__} has none: allowed twins=0")
+        w = env.world
+        twins = []
+        for k in range(self.twins):
+            m = w.model
+            d = mujoco.MjData(m)
+            d.qpos[:], d.qvel[:], d.act[:], d.ctrl[:] = w.data.qpos, w.data.qvel, w.data.act, \
+                w.data.ctrl
+            draw(m, d, np.random.default_rng([self.twin_seed, k]))
+            mujoco.mj_forward(m, d)
+            twins.append(_Twin(m, d, w.agents))
+        found = []
+        for t in twins:
+            self._on(t)
+            found.append(self._best_plan(t, env))
+        steps = np.full((len(found), len(twins)), np.inf)
+        for k, t in enumerate(twins):
+            self._on(t)
+            for p, (_, plan, _) in enumerate(found):
+                steps[p, k] = self._rollout(t, plan, env.max_steps, env.frame_skip)
+        hits = np.isfinite(steps).sum(axis=1)
+        mean = np.array([row[np.isfinite(row)].mean() if h else np.inf
+                         for row, h in zip(steps, hits)])
+        kept = int(np.lexsort((mean, -hits))[0])
+        self._on(w)
+        self.twin_hits = int(hits[kept])
+        return float(mean[kept]), found[kept][1], found[kept][2]
 
     def follow(self, waypoints: list[np.ndarray]) -> None:
         """Drive the arm through ``waypoints`` (motor angles, rad) from the first one on."""

@@ -319,14 +319,31 @@ class SocialTouch(Task):
         postures (each actuated joint at its start angle + U(-1/2, 1/2) x spread x its range),
         drawn again until the toucher's right arm touches nothing and the two infants do not
         touch each other (seeded by ``reset(seed=...)``)."""
+        self.distance = self._draw(m, d, rng, toucher=True)
+
+    def draw_unseen(self, model, data, rng) -> None:
+        """What the toucher does not sense, drawn again as at reset on a copy ``data`` (a new
+        ``MjData`` of ``model`` with the episode's state) of the episode's world: the touched
+        infant's arms, until nothing touches that should not; the toucher's own posture is
+        kept, and so is the distance, which the toucher senses (its eyes verge on the partner's
+        face: their angles in its proprioception change with the distance, tested). For a
+        toucher that plans without seeing its partner (a planner's twin worlds); this env is not
+        changed."""
+        self._draw(model, data, rng, toucher=False)
+
+    def _draw(self, m, d, rng, toucher: bool) -> float:
         o = self.options
-        lo_d, hi_d = DISTANCE_RANGE
-        dist = float(np.clip(o.distance + rng.uniform(-1.0, 1.0) * o.distance_spread, lo_d, hi_d))
-        m.body_pos[self._root, :2] = self._root_xy + (dist - o.distance) * self._axis
-        self.distance = dist
-        spreads = (o.start_spread, o.partner_spread)
+        dist = self.distance
+        if toucher:
+            lo_d, hi_d = DISTANCE_RANGE
+            dist = float(np.clip(o.distance + rng.uniform(-1.0, 1.0) * o.distance_spread,
+                                 lo_d, hi_d))
+            m.body_pos[self._root, :2] = self._root_xy + (dist - o.distance) * self._axis
+        spreads = (o.start_spread if toucher else None, o.partner_spread)
         for _ in range(START_TRIES):
             for (q, mid, lo, hi), spread in zip(self._spread_joints, spreads):
+                if spread is None:
+                    continue
                 u = rng.uniform(-0.5, 0.5, len(q))
                 d.qpos[q] = np.clip(mid + u * spread * (hi - lo), lo, hi)
             mujoco.mj_kinematics(m, d)
@@ -340,8 +357,10 @@ class SocialTouch(Task):
             if not np.any(pressed & (across | arm)):
                 break
         else:   # no clear draw: the fixed start (which touches nothing)
-            for q, mid, _, _ in self._spread_joints:
-                d.qpos[q] = mid
+            for (q, mid, _, _), spread in zip(self._spread_joints, spreads):
+                if spread is not None:
+                    d.qpos[q] = mid
+        return dist
 
     @property
     def target(self) -> str:
