@@ -366,6 +366,19 @@ def test_the_blind_toucher_plans_on_what_it_senses_only():
     np.testing.assert_array_equal(w.model.body_pos, hip)
 
 
+def test_a_blind_plan_from_the_mean_start_is_one_plan_per_target_and_distance():
+    """``twin_start="mean"``: the twins hold the toucher's arm at its mean start, so episodes
+    with other starts (the same target and distance) get the same plan; with the episode's start
+    (default) they do not."""
+    env = social_touch_v0.scripted_env(task_options={"distance_spread": 0.0,
+                                                     "target": "left_lower_arm"})
+    for start, same in (("mean", True), ("episode", False)):
+        plans = [_plan(env, SocialTouchController(twins=2, twin_start=start), seed)
+                 for seed in (3, 4)]
+        assert not np.array_equal(plans[0][1]["proprioception"], plans[1][1]["proprioception"])
+        assert np.array_equal(plans[0][0], plans[1][0]) == same, start
+
+
 @pytest.mark.slow
 def test_the_blind_toucher_succeeds_without_seeing_the_partner():
     """Seeds 1000-1009, six twins: measured 8 / 10 (60 episodes: docs/baselines.md)."""
@@ -380,6 +393,8 @@ def test_bad_twins_say_what_is_allowed():
         SocialTouchController(twins=-1)
     with pytest.raises(ValueError, match="twin_seed=1.5"):
         SocialTouchController(twins=2, twin_seed=1.5)
+    with pytest.raises(ValueError, match="twin_start='median'"):
+        SocialTouchController(twins=2, twin_start="median")
 
 
 @pytest.mark.parametrize("options, pattern", [

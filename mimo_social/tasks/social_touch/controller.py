@@ -23,7 +23,9 @@ blind plan (``twins`` K > 0):
     ``(twin_seed, k)`` (the same K draws every episode, so the plan is a function of what the
     toucher senses at the start and the target: a demonstration a clone can follow); one plan
     is made per twin as above, each plan is rolled out on every twin, and the one that touches
-    the target first on the most twins (ties: the fewest steps) is played
+    the target first on the most twins (ties: the fewest steps) is played. ``twin_start="mean"``:
+    the twins hold the toucher's arm at its mean start, not the episode's: one plan per target
+    and distance whatever the start, the PD law bringing the arm onto it
 arm:
     PD control per joint toward the current waypoint, gains from each joint's own inertia (the
     diagonal of the joint-space mass matrix at reset; natural frequency ``frequency`` 3 Hz, damping
@@ -56,7 +58,7 @@ import numpy as np
 
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
-from ...util.checks import check_int, check_number
+from ...util.checks import check_choice, check_int, check_number
 from ...partners.base import (Partner, agent_index, check_variants, follow_waypoints, motor_action,
                     pd_gains, require_motors)
 
@@ -75,6 +77,8 @@ __all__ = [
 ]
 
 ARM = RIGHT_SHOULDER_ELBOW + RIGHT_WRIST
+#: where a blind plan's twins start the toucher's arm (see the module table)
+TWIN_STARTS = ("episode", "mean")
 #: the hand touches with the finger pads: the palm's normal tipped this far towards the fingertips
 TILT_DEG = 45.0
 #: a hand contact whose normal (into the partner) has a component at or below this along the
@@ -354,7 +358,8 @@ class SocialTouchController(Partner):
     next; ``variants``: the plans tried at reset (default :data:`VARIANTS`); ``good_steps``: the
     first plan that touches the target first within this many steps on the scratch world is kept;
     ``twins`` (0: the plan sees the partner): plan without seeing the partner, on that many twin
-    worlds; ``twin_seed``: their draws (see the module table, "blind plan").
+    worlds; ``twin_seed``: their draws; ``twin_start``: ``"episode"`` (the twins' toucher starts
+    as in the episode) or ``"mean"`` (at its mean start) (see the module table, "blind plan").
     """
 
     who = "SocialTouchController"
@@ -363,7 +368,7 @@ class SocialTouchController(Partner):
                  lift: float = 0.10, frequency: float = 3.0, damping: float = 1.0,
                  tolerance: float = 0.1, hold_steps: int = 60, variants=None,
                  good_steps: int = 250, tilt_deg: float = TILT_DEG, twins: int = 0,
-                 twin_seed: int = 0):
+                 twin_seed: int = 0, twin_start: str = "episode"):
         if target is not None and (not isinstance(target, str) or not target):
             raise ValueError(f"{self.who}: target={target!r}; allowed: None or a body part "
                              "name of the partner")
@@ -380,10 +385,12 @@ class SocialTouchController(Partner):
         self.tilt_deg = check_number(self.who, "tilt_deg", tilt_deg, 0.0, 90.0)
         self.twins = check_int(self.who, "twins", twins, 0, 100)
         self.twin_seed = check_int(self.who, "twin_seed", twin_seed, 0, 2**31 - 1)
+        self.twin_start = check_choice(self.who, "twin_start", twin_start, TWIN_STARTS)
         self.twin_hits: int | None = None
 
     def __repr__(self):
-        twins = f", twins={self.twins}, twin_seed={self.twin_seed}" if self.twins else ""
+        twins = (f", twins={self.twins}, twin_seed={self.twin_seed}, twin_start="
+                 f"{self.twin_start!r}" if self.twins else "")
         return f"{type(self).__name__}(target={self.target!r}{twins})"
 
     # -- set-up shared with the hacks ------------------------------------------------------------
@@ -479,7 +486,8 @@ class SocialTouchController(Partner):
             d = mujoco.MjData(m)
             d.qpos[:], d.qvel[:], d.act[:], d.ctrl[:] = w.data.qpos, w.data.qvel, w.data.act, \
                 w.data.ctrl
-            draw(m, d, np.random.default_rng([self.twin_seed, k]))
+            draw(m, d, np.random.default_rng([self.twin_seed, k]),
+                 own_mean=self.twin_start == "mean")
             mujoco.mj_forward(m, d)
             twins.append(_Twin(m, d, w.agents))
         found = []

@@ -321,14 +321,18 @@ class SocialTouch(Task):
         touch each other (seeded by ``reset(seed=...)``)."""
         self.distance = self._draw(m, d, rng, toucher=True)
 
-    def draw_unseen(self, model, data, rng) -> None:
+    def draw_unseen(self, model, data, rng, own_mean: bool = False) -> None:
         """What the toucher does not sense, drawn again as at reset on a copy ``data`` (a new
         ``MjData`` of ``model`` with the episode's state) of the episode's world: the touched
         infant's arms, until nothing touches that should not; the toucher's own posture is
         kept, and so is the distance, which the toucher senses (its eyes verge on the partner's
         face: their angles in its proprioception change with the distance, tested). For a
         toucher that plans without seeing its partner (a planner's twin worlds); this env is not
-        changed."""
+        changed. ``own_mean``: the toucher's right arm put at its mean start (the start posture
+        without spread) first: a plan for every start."""
+        if own_mean:
+            q, mid, _, _ = self._spread_joints[TOUCHER]
+            data.qpos[q] = mid
         self._draw(model, data, rng, toucher=False)
 
     def _draw(self, m, d, rng, toucher: bool) -> float:
