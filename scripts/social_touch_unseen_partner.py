@@ -12,11 +12,18 @@ played in the real episode with its own PD law, which reads only the toucher's j
 * ``scripted``: planned on the real episode (the catalogue controller);
 * ``unseen distance``: planned with ``distance_spread`` 0;
 * ``unseen arms``: planned with ``partner_spread`` 0;
-* ``unseen both``: both at 0: what the toucher's observation allows this plan.
+* ``unseen both``: both at 0: what the toucher's observation allows this plan;
+* ``blind 6``, ``blind 12``: ``SocialTouchController(twins=K)``, the plan chosen over K twin
+  worlds with the partner's arms drawn again (the distance kept: the toucher senses it through
+  its eyes' vergence);
+* ``blind 6, mean start``: the same with ``twin_start="mean"`` (one plan per target and
+  distance, whatever the toucher's start).
 
 docs/baselines.md (social touch) cites:
 
     python3 scripts/social_touch_unseen_partner.py --episodes 60 --seed 1000
+    python3 scripts/social_touch_unseen_partner.py --episodes 60 --seed 1000 \
+        --rows "blind 6" "blind 12" "blind 6, mean start"
 """
 
 from __future__ import annotations
@@ -33,12 +40,15 @@ from mimo_social.tasks.social_touch.controller import SocialTouchController
 ROWS = {"scripted": None, "unseen distance": {"distance_spread": 0.0},
         "unseen arms": {"partner_spread": 0.0},
         "unseen both": {"distance_spread": 0.0, "partner_spread": 0.0}}
+#: rows of the blind plan: the controller's own keyword arguments
+BLIND = {"blind 6": {"twins": 6}, "blind 12": {"twins": 12},
+         "blind 6, mean start": {"twins": 6, "twin_start": "mean"}}
 AGENT = "infant_0"
 
 
-def play(real, twin, seed: int) -> tuple[str, bool, float]:
+def play(real, twin, seed: int, blind=None) -> tuple[str, bool, float]:
     """One episode: (target part, success, return)."""
-    controller = SocialTouchController()
+    controller = SocialTouchController(**(blind or {}))
     obs, _ = real.reset(seed=seed)
     rng = np.random.default_rng(seed)
     if twin is None:
@@ -62,16 +72,17 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--episodes", type=int, default=60)
     p.add_argument("--seed", type=int, default=1000)
-    p.add_argument("--rows", nargs="+", default=list(ROWS), choices=list(ROWS))
+    p.add_argument("--rows", nargs="+", default=list(ROWS), choices=list(ROWS) + list(BLIND))
     args = p.parse_args()
     real = social_touch_v0.scripted_env()
     print(f"social_touch: {args.episodes} episodes per row, seeds {args.seed}.."
           f"{args.seed + args.episodes - 1}")
     for row in args.rows:
-        twin = None if ROWS[row] is None else social_touch_v0.scripted_env(task_options=ROWS[row])
+        options = ROWS.get(row)
+        twin = None if options is None else social_touch_v0.scripted_env(task_options=options)
         per_target, returns = defaultdict(list), []
         for k in tqdm(range(args.episodes), desc=row, leave=False):
-            target, ok, ret = play(real, twin, args.seed + k)
+            target, ok, ret = play(real, twin, args.seed + k, BLIND.get(row))
             per_target[target].append(ok)
             returns.append(ret)
         wins = sum(sum(v) for v in per_target.values())
