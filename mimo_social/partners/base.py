@@ -20,8 +20,9 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..core.env import MimoParallelEnv
 
 __all__ = ["Partner", "Still", "zero_action", "agent_index", "require_motors", "require_prop",
-           "pd_gains", "motor_action", "torque_controls", "follow_waypoints", "check_angles",
-           "check_variants", "TorqueMotors", "agent_motors", "torque_motors", "push_torques"]
+           "pd_gains", "motor_action", "torque_controls", "follow_waypoints", "servo_waypoints",
+           "check_angles", "check_variants", "TorqueMotors", "agent_motors", "torque_motors",
+           "push_torques"]
 
 
 def zero_action(space: spaces.Space):
@@ -124,15 +125,32 @@ def follow_waypoints(data, waypoints, state: list, hold_steps: int, tolerance: f
     ``state`` = [waypoint index, steps spent at it, target angles] is advanced in place: to the
     next waypoint after ``hold_steps`` steps or once every joint is within ``tolerance`` (rad)."""
     q = data.qpos[qpos_adr]
+    _advance(waypoints, state, q, hold_steps, tolerance)
+    tau = kp * (state[2] - q) - kd * data.qvel[dof_adr]
+    tau += data.qfrc_bias[dof_adr] - data.qfrc_spring[dof_adr]
+    return np.clip(np.where(tau >= 0, tau / torque_pos, tau / torque_neg), -1.0, 1.0)
+
+
+def _advance(waypoints, state: list, q, hold_steps: int, tolerance: float) -> None:
+    """The walk's state (see :func:`follow_waypoints`) advanced by one step at angles ``q``."""
     state[1] += 1
     if state[0] < len(waypoints) - 1 and (
             state[1] >= hold_steps or np.max(np.abs(state[2] - q)) < tolerance):
         state[0] += 1
         state[1] = 0
         state[2] = waypoints[state[0]]
-    tau = kp * (state[2] - q) - kd * data.qvel[dof_adr]
-    tau += data.qfrc_bias[dof_adr] - data.qfrc_spring[dof_adr]
-    return np.clip(np.where(tau >= 0, tau / torque_pos, tau / torque_neg), -1.0, 1.0)
+
+
+def servo_waypoints(data, waypoints, state: list, hold_steps: int, tolerance: float, qpos_adr,
+                    dof_adr, servo_kp, lo, hi) -> np.ndarray:
+    """:func:`follow_waypoints` for positional actuation: the controls (in [-1, 1] of each
+    joint's range) whose target angle is the current waypoint plus the gravity / Coriolis
+    torque over the servo's stiffness ``servo_kp`` (the servo cancels the passive spring
+    itself), so the joint comes to rest on the waypoint under load; ``state`` advances as
+    there."""
+    _advance(waypoints, state, data.qpos[qpos_adr], hold_steps, tolerance)
+    target = state[2] + data.qfrc_bias[dof_adr] / servo_kp
+    return np.clip(2.0 * (target - lo) / (hi - lo) - 1.0, -1.0, 1.0)
 
 
 class TorqueMotors:

@@ -32,8 +32,11 @@ arm:
     ratio ``damping`` 1), plus gravity / Coriolis and passive-spring compensation (``qfrc_bias``,
     ``qfrc_spring``); ``u = tau / T_max`` clipped to [-1, 1]; the waypoint advances when every joint
     is within ``tolerance`` (0.1 rad) or after ``hold_steps`` (60)
+    With positional actuation (``per_agent=[{"actuation": "positional"}, ...]``) the action is
+    the waypoint itself, plus the gravity / Coriolis torque over the servo's stiffness, as the
+    target angle (the servo tracks it); the waypoints advance alike
 fingers:
-    held straight by the same PD
+    held straight by the same PD (positional: targeted straight)
 state:
     ``target_part``, ``waypoints``, ``variant`` (the plan kept), ``planned_steps`` (steps to the
     touch on the scratch world; inf: no plan touched the target first; blind: the mean over the
@@ -60,7 +63,7 @@ from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
 from ...core.kinematics import hand_geoms
 from ...util.checks import check_choice, check_int, check_number
 from ...partners.base import (Partner, agent_index, check_variants, follow_waypoints, motor_action,
-                    pd_gains, require_motors)
+                    pd_gains, require_motors, servo_waypoints)
 
 __all__ = [
     "BACK_COS",
@@ -407,9 +410,12 @@ class SocialTouchController(Partner):
         require_motors(self.who, agent, a, ARM,
                        "it needs the right arm's motors (shoulder, elbow, wrist) in its action")
         act = env.actuation[i]
-        if act.name == "muscle":
-            raise ValueError(f"{self.who}: {agent} is muscle-actuated; allowed actuation: "
-                             "'spring_damper' (the task's)")
+        if act.name not in ("spring_damper", "positional"):
+            raise ValueError(f"{self.who}: {agent} has actuation={act.name!r}; allowed: "
+                             "'spring_damper' (the task's) or 'positional'")
+        self._servo = act.name == "positional"
+        if self._servo:
+            self._servo_kp = act.gains(m)[0]
         self._i, self._j, self._a = i, 1 - i, a
         k = a.actuated_joint_idx
         self._qadr, self._dadr = a.qpos_adr[k], a.dof_adr[k]
@@ -587,7 +593,9 @@ class SocialTouchController(Partner):
         mujoco.mj_forward(m, d)
         state = [0, 0, waypoints[0]]
         for step in range(1, max_steps + 1):
-            d.ctrl[self._act.actuator_ids] = self._act.torque(self._control(d, waypoints, state))
+            u = self._control(d, waypoints, state)
+            d.ctrl[self._act.actuator_ids] = (self._act.targets(u) if self._servo
+                                              else self._act.torque(u))
             for _ in range(frame_skip):
                 mujoco.mj_step(m, d)
             mujoco.mj_kinematics(m, d)
@@ -599,6 +607,9 @@ class SocialTouchController(Partner):
     def _control(self, d, waypoints, state) -> np.ndarray:
         """The controls of one step (PD + compensation toward the current waypoint); ``state``
         [waypoint, steps in it, target angles] is advanced in place."""
+        if self._servo:
+            return servo_waypoints(d, waypoints, state, self.hold_steps, self.tolerance,
+                                   self._qadr, self._dadr, self._servo_kp, self._lo, self._hi)
         return follow_waypoints(d, waypoints, state, self.hold_steps, self.tolerance, self._qadr,
                                 self._dadr, self._kp, self._kd, self._tneg, self._tpos)
 
