@@ -1,0 +1,111 @@
+"""Can a CNN read from the learner's eyes which toy its partner looks at? A supervised probe.
+
+Joint attention's clones fit their demonstrations and fail new toy placements (issue 30): is the
+partner's gaze readable at all from the learner's 96x96 eye images by the recipe's CNN, given
+this many episodes? This probe records ``--episodes`` episodes of the scripted follower
+(``GazeFollowController``, with DART noise ``--noise`` so the learner's own gaze varies), keeps
+every ``--every``-th step at which the partner looks at a toy and the learner does not (yet)
+look at that toy, labelled with that toy (the task's ``target`` info: 4 toys, each its own
+colour; off the target, the toy in the middle of the learner's view does not give the answer
+away: the image must be read for the partner's gaze), and trains the recipe's image encoder
+(:class:`~mimo_social.train.encoders.EyesExtractor`: both eyes and the normalised vector)
+with a linear head to name the toy (cross-entropy, Adam). Episodes are split: the last
+``--test`` episodes are never trained on, so their accuracy measures reading new placements.
+Chance: the share of the most frequent toy. Prints per epoch the train and test accuracy.
+
+    OMP_NUM_THREADS=1 python3 scripts/joint_attention_probe.py --episodes 200 --test 40 \
+        --every 10 --epochs 10
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+import torch
+
+from mimo_social.train.demonstrations import Demonstrator, demonstrator
+from mimo_social.train.envs import make_env
+from mimo_social.train.encoders import EyesExtractor
+
+
+def record(env, episodes: int, every: int, noise: float, first: int):
+    """Observations at every ``every``-th step with a target the learner does not look at,
+    their toy and episode."""
+    teacher = Demonstrator(demonstrator("joint_attention"), env, noise)
+    obs_list, labels, episode = [], [], []
+    for k in range(episodes):
+        obs, info = env.reset(seed=first + k)
+        teacher.reset(env, "infant_0", np.random.default_rng(first + k))
+        step, done = 0, False
+        while not done:
+            action = teacher.act(env, "infant_0", obs)
+            obs, _, term, trunc, info = env.step(action)
+            done = term or trunc
+            step += 1
+            if info["target"] >= 0 and info["looked_at"] != info["target"] \
+                    and step % every == 0:
+                obs_list.append({key: np.array(v) for key, v in obs.items()})
+                labels.append(int(info["target"]))
+                episode.append(k)
+        teacher.obs.clear()
+        teacher.actions.clear()
+    stacked = {key: np.stack([o[key] for o in obs_list]) for key in obs_list[0]}
+    return stacked, np.array(labels), np.array(episode)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--episodes", type=int, default=200)
+    p.add_argument("--test", type=int, default=40, help="the last episodes, held out")
+    p.add_argument("--every", type=int, default=10)
+    p.add_argument("--noise", type=float, default=0.1)
+    p.add_argument("--epochs", type=int, default=10)
+    p.add_argument("--lr", type=float, default=3e-4)
+    p.add_argument("--seed", type=int, default=20_000)
+    a = p.parse_args(argv)
+    torch.set_num_threads(1)
+    torch.manual_seed(0)
+    env = make_env("joint_attention")
+    t0 = time.time()
+    obs, y, ep = record(env, a.episodes, a.every, a.noise, a.seed)
+    train, test = ep < a.episodes - a.test, ep >= a.episodes - a.test
+    print(f"{len(y)} labelled steps ({train.sum()} train, {test.sum()} test) from {a.episodes} "
+          f"episodes in {time.time() - t0:.0f} s; toys {np.bincount(y, minlength=4).tolist()}; "
+          f"chance (most frequent toy, test) {np.bincount(y[test]).max() / test.sum():.2f}",
+          flush=True)
+    encoder = EyesExtractor(env.observation_space, normalize_vector=True, norm_min_std=0.01)
+    head = torch.nn.Linear(encoder.features_dim, 4)
+    params = list(encoder.parameters()) + list(head.parameters())
+    optimiser = torch.optim.Adam(params, lr=a.lr)
+    tensors = {k: torch.as_tensor(v) for k, v in obs.items()}
+    target = torch.as_tensor(y)
+    rng = np.random.default_rng(0)
+
+    def accuracy(mask) -> float:
+        idx = np.flatnonzero(mask)
+        right = 0
+        with torch.no_grad():
+            for s in range(0, len(idx), 256):
+                b = idx[s:s + 256]
+                logits = head(encoder({k: v[b].float() for k, v in tensors.items()}))
+                right += int((logits.argmax(1) == target[b]).sum())
+        return right / len(idx)
+
+    for epoch in range(a.epochs):
+        order = rng.permutation(np.flatnonzero(train))
+        for s in range(0, len(order), 64):
+            b = order[s:s + 64]
+            logits = head(encoder({k: v[b].float() for k, v in tensors.items()}))
+            loss = torch.nn.functional.cross_entropy(logits, target[b])
+            optimiser.zero_grad()
+            loss.backward()
+            optimiser.step()
+        print(f"epoch {epoch + 1}: train accuracy {accuracy(train):.2f}, test (new placements) "
+              f"{accuracy(test):.2f}, {time.time() - t0:.0f} s", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
