@@ -24,6 +24,8 @@ docs/baselines.md (social touch) cites:
     python3 scripts/social_touch_unseen_partner.py --episodes 60 --seed 1000
     python3 scripts/social_touch_unseen_partner.py --episodes 60 --seed 1000 \
         --rows "blind 6" "blind 12" "blind 6, mean start"
+    python3 scripts/social_touch_unseen_partner.py --episodes 60 --seed 1000 --positional \
+        --rows scripted "blind 6"
 """
 
 from __future__ import annotations
@@ -73,13 +75,17 @@ def main() -> None:
     p.add_argument("--episodes", type=int, default=60)
     p.add_argument("--seed", type=int, default=1000)
     p.add_argument("--rows", nargs="+", default=list(ROWS), choices=list(ROWS) + list(BLIND))
+    p.add_argument("--positional", action="store_true",
+                   help="the toucher's arm with positional actuation (the controller's targets)")
     args = p.parse_args()
-    real = social_touch_v0.scripted_env()
+    per_agent = [{"actuation": "positional"}, {}] if args.positional else None
+    real = social_touch_v0.scripted_env(per_agent=per_agent)
     print(f"social_touch: {args.episodes} episodes per row, seeds {args.seed}.."
           f"{args.seed + args.episodes - 1}")
     for row in args.rows:
         options = ROWS.get(row)
-        twin = None if options is None else social_touch_v0.scripted_env(task_options=options)
+        twin = None if options is None else social_touch_v0.scripted_env(
+            task_options=options, per_agent=per_agent)
         per_target, returns = defaultdict(list), []
         for k in tqdm(range(args.episodes), desc=row, leave=False):
             target, ok, ret = play(real, twin, args.seed + k, BLIND.get(row))
