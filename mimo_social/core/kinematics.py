@@ -16,7 +16,7 @@ import numpy as np
 
 from ..body.joint_groups import GAZE_JOINTS
 
-__all__ = ["LookAt", "Gaze", "reach_sites", "hand_geoms"]
+__all__ = ["LookAt", "Gaze", "reach_sites", "hand_geoms", "geoms_collide"]
 
 
 class LookAt:
@@ -141,3 +141,13 @@ def hand_geoms(world, i: int, side: int = 0) -> np.ndarray:
         if inside[m.body_parentid[b]]:
             inside[b] = True
     return a.geom_ids[inside[m.geom_bodyid[a.geom_ids]]]
+
+
+def geoms_collide(model, g1: int, g2: int) -> bool:
+    """Whether MuJoCo's collision filter lets geoms ``g1`` and ``g2`` touch: not on a parent and
+    its child body, and one's ``contype`` matching the other's ``conaffinity``."""
+    b1, b2 = int(model.geom_bodyid[g1]), int(model.geom_bodyid[g2])
+    if model.body_parentid[b1] == b2 or model.body_parentid[b2] == b1:
+        return False
+    return bool((model.geom_contype[g1] & model.geom_conaffinity[g2])
+                or (model.geom_contype[g2] & model.geom_conaffinity[g1]))

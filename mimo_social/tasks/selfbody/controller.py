@@ -43,7 +43,7 @@ import zlib
 import mujoco
 import numpy as np
 
-from ...core.kinematics import hand_geoms
+from ...core.kinematics import geoms_collide, hand_geoms
 from ...util.checks import check_int, check_number
 from ...partners.base import (Partner, agent_index, check_angles, check_variants, follow_waypoints,
                     motor_action, pd_gains)
@@ -91,7 +91,7 @@ def touch_posture(world, i: int, target_geom: int, depth: float = 0.01, iters: i
     arm = [int(g) for g in a.geom_ids if _below(m, int(m.geom_bodyid[g]), arm_root)]
     others = [int(g) for g in a.geom_ids if int(g) not in arm and int(g) != int(target_geom)]
     # pairs MuJoCo would not collide (parent-child bodies) are no obstacles
-    others_of = {g: [o for o in others if _collide(m, g, o)] for g in arm}
+    others_of = {g: [o for o in others if geoms_collide(m, g, o)] for g in arm}
     d = mujoco.MjData(m)
     d.qpos[:] = world.data.qpos
     start = d.qpos[qadr].copy() if start is None else np.asarray(start, float)
@@ -159,14 +159,6 @@ def _below(m, body: int, root: int) -> bool:
             return True
         body = int(m.body_parentid[body])
     return False
-
-
-def _collide(m, g1: int, g2: int) -> bool:
-    b1, b2 = int(m.geom_bodyid[g1]), int(m.geom_bodyid[g2])
-    if m.body_parentid[b1] == b2 or m.body_parentid[b2] == b1:
-        return False
-    return bool((m.geom_contype[g1] & m.geom_conaffinity[g2])
-                or (m.geom_contype[g2] & m.geom_conaffinity[g1]))
 
 
 def _direction(p_from, p_to, centre_to, dist) -> np.ndarray:

@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 
 from ...body.joint_groups import RIGHT_SHOULDER_ELBOW, RIGHT_WRIST
-from ...core.kinematics import hand_geoms
+from ...core.kinematics import geoms_collide, hand_geoms
 
 __all__ = ["ARM", "ArmGeometry", "BACK_COS", "SIDES", "TILT_DEG", "TOUCH_CLEARANCE", "first_touch",
            "hand_posture", "reach_posture", "side_normal", "surface_point"]
@@ -43,14 +43,6 @@ def _subtree_geoms(m, a, root: int) -> np.ndarray:
         if b != root and inside[m.body_parentid[b]]:
             inside[b] = True
     return a.geom_ids[inside[m.geom_bodyid[a.geom_ids]]]
-
-
-def _collide(m, g1: int, g2: int) -> bool:
-    b1, b2 = int(m.geom_bodyid[g1]), int(m.geom_bodyid[g2])
-    if m.body_parentid[b1] == b2 or m.body_parentid[b2] == b1:
-        return False
-    return bool((m.geom_contype[g1] & m.geom_conaffinity[g2])
-                or (m.geom_contype[g2] & m.geom_conaffinity[g1]))
 
 
 class ArmGeometry:
@@ -88,7 +80,7 @@ class ArmGeometry:
         for g in self.arm.tolist():
             hand = g in set(self.hand.tolist())
             self.obstacles[g] = np.array([o for o, t in zip(others.tolist(), is_target)
-                                          if _collide(m, g, o) and not (hand and t)], np.intp)
+                                          if geoms_collide(m, g, o) and not (hand and t)], np.intp)
 
 
 def hand_posture(world, i: int, j: int, part: str, gap: float, start=None, iters: int = 300,
