@@ -102,8 +102,8 @@ VARIANTS = (({}, {"side": "front_above"}, {"side": "above"}, {"side": "front"},
 
 
 class _Twin:
-    """A twin of the episode's world for a blind plan: the model, its own data, the agents'
-    index tables."""
+    """A twin of the episode's world for a blind plan: the episode's model, its own data, the
+    agents' index tables."""
 
     def __init__(self, model, data, agents):
         self.model, self.data, self.agents = model, data, agents
@@ -207,20 +207,14 @@ class SocialTouchController(Partner):
         self.bind(env, agent)
         self.target_part = self._part(env)
         w = env.world
-        self.twin_hits = None
-        if self.twins:
-            best = self._blind_plan(env)
-        else:
-            self._on(w)
-            best = self._best_plan(w, env)
-        self.planned_steps, _, self.variant = best
-        self.follow(best[1])
-
-    def _on(self, w) -> None:
-        """Plan and roll out on world ``w`` (the episode's or a twin)."""
+        # geom sets of the model only: the blind plan's twins, which share it, use them too
         self._geo = ArmGeometry(w, self._i, self._j, self.target_part)
         self._arm_mask[:] = False
         self._arm_mask[self._geo.arm] = True
+        self.twin_hits = None
+        best = self._blind_plan(env) if self.twins else self._best_plan(w, env)
+        self.planned_steps, _, self.variant = best
+        self.follow(best[1])
 
     def _best_plan(self, w, env) -> tuple[float, list, dict]:
         """(steps to the touch, waypoints, variant) of the first variant that touches the target
@@ -247,9 +241,9 @@ class SocialTouchController(Partner):
                              f"toucher does not sense (env.task.draw_unseen); "
                              f"{type(env.task).__name__} has none: allowed twins=0")
         w = env.world
+        m = w.model
         twins = []
         for k in range(self.twins):
-            m = w.model
             d = mujoco.MjData(m)
             d.qpos[:], d.qvel[:], d.act[:], d.ctrl[:] = w.data.qpos, w.data.qvel, w.data.act, \
                 w.data.ctrl
@@ -257,20 +251,13 @@ class SocialTouchController(Partner):
                  own_mean=self.twin_start == "mean")
             mujoco.mj_forward(m, d)
             twins.append(_Twin(m, d, w.agents))
-        found = []
-        for t in twins:
-            self._on(t)
-            found.append(self._best_plan(t, env))
-        steps = np.full((len(found), len(twins)), np.inf)
-        for k, t in enumerate(twins):
-            self._on(t)
-            for p, (_, plan, _) in enumerate(found):
-                steps[p, k] = self._rollout(t, plan, env.max_steps, env.frame_skip)
+        found = [self._best_plan(t, env) for t in twins]
+        steps = np.array([[self._rollout(t, plan, env.max_steps, env.frame_skip) for t in twins]
+                          for _, plan, _ in found])
         hits = np.isfinite(steps).sum(axis=1)
         mean = np.array([row[np.isfinite(row)].mean() if h else np.inf
                          for row, h in zip(steps, hits)])
         kept = int(np.lexsort((mean, -hits))[0])
-        self._on(w)
         self.twin_hits = int(hits[kept])
         return float(mean[kept]), found[kept][1], found[kept][2]
 
