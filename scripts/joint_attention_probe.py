@@ -15,11 +15,16 @@ Chance: the share of the most frequent toy. Prints per epoch the train and test 
 
     OMP_NUM_THREADS=1 python3 scripts/joint_attention_probe.py --episodes 200 --test 40 \
         --every 10 --epochs 10
+
+``--env-kwargs`` sets the env's options (JSON), e.g. foveated 64x64 eyes that magnify the
+partner's face at the centre of the view: ``--env-kwargs '{"per_agent": [{"vision": {"width":
+64, "height": 64, "fovea": 4}}, {}]}'``.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import time
 
 import numpy as np
@@ -64,10 +69,13 @@ def main(argv=None) -> int:
     p.add_argument("--epochs", type=int, default=10)
     p.add_argument("--lr", type=float, default=3e-4)
     p.add_argument("--seed", type=int, default=20_000)
+    p.add_argument("--env-kwargs", type=json.loads, default={},
+                   help='the env\'s options as JSON, e.g. \'{"per_agent": [{"vision": '
+                        '{"width": 64, "height": 64, "fovea": 4}}, {}]}\' (foveated eyes)')
     a = p.parse_args(argv)
     torch.set_num_threads(1)
     torch.manual_seed(0)
-    env = make_env("joint_attention")
+    env = make_env("joint_attention", **a.env_kwargs)
     t0 = time.time()
     obs, y, ep = record(env, a.episodes, a.every, a.noise, a.seed)
     train, test = ep < a.episodes - a.test, ep >= a.episodes - a.test
