@@ -22,7 +22,10 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
   drops with it);
 * ``log_std`` (PPO with a Gaussian, optional): the policy's log-std set to this value after
   cloning (SB3's initial value is 0: std 1 on actions in [-1, 1]; e.g. -1 keeps the cloned
-  mean from being drowned by the sampling noise in the first rollouts);
+  mean from being drowned by the sampling noise in the first rollouts); or a list, one value
+  per action dimension (checked against the policy's action size before any episode plays),
+  e.g. a learner with motors and a face (the flat Box: the motors, then the expression's
+  logits) with its motors precise and its face sampled: ``[-2] * 9 + [0] * 7``;
 * ``batch_size`` (64), ``lr`` (1e-3; its own optimiser, the algorithm's is untouched);
 * ``critic_epochs`` (PPO, default 0: none): after the actor, the value function is fitted for
   that many epochs to the demonstrations' discounted returns-to-go (PPO's ``gamma``; each
@@ -91,7 +94,8 @@ from .tasks import TrainInputError
 
 __all__ = ["BC_DEFAULTS", "BC_ALGOS", "DEMO_SEED", "Demonstrations", "Demonstrator", "demonstrator",
            "check_bc", "play", "record_demonstrations", "Cloner", "clone", "keep_cloning",
-           "returns_to_go", "fit_critic", "warm_start", "evaluate_after_bc"]
+           "returns_to_go", "fit_critic", "warm_start", "evaluate_after_bc", "check_log_std_size",
+           "set_log_std"]
 
 #: the settings of ``bc_kwargs`` and their defaults (``epochs``: ``bc_epochs``)
 BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None,
@@ -148,10 +152,15 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
         allowed = "mse" if algo == "sac" else ", ".join(BC_LOSSES)
         raise TrainInputError(f"bc_kwargs: loss={s['loss']!r}; allowed with {algo}: {allowed}")
     ls = s["log_std"]
-    if ls is not None and (algo != "ppo" or isinstance(ls, bool)
-                           or not isinstance(ls, (int, float)) or not math.isfinite(ls)):
+    values = ls if isinstance(ls, (list, tuple)) else [ls]
+    if ls is not None and (algo != "ppo" or not values or any(
+            isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
+            for v in values)):
         raise TrainInputError(f"bc_kwargs: log_std={ls!r}; allowed: None, or with ppo a finite "
-                              "number (the Gaussian's log-std after cloning)")
+                              "number or a non-empty list of them, one per action dimension "
+                              "(the Gaussian's log-std after cloning)")
+    if isinstance(ls, tuple):
+        s["log_std"] = list(ls)
     ce = s["critic_epochs"]
     if isinstance(ce, bool) or not isinstance(ce, int) or ce < 0 or (ce and algo != "ppo"):
         raise TrainInputError(f"bc_kwargs: critic_epochs={ce!r}; allowed: an integer >= 0 "
@@ -422,12 +431,36 @@ class Cloner:
         return float(sum(v * k for v, k in parts) / n)
 
 
-def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: float = 1e-3,
-          loss: str = "mse", seed: int = 0, log_std: float | None = None) -> dict:
-    """Trains ``model``'s policy on ``demos`` (module docstring); returns the mean loss over
-    all pairs before and after, the updates made and the kind of loss."""
+def check_log_std_size(model, log_std) -> None:
+    """A TrainInputError unless ``log_std`` (a number, a list or None) fits ``model``'s
+    policy: a list needs one value per action dimension and a Gaussian policy."""
+    if not isinstance(log_std, (list, tuple)):
+        return
+    std = getattr(model.policy, "log_std", None)
+    size = None if std is None else int(std.numel())
+    if size != len(log_std):
+        what = "its policy has no Gaussian log-std" if size is None else f"{size} of them"
+        raise TrainInputError(
+            f"bc_kwargs: log_std={list(log_std)!r} has {len(log_std)} values; allowed: one per "
+            f"action dimension of this learner ({what})")
+
+
+def set_log_std(policy, log_std) -> None:
+    """The Gaussian policy's log-std set to ``log_std``: one number for every dimension, or
+    one per dimension (:func:`check_log_std_size` checked the size)."""
     import torch
 
+    with torch.no_grad():
+        if isinstance(log_std, (list, tuple)):
+            policy.log_std.copy_(torch.as_tensor(log_std, dtype=policy.log_std.dtype))
+        else:
+            policy.log_std.fill_(float(log_std))
+
+
+def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: float = 1e-3,
+          loss: str = "mse", seed: int = 0, log_std: float | list | None = None) -> dict:
+    """Trains ``model``'s policy on ``demos`` (module docstring); returns the mean loss over
+    all pairs before and after, the updates made and the kind of loss."""
     cloner = Cloner(model, demos, lr, loss)
     before = cloner.mean_loss()
     rng = np.random.default_rng(seed)
@@ -440,8 +473,7 @@ def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: f
             updates += 1
     after = cloner.mean_loss()
     if log_std is not None:
-        with torch.no_grad():
-            cloner.policy.log_std.fill_(float(log_std))
+        set_log_std(cloner.policy, log_std)
     cloner.policy.set_training_mode(False)
     return {"loss": cloner.kind, "loss_before": before, "loss_after": after, "updates": updates}
 
@@ -490,6 +522,7 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
     """Records ``settings["episodes"]`` controller episodes on ``env`` (seeds from
     ``DEMO_SEED + seed``) and clones them into ``model`` (:func:`clone`); returns what
     config.json records under ``bc``, and the demonstrations."""
+    check_log_std_size(model, settings["log_std"])
     t0 = time.perf_counter()
     demos = record_demonstrations(task, env, int(settings["episodes"]), DEMO_SEED + int(seed),
                                   settings.get("controller"), settings.get("noise", 0.0))

@@ -103,10 +103,22 @@ def test_sac_s_actor_and_the_log_std_after_cloning():
         ppo = PPO("MlpPolicy", env, seed=0, device="cpu")
         clone(ppo, demos, 1, seed=0, log_std=-1.5)
         assert torch.allclose(ppo.policy.log_std, torch.full_like(ppo.policy.log_std, -1.5))
+        per_dim = [-2.0] * (env.action_space.shape[0] - 1) + [0.5]
+        clone(ppo, demos, 1, seed=0, log_std=per_dim)
+        assert ppo.policy.log_std.tolist() == per_dim
         nll = clone(PPO("MlpPolicy", env, seed=0, device="cpu"), demos, 5, loss="nll")
         assert nll["loss"] == "nll" and nll["loss_after"] < nll["loss_before"]
     finally:
         env.close()
+
+
+def test_a_per_dimension_log_std_of_the_wrong_size_is_refused_before_any_episode(tmp_path):
+    with pytest.raises(TrainInputError) as err:
+        train("reach", "ppo", 512, 0, tmp_path / "run", progress=False, n_envs=1, n_cpus=0,
+              algo_kwargs={"n_steps": 256}, bc_episodes=2, bc_kwargs={"log_std": [-1.0, -2.0]})
+    msg = str(err.value)
+    assert "log_std=[-1.0, -2.0] has 2 values" in msg and "one per action dimension" in msg
+    assert not (tmp_path / "run" / "progress.csv").exists()
 
 
 def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_path, capfd):
@@ -137,6 +149,9 @@ def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_pa
     ({"bc_episodes": 0, "bc_kwargs": {"lr": 0.1}}, ["without bc_episodes"]),
     ({"bc_episodes": 2, "algo": "sac", "bc_kwargs": {"loss": "nll"}}, ["with sac: mse"]),
     ({"bc_episodes": 2, "algo": "sac", "bc_kwargs": {"log_std": -1}}, ["log_std=-1", "ppo"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"log_std": []}}, ["log_std=[]", "one per action"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"log_std": [-1, "a"]}}, ["log_std=[-1, 'a']", "finite"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"log_std": [-1, float("nan")]}}, ["log_std=", "finite"]),
     ({"bc_episodes": 2, "algo": "sac", "bc_kwargs": {"critic_epochs": 3}},
      ["critic_epochs=3", "with ppo only"]),
     ({"bc_episodes": 2, "bc_kwargs": {"critic_epochs": -1}}, ["critic_epochs=-1", ">= 0"]),
