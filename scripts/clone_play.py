@@ -29,6 +29,7 @@ import torch
 from stable_baselines3 import PPO
 from stable_baselines3.common.vec_env import DummyVecEnv
 
+from mimo_social.cli._args import env_kwargs
 from mimo_social.core.episodes import run_episode
 from mimo_social.train.dagger import Labeller
 from mimo_social.train.demonstrations import clone, demonstrator, record_demonstrations
@@ -49,7 +50,7 @@ def main(argv=None) -> int:
     p.add_argument("--obs-min-std", type=float, default=0.0)
     p.add_argument("--play", type=int, default=20, help="fresh episodes the clone plays")
     p.add_argument("--seed", type=int, default=1000)
-    p.add_argument("--env-kwargs", type=json.loads, default={},
+    p.add_argument("--env-kwargs", type=env_kwargs, default={},
                    help="JSON keyword arguments of the learner's env (a recipe's env_kwargs)")
     a = p.parse_args(argv)
     torch.set_num_threads(1)

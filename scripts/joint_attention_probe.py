@@ -24,12 +24,12 @@ partner's face at the centre of the view: ``--env-kwargs '{"per_agent": [{"visio
 from __future__ import annotations
 
 import argparse
-import json
 import time
 
 import numpy as np
 import torch
 
+from mimo_social.cli._args import env_kwargs
 from mimo_social.train.demonstrations import Demonstrator, demonstrator
 from mimo_social.train.envs import make_env
 from mimo_social.train.encoders import EyesExtractor
@@ -56,6 +56,9 @@ def record(env, episodes: int, every: int, noise: float, first: int):
                 episode.append(k)
         teacher.obs.clear()
         teacher.actions.clear()
+    if not obs_list:
+        raise SystemExit(f"joint_attention_probe: no labelled step in {episodes} episodes at "
+                         f"--every {every}; allowed: more episodes or a smaller --every")
     stacked = {key: np.stack([o[key] for o in obs_list]) for key in obs_list[0]}
     return stacked, np.array(labels), np.array(episode)
 
@@ -69,7 +72,7 @@ def main(argv=None) -> int:
     p.add_argument("--epochs", type=int, default=10)
     p.add_argument("--lr", type=float, default=3e-4)
     p.add_argument("--seed", type=int, default=20_000)
-    p.add_argument("--env-kwargs", type=json.loads, default={},
+    p.add_argument("--env-kwargs", type=env_kwargs, default={},
                    help='the env\'s options as JSON, e.g. \'{"per_agent": [{"vision": '
                         '{"width": 64, "height": 64, "fovea": 4}}, {}]}\' (foveated eyes)')
     a = p.parse_args(argv)
