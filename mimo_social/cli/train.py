@@ -8,6 +8,8 @@
     ``--algo-kwargs '{"n_steps": 512}'`` and ``--env-kwargs '{"max_steps": 200}'`` override.
     ``--algo recurrent_ppo``: sb3-contrib's RecurrentPPO (an LSTM policy: memory);
     ``--normalize-reward``: SB3's VecNormalize on the rewards, saved as ``vecnormalize.pkl``.
+    ``--categorical-heads``: the face (and voice) sampled as categorical choices beside the
+    Gaussian motors (:mod:`mimo_social.train.categorical_heads`).
     ``--curriculum selfbody`` (env options by stage) and ``--bc-episodes N`` (a warm start
     cloned from the scripted controller): docs/training.md. ``--growth forward:1-12`` (the
     infant's age by training step: forward, inverse or stochastic): docs/training.md, "Growth".
@@ -108,6 +110,7 @@ def _engine_conflicts(args) -> str | None:
         return (f"{', '.join(bad)}: for --engine sb3; with --engine rllib use --num-env-runners "
                 "and --num-envs-per-runner")
     bad = [f for f, k, d in (("--normalize-reward", "normalize_reward", False),
+                             ("--categorical-heads", "categorical_heads", False),
                              ("--obs-min-std", "obs_min_std", None),
                              ("--algo recurrent_ppo", "algo", None),
                              ("--curriculum", "curriculum", None),
@@ -151,6 +154,8 @@ def _sb3_train_kwargs(args) -> dict:
         kw["frame_stack"] = args.frame_stack
     if getattr(args, "normalize_reward", False):
         kw["normalize_reward"] = True
+    if getattr(args, "categorical_heads", False):
+        kw["categorical_heads"] = True
     if getattr(args, "obs_min_std", None) is not None:
         kw["obs_min_std"] = args.obs_min_std
     for key in ("curriculum", "bc_episodes", "bc_epochs", "bc_kwargs", "growth"):
@@ -417,6 +422,9 @@ def add_parser(subparsers) -> None:
                    "learner sees by a running estimate of the return's spread (SB3's "
                    "VecNormalize, saved as vecnormalize.pkl next to each model; evaluations "
                    "report the env's own returns); not with --mode independent")
+    p.add_argument("--categorical-heads", action="store_true", help="PPO, A2C: the learner's "
+                   "face (and voice) sampled as categorical choices beside its Gaussian motors "
+                   "instead of as Gaussian logits (docs/training.md, 'Categorical heads')")
     p.add_argument("--worker-timeout", type=positive_float, default=None, metavar="SECONDS",
                    help="an env worker process that does not answer within this time is an "
                    "error naming it (default 600)")

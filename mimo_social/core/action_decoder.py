@@ -122,6 +122,20 @@ class ActionDecoder:
         self.space = spaces.Box(np.asarray(low, np.float32), np.asarray(high, np.float32),
                                 dtype=np.float32)
 
+    @property
+    def categorical_groups(self) -> tuple[tuple[int, int], ...]:
+        """The flat ``Box``'s logit groups as ``(start, n)``: the expression's, then the
+        voice's; ``()`` for a ``Box`` of motors and for a ``Discrete`` (face- or voice-only)
+        action."""
+        if self.discrete:
+            return ()
+        groups, start = [], self.n_motors
+        for n in (self.n_expressions, self.n_voices):
+            if n:
+                groups.append((start, n))
+                start += n
+        return tuple(groups)
+
     def __call__(self, action, who: str = "agent"):
         if self.voice_only:
             kind = _one_id(action, who, "voice", "sound", self.voice_start, self.n_voices,

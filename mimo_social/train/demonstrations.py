@@ -25,7 +25,10 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
   mean from being drowned by the sampling noise in the first rollouts); or a list, one value
   per action dimension (checked against the policy's action size before any episode plays),
   e.g. a learner with motors and a face (the flat Box: the motors, then the expression's
-  logits) with its motors precise and its face sampled: ``[-2] * 9 + [0] * 7``;
+  logits) with its motors precise and its face sampled: ``[-2] * 9 + [0] * 7``; with
+  categorical heads (``categorical_heads``, :mod:`~mimo_social.train.categorical_heads`) the
+  face is a categorical choice, cloned by cross-entropy beside the motors' squared error
+  (``mse``), and the list has one value per motor (``[-2] * 9``);
 * ``batch_size`` (64), ``lr`` (1e-3; its own optimiser, the algorithm's is untouched);
 * ``critic_epochs`` (PPO, default 0: none): after the actor, the value function is fitted for
   that many epochs to the demonstrations' discounted returns-to-go (PPO's ``gamma``; each
@@ -400,6 +403,8 @@ class Cloner:
         self.sac = _is_sac(policy)
         self.discrete = isinstance(model.action_space, spaces.Discrete)
         self.kind = "cross-entropy" if self.discrete else ("mse" if self.sac else loss)
+        if self.kind == "mse" and hasattr(getattr(policy, "action_dist", None), "clone_loss"):
+            self.kind = "mse + cross-entropy"
         params = list(policy.actor.parameters()) if self.sac else list(policy.parameters())
         self.optimiser = torch.optim.Adam(params, lr=lr)
         self.targets = policy.scale_action(demos.actions) if self.sac else demos.actions
@@ -415,6 +420,8 @@ class Cloner:
             return -dist.log_prob(act.long()).mean()
         if self.loss_name == "nll":
             return -dist.log_prob(act.float()).mean()
+        if hasattr(dist, "clone_loss"):     # categorical heads: mse on motors + cross-entropy
+            return dist.clone_loss(act.float())
         return torch.mean((dist.mode() - act.float()) ** 2)
 
     def step(self, idx) -> None:
@@ -433,13 +440,17 @@ class Cloner:
 
 def check_log_std_size(model, log_std) -> None:
     """A TrainInputError unless ``log_std`` (a number, a list or None) fits ``model``'s
-    policy: a list needs one value per action dimension and a Gaussian policy."""
+    policy: a list needs one value per Gaussian action dimension (with categorical heads: per
+    motor) and a Gaussian policy."""
     if not isinstance(log_std, (list, tuple)):
         return
     std = getattr(model.policy, "log_std", None)
     size = None if std is None else int(std.numel())
     if size != len(log_std):
-        what = "its policy has no Gaussian log-std" if size is None else f"{size} of them"
+        what = ("its policy has no Gaussian log-std" if size is None else f"{size} of them"
+                + ("; the motors: the face and voice are categorical heads"
+                   if hasattr(getattr(model.policy, "action_dist", None), "clone_loss")
+                   else ""))
         raise TrainInputError(
             f"bc_kwargs: log_std={list(log_std)!r} has {len(log_std)} values; allowed: one per "
             f"action dimension of this learner ({what})")

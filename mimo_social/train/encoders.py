@@ -153,7 +153,7 @@ RECURRENT_POLICIES = {"MlpPolicy": "MlpLstmPolicy", "MultiInputPolicy": "MultiIn
 
 def policy_for(observation_space: spaces.Space, algo_kwargs: dict,
                normalize_obs: bool = False, recurrent: bool = False,
-               min_std: float = 0.0) -> tuple[str, dict]:
+               min_std: float = 0.0, categorical_groups=None) -> tuple[Any, dict]:
     """What the trainers build: the SB3 policy name and the algorithm's keyword arguments for
     an observation space. Images: :func:`policy_spec`'s ``MultiInputPolicy`` with the CNN
     (``normalize_obs``: running statistics over the ``"vector"`` part); otherwise
@@ -162,7 +162,9 @@ def policy_for(observation_space: spaces.Space, algo_kwargs: dict,
     scale (``--obs-min-std``). ``recurrent`` (``--algo recurrent_ppo``): the LSTM policies of
     sb3-contrib, ``MultiInputLstmPolicy`` (the same CNN in front of the LSTM) and
     ``MlpLstmPolicy``. The ``policy_kwargs`` of ``algo_kwargs`` (the shipped hyperparameters and the command line's)
-    are merged over these."""
+    are merged over these. ``categorical_groups`` (the learner's logit groups, ``[[start, n],
+    ...]``): the policy is :class:`~mimo_social.train.categorical_heads.CategoricalHeadsPolicy`
+    (the class, not a name) with them among its ``policy_kwargs``."""
     kwargs = dict(algo_kwargs)
     own = dict(kwargs.pop("policy_kwargs", None) or {})
     if image_space_keys(observation_space):
@@ -177,6 +179,12 @@ def policy_for(observation_space: spaces.Space, algo_kwargs: dict,
             if min_std:
                 base["features_extractor_kwargs"] = {"min_std": float(min_std)}
     merged = {**base, **own}
+    if categorical_groups:
+        from .categorical_heads import CategoricalHeadsPolicy
+        if recurrent:
+            raise ValueError("categorical heads are not for a recurrent policy")
+        merged["categorical_groups"] = [list(g) for g in categorical_groups]
+        return CategoricalHeadsPolicy, {**kwargs, "policy_kwargs": merged}
     if merged:
         kwargs["policy_kwargs"] = merged
     return (RECURRENT_POLICIES[policy] if recurrent else policy), kwargs

@@ -105,6 +105,14 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
             raise
     agents = list(eval_env.possible_agents)
     config["agents"] = agents
+    if config.get("categorical_heads"):
+        from .categorical_heads import learner_groups
+        try:
+            config["categorical_groups"] = learner_groups(
+                eval_env.unwrapped.action_space(agents[0]), agents[0])
+        except TrainInputError:
+            eval_env.close()
+            raise
     if (mode == "shared" and algo == "sac"
             and algo_kwargs.get("buffer_size") == min(1_000_000, steps)
             and "buffer_size" not in config.get("algo_kwargs_given", ())):

@@ -90,7 +90,7 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
           obs_min_std: float = 0.0, worker_timeout: float = 600.0, normalize_reward: bool = False,
           curriculum=None, bc_episodes: int = 0, bc_epochs: int = 20, intrinsic=None,
           bc_kwargs: Mapping[str, Any] | None = None, recipe: str | None = None,
-          growth=None) -> dict:
+          growth=None, categorical_heads: bool = False) -> dict:
     """Train one policy (or one per agent); returns a summary (paths, last evaluation, wall
     time). See the module docstring for what it writes.
 
@@ -123,7 +123,9 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
     run follows (:mod:`mimo_social.train.recipes`), recorded in ``config.json``. ``growth``
     (one-agent tasks): the infant's age as training goes, a spec such as ``"forward:1-12"``
     or a :class:`~mimo_social.train.growth.Growth` (:mod:`mimo_social.train.growth`; a
-    curriculum file may give it instead)."""
+    curriculum file may give it instead). ``categorical_heads`` (PPO, A2C; one learner or
+    ``shared``): the learner's face and voice logits sampled as categorical choices beside its
+    Gaussian motors (:mod:`mimo_social.train.categorical_heads`)."""
     from .hyperparams import resolve, run_options, to_json, to_sb3
 
     mode = check_mode(task, mode)
@@ -146,6 +148,8 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
         raise TrainInputError(f"frame_stack={frame_stack} stacks eye images for the CNN: not "
                               "with flat observations (--flat-obs, or --mode shared / "
                               "independent, whose observations are flat)")
+    from .categorical_heads import check_categorical_heads
+    check_categorical_heads(categorical_heads, algo, mode)
     # the shipped hyperparameters under the command line's, every key checked: before anything
     resolved, provenance = resolve(task, algo, algo_kwargs, mode=mode, steps=steps)
     if normalize_obs is None:
@@ -209,6 +213,8 @@ def train(task: str, algo: str, steps: int, seed: int, out: str | Path, *,
               "algo_kwargs_provenance": provenance, "eval_every": eval_every,
               "eval_episodes": eval_episodes, "checkpoint_every": checkpoint_every,
               "algo_kwargs_given": sorted(algo_kwargs or {})}
+    if categorical_heads:
+        config["categorical_heads"] = True
     if recipe is not None:
         config["recipe"] = str(recipe)
     if bc is not None:

@@ -32,6 +32,7 @@ from .interrupt import StopSignals
 from .progress import write_config
 from .rollouts import evaluate_policy, vecnormalize_path
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
+from .tasks import TrainInputError
 
 __all__ = ["train_single", "monitored_env", "vector_defaults", "warn", "reward_normalizer",
            "model_saver", "build_model", "learn_and_finish"]
@@ -115,7 +116,8 @@ def build_model(cls, algo: str, venv, config: dict, algo_kwargs: dict, seed: int
     an intrinsic bonus added to the rewards when ``config["intrinsic"]`` asks for one
     (:class:`~mimo_social.train.intrinsic.RNDBonus`), the rewards normalised when the run asks
     for it (:func:`reward_normalizer`), the policy
-    :func:`~mimo_social.train.encoders.policy_for` picks for the observation (recorded in
+    :func:`~mimo_social.train.encoders.policy_for` picks for the observation and, with
+    ``config["categorical_groups"]``, the categorical heads (its name recorded in
     ``config["policy"]``). Returns ``(venv, model, save)``: the env the model steps, the model
     and its :func:`model_saver`."""
     from .encoders import policy_for     # (torch: lazily, see train_single)
@@ -126,8 +128,9 @@ def build_model(cls, algo: str, venv, config: dict, algo_kwargs: dict, seed: int
     venv, normalizer = reward_normalizer(venv, config, algo_kwargs)
     policy, kw = policy_for(venv.observation_space, algo_kwargs,
                             bool(config.get("normalize_obs")), algo in RECURRENT_ALGOS,
-                            float(config.get("obs_min_std", 0.0)))
-    config["policy"] = policy
+                            float(config.get("obs_min_std", 0.0)),
+                            config.get("categorical_groups"))
+    config["policy"] = getattr(policy, "__name__", policy)
     model = cls(policy, venv, seed=seed, device="cpu", verbose=verbose, **kw)
     return venv, model, model_saver(model, normalizer)
 
@@ -251,6 +254,13 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
     if growth is not None:
         eval_env, env_fn = growth_envs(growth, task, observation, env_kwargs, curriculum,
                                        eval_env, steps)
+    if config.get("categorical_heads"):
+        from .categorical_heads import learner_groups
+        try:
+            config["categorical_groups"] = learner_groups(eval_env.unwrapped.action_space, task)
+        except TrainInputError:
+            eval_env.close()
+            raise
     venv = one_learner_vec_env(env_fn, int(n_envs), worker_timeout, n_workers=int(n_cpus))
     stop = StopSignals()
     try:
