@@ -22,7 +22,8 @@ from mimo_social.train.envs import make_env
 
 torch.set_num_threads(1)
 
-FACE = spaces.Dict({"motors": spaces.Box(-1, 1, (8,), np.float32), "expression": spaces.Discrete(7)})
+FACE = spaces.Dict({"motors": spaces.Box(-1, 1, (8,), np.float32),
+                    "expression": spaces.Discrete(7)})
 
 
 def _heads(groups=((8, 7),), dim=15, latent=6, log_std=-1.0, seed=0):
