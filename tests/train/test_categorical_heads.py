@@ -176,3 +176,34 @@ def test_categorical_heads_must_be_a_bool(tmp_path):
     with pytest.raises(TrainInputError, match="categorical_heads='yes'; allowed: True or False"):
         train("high_five", "ppo", 128, 0, tmp_path / "run", progress=False, mode="scripted",
               categorical_heads="yes")
+
+
+def test_the_cli_trains_with_categorical_heads_and_eval_loads_the_run(tmp_path, capsys):
+    from mimo_social import cli
+    out = tmp_path / "cli"
+    assert cli.main(["train", "--task", "high_five", "--mode", "scripted", "--algo", "ppo",
+                     "--steps", "64", "--out", str(out), "--eval-episodes", "1",
+                     "--checkpoint-every", "0", "--no-progress", "--n-envs", "1",
+                     "--categorical-heads", "--env-kwargs", '{"max_steps": 20}',
+                     "--algo-kwargs", '{"n_steps": 64, "batch_size": 32}']) == 0
+    assert json.loads((out / "config.json").read_text())["policy"] == "CategoricalHeadsPolicy"
+    assert cli.main(["eval", str(out), "--episodes", "1", "--no-progress"]) == 0
+    assert "high_five PPO" in capsys.readouterr().out
+    assert cli.main(["train", "--task", "high_five", "--engine", "rllib", "--algo", "ppo",
+                     "--steps", "64", "--out", str(tmp_path / "x"), "--categorical-heads"]) == 2
+    assert "--categorical-heads: for --engine sb3" in capsys.readouterr().err
+
+
+def test_a_shared_policy_gets_categorical_heads_for_every_agent(tmp_path):
+    """High five, --mode shared: both infants (8 motors and a face each) share one policy with
+    the face as a categorical head."""
+    from stable_baselines3 import PPO
+    out = tmp_path / "shared"
+    train("high_five", "ppo", 128, 0, out, progress=False, mode="shared", n_envs=1, n_cpus=0,
+          env_kwargs={"max_steps": 20}, algo_kwargs={"n_steps": 64, "batch_size": 32},
+          eval_episodes=1, categorical_heads=True)
+    cfg = json.loads((out / "config.json").read_text())
+    assert cfg["categorical_groups"] == [[8, 7]] and len(cfg["agents"]) == 2
+    model = PPO.load(out / "model.zip", device="cpu")
+    assert isinstance(model.policy, CategoricalHeadsPolicy)
+    assert model.policy.log_std.shape == (8,)
