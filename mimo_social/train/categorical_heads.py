@@ -49,7 +49,8 @@ from ..core.action_decoder import LOGIT_HIGH, LOGIT_LOW, ActionDecoder
 from .tasks import TrainInputError
 
 __all__ = ["CategoricalHeads", "CategoricalHeadsPolicy", "check_categorical_heads", "check_groups",
-           "learner_groups", "CATEGORICAL_ALGOS"]
+           "learner_groups", "record_learner_groups", "has_categorical_heads",
+           "CATEGORICAL_ALGOS"]
 
 #: the algorithms whose policy can have categorical heads
 CATEGORICAL_ALGOS = ("ppo", "a2c")
@@ -106,6 +107,24 @@ def learner_groups(raw_space, who: str) -> list[list[int]]:
                               f"voice) beside motors; {what}; allowed: a learner with a "
                               "Dict(motors, expression / voice) action")
     return [list(g) for g in decoder.categorical_groups]
+
+
+def record_learner_groups(config: dict, env, raw_space, who: str) -> None:
+    """``config["categorical_groups"]``: the learner's logit groups (:func:`learner_groups`),
+    for a run whose ``config`` asks for categorical heads; ``env`` (the run's evaluation env,
+    made before) is closed when the learner has none, and the TrainInputError raised."""
+    if not config.get("categorical_heads"):
+        return
+    try:
+        config["categorical_groups"] = learner_groups(raw_space, who)
+    except TrainInputError:
+        env.close()
+        raise
+
+
+def has_categorical_heads(policy) -> bool:
+    """Whether an SB3 policy's action distribution is :class:`CategoricalHeads`."""
+    return isinstance(getattr(policy, "action_dist", None), CategoricalHeads)
 
 
 class CategoricalHeads(DiagGaussianDistribution):

@@ -403,7 +403,9 @@ class Cloner:
         self.sac = _is_sac(policy)
         self.discrete = isinstance(model.action_space, spaces.Discrete)
         self.kind = "cross-entropy" if self.discrete else ("mse" if self.sac else loss)
-        if self.kind == "mse" and hasattr(getattr(policy, "action_dist", None), "clone_loss"):
+        from .categorical_heads import has_categorical_heads
+        self.heads = has_categorical_heads(policy)
+        if self.kind == "mse" and self.heads:
             self.kind = "mse + cross-entropy"
         params = list(policy.actor.parameters()) if self.sac else list(policy.parameters())
         self.optimiser = torch.optim.Adam(params, lr=lr)
@@ -420,7 +422,7 @@ class Cloner:
             return -dist.log_prob(act.long()).mean()
         if self.loss_name == "nll":
             return -dist.log_prob(act.float()).mean()
-        if hasattr(dist, "clone_loss"):     # categorical heads: mse on motors + cross-entropy
+        if self.heads:     # categorical heads: mse on the motors + the face's cross-entropy
             return dist.clone_loss(act.float())
         return torch.mean((dist.mode() - act.float()) ** 2)
 
@@ -447,10 +449,10 @@ def check_log_std_size(model, log_std) -> None:
     std = getattr(model.policy, "log_std", None)
     size = None if std is None else int(std.numel())
     if size != len(log_std):
+        from .categorical_heads import has_categorical_heads
         what = ("its policy has no Gaussian log-std" if size is None else f"{size} of them"
                 + ("; the motors: the face and voice are categorical heads"
-                   if hasattr(getattr(model.policy, "action_dist", None), "clone_loss")
-                   else ""))
+                   if has_categorical_heads(model.policy) else ""))
         raise TrainInputError(
             f"bc_kwargs: log_std={list(log_std)!r} has {len(log_std)} values; allowed: one per "
             f"action dimension of this learner ({what})")

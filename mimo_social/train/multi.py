@@ -106,13 +106,9 @@ def train_multi(task: str, algo: str, steps: int, seed: int, out: Path, *, mode:
     agents = list(eval_env.possible_agents)
     config["agents"] = agents
     if config.get("categorical_heads"):
-        from .categorical_heads import learner_groups
-        try:
-            config["categorical_groups"] = learner_groups(
-                eval_env.unwrapped.action_space(agents[0]), agents[0])
-        except TrainInputError:
-            eval_env.close()
-            raise
+        from .categorical_heads import record_learner_groups
+        record_learner_groups(config, eval_env, eval_env.unwrapped.action_space(agents[0]),
+                              agents[0])
     if (mode == "shared" and algo == "sac"
             and algo_kwargs.get("buffer_size") == min(1_000_000, steps)
             and "buffer_size" not in config.get("algo_kwargs_given", ())):

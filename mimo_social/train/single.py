@@ -32,7 +32,6 @@ from .interrupt import StopSignals
 from .progress import write_config
 from .rollouts import evaluate_policy, vecnormalize_path
 from .runlog import RunLog, Schedule, episode_limit, first_update, rounding_note, sb3_callback
-from .tasks import TrainInputError
 
 __all__ = ["train_single", "monitored_env", "vector_defaults", "warn", "reward_normalizer",
            "model_saver", "build_model", "learn_and_finish"]
@@ -255,12 +254,8 @@ def train_single(cls, task: str, steps: int, seed: int, out: Path, *, eval_every
         eval_env, env_fn = growth_envs(growth, task, observation, env_kwargs, curriculum,
                                        eval_env, steps)
     if config.get("categorical_heads"):
-        from .categorical_heads import learner_groups
-        try:
-            config["categorical_groups"] = learner_groups(eval_env.unwrapped.action_space, task)
-        except TrainInputError:
-            eval_env.close()
-            raise
+        from .categorical_heads import record_learner_groups
+        record_learner_groups(config, eval_env, eval_env.unwrapped.action_space, task)
     venv = one_learner_vec_env(env_fn, int(n_envs), worker_timeout, n_workers=int(n_cpus))
     stop = StopSignals()
     try:
