@@ -34,8 +34,8 @@ DAGGER_SEED = 30_000
 class Labeller(Demonstrator):
     """The model's mean action plays; the controller labels each observation it meets."""
 
-    def __init__(self, controller_cls, env, model):
-        super().__init__(controller_cls, env)
+    def __init__(self, controller_cls, env, model, aux_label: str | None = None):
+        super().__init__(controller_cls, env, aux_label=aux_label)
         self.model = model
 
     def act(self, env, agent: str, obs):
@@ -50,10 +50,12 @@ def _joined(a: Demonstrations, b: Demonstrations) -> Demonstrations:
         obs = {k: np.concatenate([a.obs[k], b.obs[k]]) for k in a.obs}
     else:
         obs = np.concatenate([a.obs, b.obs])
+    labels = (None if a.labels is None or b.labels is None
+              else np.concatenate([a.labels, b.labels]))
     return Demonstrations(obs, np.concatenate([a.actions, b.actions]),
                           np.concatenate([a.rewards, b.rewards]),
                           np.concatenate([a.ends, b.ends]),
-                          a.seeds, a.returns, a.lengths, a.successes)
+                          a.seeds, a.returns, a.lengths, a.successes, labels)
 
 
 def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, Any],
@@ -71,7 +73,7 @@ def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, 
     rounds, best = [], None
     for r in range(int(settings["dagger_rounds"]) + 1):
         first = DAGGER_SEED + int(seed) + 1000 * r
-        played = play(Labeller(controller, env, model), env, first,
+        played = play(Labeller(controller, env, model, settings.get("aux_label")), env, first,
                       int(settings["dagger_episodes"]))
         demos = _joined(demos, played)
         measured = played.summary()
@@ -91,8 +93,10 @@ def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, 
         if r < int(settings["dagger_rounds"]):
             res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
                         float(settings["lr"]), str(settings["loss"]), int(seed) + r + 1,
-                        settings["log_std"])
+                        settings["log_std"], float(settings.get("aux_weight", 1.0)))
             record["loss_after"] = res["loss_after"]
+            if "aux_accuracy_after" in res:
+                record["aux_accuracy_after"] = res["aux_accuracy_after"]
         rounds.append(record)
     model.policy.load_state_dict(best[1])
     for record in rounds:

@@ -59,6 +59,11 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
   from 97 % to 67 % (0.06: 57 %); at 6 Hz 97 % to 83 % (0.06: 80 %). Checked by making the
   controller once (its own error, named).
 
+* ``aux_label`` (default None: none) and ``aux_weight`` (1.0, PPO): each pair keeps the step's
+  ``info[aux_label]`` (an integer class) and every cloning minibatch adds the cross-entropy of
+  a linear head on the actor's last hidden layer naming it (:mod:`~mimo_social.train.auxiliary`): the
+  features extractor learns to read what the label names (which toy the partner looks at).
+
 * ``noise`` (default 0: none): the demonstrations are played with the executed action
   perturbed and the controller's own action recorded (DART, Laskey et al. 2017): a Box action
   plus Gaussian noise of that sd (clipped to the space), a ``Discrete`` one replaced by a
@@ -81,8 +86,6 @@ stable-baselines3 2.9.
 from __future__ import annotations
 
 import functools
-
-import math
 import time
 from dataclasses import dataclass
 from typing import Any, Mapping
@@ -93,112 +96,18 @@ from gymnasium import spaces
 from ..core.episodes import run_episode
 from ..core.wrappers import ActionDecoder
 from ..envs.catalog import entry
+from .auxiliary import aux_head, features_and_distribution, label_of
+from .bc_settings import BC_ALGOS, BC_DEFAULTS, BC_LOSSES, check_bc
 from .tasks import TrainInputError
 
-__all__ = ["BC_DEFAULTS", "BC_ALGOS", "DEMO_SEED", "Demonstrations", "Demonstrator", "demonstrator",
-           "check_bc", "play", "record_demonstrations", "Cloner", "clone", "keep_cloning",
+__all__ = ["BC_DEFAULTS", "BC_ALGOS", "BC_LOSSES", "DEMO_SEED", "Demonstrations", "Demonstrator",
+           "demonstrator", "check_bc", "play", "record_demonstrations", "Cloner", "clone", "keep_cloning",
            "returns_to_go", "fit_critic", "warm_start", "evaluate_after_bc", "check_log_std_size",
            "set_log_std"]
 
-#: the settings of ``bc_kwargs`` and their defaults (``epochs``: ``bc_epochs``)
-BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None,
-               "critic_epochs": 0, "keep_updates": 0, "keep_until": 0.5, "dagger_rounds": 0,
-               "dagger_episodes": 50, "controller": None, "noise": 0.0}
-BC_LOSSES = ("mse", "nll")
-BC_ALGOS = ("ppo", "sac")
 #: the demonstrations' first seed is this plus the run's seed (training: seed + i; the
 #: evaluations: 10000 + seed + k)
 DEMO_SEED = 20_000
-
-
-def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
-             kwargs: Mapping[str, Any] | None) -> dict | None:
-    """The warm start's settings, checked (None: no warm start, ``episodes`` 0); a
-    TrainInputError naming the argument, its value and what is allowed otherwise."""
-    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 0:
-        raise TrainInputError(f"bc_episodes={episodes!r}; allowed: an integer >= 0 (scripted "
-                              "episodes to clone before training; 0: none)")
-    if isinstance(epochs, bool) or not isinstance(epochs, int) or epochs < 1:
-        raise TrainInputError(f"bc_epochs={epochs!r}; allowed: an integer >= 1")
-    if kwargs is not None and not isinstance(kwargs, Mapping):
-        raise TrainInputError(f"bc_kwargs={kwargs!r}; allowed: a dict of "
-                              f"{', '.join(k for k in BC_DEFAULTS if k != 'epochs')}")
-    kwargs = dict(kwargs or {})
-    if episodes == 0:
-        if kwargs:
-            raise TrainInputError(f"bc_kwargs={kwargs!r} without bc_episodes; allowed: "
-                                  "bc_kwargs with bc_episodes >= 1")
-        return None
-    unknown = sorted(set(kwargs) - set(BC_DEFAULTS) | ({"epochs"} & set(kwargs)))
-    if unknown:
-        raise TrainInputError(f"bc_kwargs: unknown key(s) {', '.join(unknown)}; allowed: "
-                              f"{', '.join(k for k in BC_DEFAULTS if k != 'epochs')} (the "
-                              "epochs: bc_epochs)")
-    if algo not in BC_ALGOS:
-        raise TrainInputError(f"bc_episodes with algo {algo!r}; allowed: {', '.join(BC_ALGOS)} "
-                              "(a recurrent policy is cloned over whole sequences: not here)")
-    if mode not in (None, "scripted"):
-        raise TrainInputError(f"bc_episodes with --mode {mode}; allowed: one learner (a "
-                              "one-agent task, or --mode scripted): the controller drives one "
-                              "agent")
-    if entry(task).controller is None:
-        raise TrainInputError(f"bc_episodes: {task} has no scripted controller (catalogue "
-                              "entry: controller=None); allowed: tasks with one")
-    s = {**BC_DEFAULTS, **kwargs, "epochs": epochs, "episodes": episodes}
-    bs = s["batch_size"]
-    if isinstance(bs, bool) or not isinstance(bs, int) or bs < 1:
-        raise TrainInputError(f"bc_kwargs: batch_size={bs!r}; allowed: an integer >= 1")
-    lr = s["lr"]
-    if isinstance(lr, bool) or not isinstance(lr, (int, float)) or not 0 < lr < math.inf:
-        raise TrainInputError(f"bc_kwargs: lr={lr!r}; allowed: a number > 0")
-    if s["loss"] not in BC_LOSSES or (algo == "sac" and s["loss"] != "mse"):
-        allowed = "mse" if algo == "sac" else ", ".join(BC_LOSSES)
-        raise TrainInputError(f"bc_kwargs: loss={s['loss']!r}; allowed with {algo}: {allowed}")
-    ls = s["log_std"]
-    values = ls if isinstance(ls, (list, tuple)) else [ls]
-    if ls is not None and (algo != "ppo" or not values or any(
-            isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
-            for v in values)):
-        raise TrainInputError(f"bc_kwargs: log_std={ls!r}; allowed: None, or with ppo a finite "
-                              "number or a non-empty list of them, one per action dimension "
-                              "(the Gaussian's log-std after cloning)")
-    if isinstance(ls, tuple):
-        s["log_std"] = list(ls)
-    ce = s["critic_epochs"]
-    if isinstance(ce, bool) or not isinstance(ce, int) or ce < 0 or (ce and algo != "ppo"):
-        raise TrainInputError(f"bc_kwargs: critic_epochs={ce!r}; allowed: an integer >= 0 "
-                              "(> 0 with ppo only: epochs fitting its value function to the "
-                              "demonstrations' returns)")
-    nz = s["noise"]
-    if isinstance(nz, bool) or not isinstance(nz, (int, float)) or not 0 <= nz <= 1:
-        raise TrainInputError(f"bc_kwargs: noise={nz!r}; allowed: a number in [0, 1] (the sd "
-                              "of the Gaussian noise on a Box action, the chance of a random "
-                              "choice of a Discrete one, while the demonstrations play; 0: none)")
-    s["noise"] = float(nz)
-    for key in ("dagger_rounds", "dagger_episodes"):
-        v = s[key]
-        if isinstance(v, bool) or not isinstance(v, int) or v < (key == "dagger_episodes"):
-            raise TrainInputError(f"bc_kwargs: {key}={v!r}; allowed: an integer >= "
-                                  f"{int(key == 'dagger_episodes')} (DAgger: rounds of the "
-                                  "cloned policy's episodes labelled by the controller)")
-    ku, kt = s["keep_updates"], s["keep_until"]
-    if isinstance(ku, bool) or not isinstance(ku, int) or ku < 0:
-        raise TrainInputError(f"bc_kwargs: keep_updates={ku!r}; allowed: an integer >= 0 "
-                              "(behaviour-cloning minibatches after each RL update; 0: none)")
-    if isinstance(kt, bool) or not isinstance(kt, (int, float)) or not 0 < kt <= 1:
-        raise TrainInputError(f"bc_kwargs: keep_until={kt!r}; allowed: a number in (0, 1] (the "
-                              "share of the run over which keep_updates falls to 0)")
-    ck = s["controller"]
-    if ck is not None:
-        if not isinstance(ck, Mapping) or not all(isinstance(k, str) for k in ck):
-            raise TrainInputError(f"bc_kwargs: controller={ck!r}; allowed: None or a dict of "
-                                  f"{entry(task).controller.__name__}'s keyword arguments")
-        try:
-            entry(task).controller(**ck)
-        except (TypeError, ValueError) as e:
-            raise TrainInputError(f"bc_kwargs: controller={dict(ck)!r} not allowed: {e}") from None
-        s["controller"] = dict(ck)
-    return s
 
 
 def demonstrator(task: str, settings: Mapping[str, Any] | None = None):
@@ -224,6 +133,8 @@ class Demonstrations:
     returns: list[float]
     lengths: list[int]
     successes: list[bool | None]
+    labels: np.ndarray | None = None
+    """each pair's auxiliary label (``aux_label``: the step's info; -1: none), or None"""
 
     def __len__(self) -> int:
         return len(self.actions)
@@ -248,9 +159,11 @@ class Demonstrator:
     it acts on the core env under ``env`` (looked up at every reset: a curriculum's env may
     change it) and returns its action in the learner's form, recording each pair."""
 
-    def __init__(self, controller_cls, env, noise: float = 0.0):
+    def __init__(self, controller_cls, env, noise: float = 0.0, aux_label: str | None = None):
         self.controller, self.env = controller_cls(), env
         self.noise = float(noise)
+        self.aux_label = aux_label
+        self.labels: list[int] = []
         self.rng = None
         raw = env.unwrapped.action_space       # the agent's own action space
         self.decoder = ActionDecoder(raw)
@@ -261,8 +174,10 @@ class Demonstrator:
         self.rewards: list = []
 
     def on_step(self, env, obs, rewards, terminations, truncations, infos) -> None:
-        """``run_episode``'s hook: the reward of the action just recorded."""
+        """``run_episode``'s hook: the reward of the action just recorded (and its label)."""
         self.rewards.append(float(next(iter(rewards.values()))))
+        if self.aux_label is not None:
+            self.labels.append(label_of(next(iter(infos.values())), self.aux_label))
 
     def reset(self, env, agent: str, rng) -> None:
         self.core = self.env.unwrapped.parallel.unwrapped
@@ -304,22 +219,25 @@ def play(recorder: Demonstrator, env, first: int, episodes: int) -> Demonstratio
            if isinstance(recorder.obs[0], dict) else np.stack(recorder.obs))
     ends = np.zeros(len(recorder.actions), bool)
     ends[np.cumsum(lengths) - 1] = True
+    labels = (np.asarray(recorder.labels, np.int64)
+              if getattr(recorder, "aux_label", None) is not None else None)
     return Demonstrations(obs, np.stack(recorder.actions),
                           np.asarray(recorder.rewards, np.float32), ends, seeds, returns,
-                          lengths, successes)
+                          lengths, successes, labels)
 
 
 def record_demonstrations(task: str, env, episodes: int, seed: int,
                           controller: Mapping[str, Any] | None = None,
-                          noise: float = 0.0) -> Demonstrations:
+                          noise: float = 0.0, aux_label: str | None = None) -> Demonstrations:
     """``episodes`` episodes of the task's controller (made with the keyword arguments
     ``controller``, if given) on the learner's env ``env`` (seeds ``seed, seed+1, ...``; the
     controller reset with each episode's seed), the executed actions perturbed by ``noise``
-    (``bc_kwargs``, DART) and the controller's own recorded."""
+    (``bc_kwargs``, DART) and the controller's own recorded; ``aux_label``: each pair's label
+    (the step's info under that key)."""
     if entry(task).controller is None:
         raise TrainInputError(f"{task} has no scripted controller")
-    return play(Demonstrator(demonstrator(task, {"controller": controller}), env, noise), env,
-                seed, episodes)
+    return play(Demonstrator(demonstrator(task, {"controller": controller}), env, noise,
+                             aux_label), env, seed, episodes)
 
 
 def returns_to_go(rewards: np.ndarray, ends: np.ndarray, gamma: float) -> np.ndarray:
@@ -395,7 +313,8 @@ class Cloner:
     """The cloning loss of ``model``'s policy on ``demos`` (module docstring) and its own Adam
     optimiser: ``step(idx)`` one update on the pairs ``idx``, ``mean_loss()`` over all."""
 
-    def __init__(self, model, demos: Demonstrations, lr: float = 1e-3, loss: str = "mse"):
+    def __init__(self, model, demos: Demonstrations, lr: float = 1e-3, loss: str = "mse",
+                 aux_weight: float = 1.0):
         import torch
 
         self.torch, self.demos, self.loss_name = torch, demos, loss
@@ -408,6 +327,10 @@ class Cloner:
         if self.kind == "mse" and self.heads:
             self.kind = "mse + cross-entropy"
         params = list(policy.actor.parameters()) if self.sac else list(policy.parameters())
+        self.aux = None if demos.labels is None else aux_head(policy, demos.labels)
+        self.aux_weight = float(aux_weight)
+        if self.aux is not None:
+            params += list(self.aux.parameters())
         self.optimiser = torch.optim.Adam(params, lr=lr)
         self.targets = policy.scale_action(demos.actions) if self.sac else demos.actions
 
@@ -417,19 +340,37 @@ class Cloner:
         act = torch.as_tensor(np.asarray(self.targets[idx]), device=policy.device)
         if self.sac:
             return torch.mean((policy.actor(obs, deterministic=True) - act.float()) ** 2)
-        dist = policy.get_distribution(obs)
+        if self.aux is None:
+            return self.action_loss(policy.get_distribution(obs), act)
+        latent, dist = features_and_distribution(policy, obs)
+        return self.action_loss(dist, act) + self.aux_weight * self.aux.loss(
+            latent, self.demos.labels[idx])
+
+    def action_loss(self, dist, act):
         if self.discrete:
             return -dist.log_prob(act.long()).mean()
         if self.loss_name == "nll":
             return -dist.log_prob(act.float()).mean()
         if self.heads:     # categorical heads: mse on the motors + the face's cross-entropy
             return dist.clone_loss(act.float())
-        return torch.mean((dist.mode() - act.float()) ** 2)
+        return self.torch.mean((dist.mode() - act.float()) ** 2)
 
     def step(self, idx) -> None:
         self.optimiser.zero_grad()
         self.loss(idx).backward()
         self.optimiser.step()
+
+    def aux_accuracy(self) -> float | None:
+        """The auxiliary head's accuracy on every labelled pair (None: no label)."""
+        n, right, labelled = len(self.demos), 0, 0
+        self.policy.set_training_mode(False)
+        with self.torch.no_grad():
+            for idx in np.array_split(np.arange(n), max(1, -(-n // 1024))):
+                obs = self.policy.obs_to_tensor(self.demos.take(idx))[0]
+                latent, _ = features_and_distribution(self.policy, obs)
+                r, k = self.aux.accuracy(latent, self.demos.labels[idx])
+                right, labelled = right + r, labelled + k
+        return right / labelled if labelled else None
 
     def mean_loss(self) -> float:
         n = len(self.demos)
@@ -471,10 +412,12 @@ def set_log_std(policy, log_std) -> None:
 
 
 def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: float = 1e-3,
-          loss: str = "mse", seed: int = 0, log_std: float | list | None = None) -> dict:
+          loss: str = "mse", seed: int = 0, log_std: float | list | None = None,
+          aux_weight: float = 1.0) -> dict:
     """Trains ``model``'s policy on ``demos`` (module docstring); returns the mean loss over
-    all pairs before and after, the updates made and the kind of loss."""
-    cloner = Cloner(model, demos, lr, loss)
+    all pairs before and after, the updates made and the kind of loss (with an auxiliary label:
+    the head's accuracy on the labelled pairs after)."""
+    cloner = Cloner(model, demos, lr, loss, aux_weight)
     before = cloner.mean_loss()
     rng = np.random.default_rng(seed)
     updates = 0
@@ -488,7 +431,10 @@ def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: f
     if log_std is not None:
         set_log_std(cloner.policy, log_std)
     cloner.policy.set_training_mode(False)
-    return {"loss": cloner.kind, "loss_before": before, "loss_after": after, "updates": updates}
+    res = {"loss": cloner.kind, "loss_before": before, "loss_after": after, "updates": updates}
+    if cloner.aux is not None:
+        res["aux_accuracy_after"] = cloner.aux_accuracy()
+    return res
 
 
 def keep_cloning(model, demos: Demonstrations, settings: Mapping[str, Any], total_steps: int,
@@ -500,7 +446,8 @@ def keep_cloning(model, demos: Demonstrations, settings: Mapping[str, Any], tota
 
     if not int(settings.get("keep_updates", 0)):
         return None
-    cloner = Cloner(model, demos, float(settings["lr"]), str(settings["loss"]))
+    cloner = Cloner(model, demos, float(settings["lr"]), str(settings["loss"]),
+                    float(settings.get("aux_weight", 1.0)))
     rng = np.random.default_rng(seed + 2)
     per_update, until = int(settings["keep_updates"]), float(settings["keep_until"])
     batch = int(settings["batch_size"])
@@ -538,16 +485,20 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
     check_log_std_size(model, settings["log_std"])
     t0 = time.perf_counter()
     demos = record_demonstrations(task, env, int(settings["episodes"]), DEMO_SEED + int(seed),
-                                  settings.get("controller"), settings.get("noise", 0.0))
+                                  settings.get("controller"), settings.get("noise", 0.0),
+                                  settings.get("aux_label"))
     t1 = time.perf_counter()
     res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
-                float(settings["lr"]), str(settings["loss"]), int(seed), settings["log_std"])
+                float(settings["lr"]), str(settings["loss"]), int(seed), settings["log_std"],
+                float(settings.get("aux_weight", 1.0)))
     if int(settings["critic_epochs"]):
         res.update(fit_critic(model, demos, int(settings["critic_epochs"]),
                               int(settings["batch_size"]), float(settings["lr"]), int(seed)))
     return {**demos.summary(), "controller": entry(task).controller.__name__,
             "controller_kwargs": settings.get("controller") or {},
             "noise": float(settings.get("noise", 0.0)),
+            "aux_label": settings.get("aux_label"),
+            "aux_weight": float(settings.get("aux_weight", 1.0)),
             "epochs": int(settings["epochs"]), "batch_size": int(settings["batch_size"]),
             "lr": float(settings["lr"]), "log_std": settings["log_std"],
             "keep_updates": int(settings["keep_updates"]),
