@@ -1,5 +1,12 @@
 """Proprioception (paper Sec. V): joint angles, velocities, actuator torques, limit sensors,
-and the actuation model's state, each component switchable.
+and the actuation model's state, each component switchable; and, when asked for, the face.
+
+``face`` (off by default: not in :data:`DEFAULT_COMPONENTS`): the expression the agent's own face
+shows now, one-hot over the 7 expressions (what its facial muscles report; the face is changed
+by the agent's action and shown on its head's material, so it reads the world's model, not
+MjData). A policy without memory that chooses its face every step cannot otherwise tell the
+face it holds from the one it would switch to: measured on contingency with the gaze free, a
+categorical face sampled every step flickered 18 onsets a second (issue 30, ninth session).
 
 Limit sensors rise linearly from 0 to 1 over the last ``limit_margin_deg`` before a joint limit:
 positive near the upper limit, negative near the lower one, 0 elsewhere.
@@ -19,25 +26,32 @@ from dataclasses import dataclass
 import numpy as np
 from gymnasium import spaces
 
+from ..expressions.faces import EXPRESSIONS
 from ..util.checks import check_number
 from ..util.indexing import as_slice
 from ..body.actuation.muscle import Muscle
 from ..body.actuation.spring_damper import SpringDamper
 from .base import SenseEntry, components
 
-__all__ = ["ProprioceptionConfig", "Proprioception", "SENSE", "COMPONENTS", "JOINT_OVERSHOOT"]
+__all__ = ["ProprioceptionConfig", "Proprioception", "SENSE", "COMPONENTS", "DEFAULT_COMPONENTS",
+           "JOINT_OVERSHOOT"]
 
 #: how far (rad) past its range a joint angle may read (the Box's bound; clipped beyond)
 JOINT_OVERSHOOT = np.pi / 2
 
-COMPONENTS = ("qpos", "qvel", "torque", "limits", "actuation")
+#: every component, in the order observed
+COMPONENTS = ("qpos", "qvel", "torque", "limits", "actuation", "face")
+#: the components of the default config (the face is asked for)
+DEFAULT_COMPONENTS = COMPONENTS[:5]
 
 
 @dataclass(frozen=True)
 class ProprioceptionConfig:
     """Joint positions, velocities, actuator torques, limit proximity, actuation state."""
 
-    components: tuple[str, ...] = COMPONENTS   # the parts observed, in this order
+    # the parts observed, in COMPONENTS' order ("face": the own expression, one-hot; off unless
+    # listed)
+    components: tuple[str, ...] = DEFAULT_COMPONENTS
     limit_margin_deg: float = 5.0  # a limit sensor rises from 0 to 1 over this last stretch
 
     def __post_init__(self):
@@ -50,8 +64,9 @@ class ProprioceptionConfig:
 class Proprioception:
     name = "proprioception"
 
-    def __init__(self, config, agent, actuation):
+    def __init__(self, config, agent, actuation, faces=None):
         self.config = config
+        self.faces = faces           # the world's face textures (the "face" component reads them)
         self.agent = agent
         self.actuation = actuation
         self.margin = np.deg2rad(config.limit_margin_deg)
@@ -60,7 +75,7 @@ class Proprioception:
         self._hi = agent.joint_range[:, 1].copy()
         n = len(agent.joint_names)
         sizes = {"qpos": n, "qvel": n, "torque": n, "limits": n,
-                 "actuation": actuation.observation_size}
+                 "actuation": actuation.observation_size, "face": len(EXPRESSIONS)}
         self.slices, start = {}, 0
         for c in config.components:
             self.slices[c] = slice(start, start + sizes[c])
@@ -81,6 +96,11 @@ class Proprioception:
                 high[sl] = np.where(limited, hi, np.inf)
             elif c == "actuation":
                 low[sl], high[sl] = _actuation_bounds(actuation)
+            elif c == "face":
+                low[sl], high[sl] = 0.0, 1.0
+        if "face" in self.slices and faces is None:
+            raise ValueError("proprioception: the face component needs the world's face "
+                             "textures (faces=world.faces)")
         self.space = spaces.Box(low.astype(np.float32), high.astype(np.float32), dtype=np.float32)
         self.spaces = {self.name: self.space}
         # the agent's joints in MuJoCo's arrays: a slice (a view) when consecutive, as they are
@@ -120,6 +140,9 @@ class Proprioception:
                 np.maximum(np.subtract(self._B, s, out=t), 0.0, out=t)     # lower side
                 np.maximum(np.add(self._A, s, out=s), 0.0, out=s)          # upper side
                 np.subtract(s, t, out=out[sl])
+            elif c == "face":
+                out[sl] = 0.0
+                out[sl.start + self.faces.shown(model, self.agent.head_material)] = 1.0
             else:
                 out[sl] = self.actuation.observation(data)
         return out
@@ -142,7 +165,7 @@ def _actuation_bounds(actuation) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _build(config: ProprioceptionConfig, world, index: int, actuation) -> Proprioception:
-    return Proprioception(config, world.agents[index], actuation)
+    return Proprioception(config, world.agents[index], actuation, world.faces)
 
 
 SENSE = SenseEntry("proprioception", ProprioceptionConfig, per_agent=_build)

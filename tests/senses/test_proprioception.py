@@ -11,7 +11,7 @@ import pytest
 
 from mimo_social.core.random_actions import random_action_block
 from mimo_social.envs import free_play_v0
-from mimo_social.senses.proprioception import COMPONENTS
+from mimo_social.senses.proprioception import COMPONENTS, DEFAULT_COMPONENTS
 
 AGENTS = ("infant_0", "infant_1")
 
@@ -36,15 +36,15 @@ def _joints(env, i):
     return ids, m.jnt_qposadr[ids], m.jnt_dofadr[ids]
 
 
-def _parts(env, i, obs, components=COMPONENTS):
+def _parts(env, i, obs, components=DEFAULT_COMPONENTS):
     """The observation cut into its parts: the components in the order of COMPONENTS, one value
-    per joint each (``actuation``: the rest)."""
+    per joint each (``face``: 7, the expressions; ``actuation``: the rest)."""
     n = len(env.world.agents[i].joint_names)
     out, start = {}, 0
     for c in COMPONENTS:
         if c not in components:
             continue
-        size = n if c != "actuation" else len(obs) - start
+        size = {"face": 7, "actuation": len(obs) - start - 7 * ("face" in components)}.get(c, n)
         out[c] = obs[start:start + size]
         start += size
     assert start == len(obs)
@@ -153,3 +153,27 @@ def test_limit_sensors_in_the_observation_of_a_step_follow_the_joint_angles():
         # (a joint pushed past its limit reads beyond +-1)
         assert np.mean(limits[upper[i]] > 0) > 0.7, limits[upper[i]]
         assert np.mean(limits[lower[i]] < 0) > 0.7, limits[lower[i]]
+
+
+def test_the_face_component_is_off_by_default_and_reads_the_face_the_agent_shows():
+    plain = _env()
+    assert plain.observation_space("infant_0")["proprioception"].shape[0] == \
+        _sense(plain, 0).size and "face" not in _sense(plain, 0).slices
+    env = free_play_v0.parallel_env(n_agents=2, proprioception={"components": ["qpos", "face"]})
+    obs, _ = env.reset(seed=3)
+    n = len(env.world.agents[0].joint_names)
+    space = env.observation_space("infant_0")["proprioception"]
+    assert space.shape == (n + 7,) and space.low[n:].tolist() == [0.0] * 7
+    for faces in [(1, 4), (6, 0), (2, 2)]:
+        actions = {}
+        for i, agent in enumerate(AGENTS):
+            a = env.action_space(agent).sample()
+            a["motors"][:] = 0.0
+            a["expression"] = faces[i]
+            actions[agent] = a
+        obs = env.step(actions)[0]
+        for i, agent in enumerate(AGENTS):
+            face = obs[agent]["proprioception"][n:]
+            assert face.tolist() == np.eye(7)[faces[i]].tolist()     # its own face, one-hot
+            assert env.world.expression_of(i) == faces[i]
+            assert space.contains(obs[agent]["proprioception"])
