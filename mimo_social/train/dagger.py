@@ -22,8 +22,6 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
-import numpy as np
-
 from .demonstrations import Demonstrations, Demonstrator, clone, demonstrator, play
 
 __all__ = ["DAGGER_SEED", "Labeller", "dagger"]
@@ -44,20 +42,6 @@ class Labeller(Demonstrator):
         return action
 
 
-def _joined(a: Demonstrations, b: Demonstrations) -> Demonstrations:
-    """``a``'s pairs followed by ``b``'s (the episode numbers: ``a``'s, the demonstrations')."""
-    if isinstance(a.obs, dict):
-        obs = {k: np.concatenate([a.obs[k], b.obs[k]]) for k in a.obs}
-    else:
-        obs = np.concatenate([a.obs, b.obs])
-    labels = (None if a.labels is None or b.labels is None
-              else np.concatenate([a.labels, b.labels]))
-    return Demonstrations(obs, np.concatenate([a.actions, b.actions]),
-                          np.concatenate([a.rewards, b.rewards]),
-                          np.concatenate([a.ends, b.ends]),
-                          a.seeds, a.returns, a.lengths, a.successes, labels)
-
-
 def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, Any],
            seed: int, report=None) -> tuple[Demonstrations, list[dict]]:
     """``settings["dagger_rounds"]`` rounds of DAgger on ``env`` (module docstring), each
@@ -75,7 +59,7 @@ def dagger(model, task: str, env, demos: Demonstrations, settings: Mapping[str, 
         first = DAGGER_SEED + int(seed) + 1000 * r
         played = play(Labeller(controller, env, model, settings.get("aux_label")), env, first,
                       int(settings["dagger_episodes"]))
-        demos = _joined(demos, played)
+        demos = demos.joined(played)
         measured = played.summary()
         score = (measured["success_rate"] or 0.0, measured["return_mean"])
         if best is None or score > best[0]:

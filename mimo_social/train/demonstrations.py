@@ -139,6 +139,20 @@ class Demonstrations:
     def __len__(self) -> int:
         return len(self.actions)
 
+    def joined(self, other: "Demonstrations") -> "Demonstrations":
+        """These pairs followed by ``other``'s (the episode numbers: these, the
+        demonstrations'; the labels only when both have them)."""
+        if isinstance(self.obs, dict):
+            obs = {k: np.concatenate([self.obs[k], other.obs[k]]) for k in self.obs}
+        else:
+            obs = np.concatenate([self.obs, other.obs])
+        labels = (None if self.labels is None or other.labels is None
+                  else np.concatenate([self.labels, other.labels]))
+        return Demonstrations(obs, np.concatenate([self.actions, other.actions]),
+                              np.concatenate([self.rewards, other.rewards]),
+                              np.concatenate([self.ends, other.ends]), self.seeds,
+                              self.returns, self.lengths, self.successes, labels)
+
     def take(self, idx):
         """The observations at the indices ``idx``."""
         if isinstance(self.obs, dict):

@@ -5,6 +5,7 @@ the clone plays fresh episodes while the follower labels them.
 Arguments: episodes, k (every k-th pair kept), epochs, DART noise, episodes played, aux weight
 (0: none, the seventh session's pilot) (README.md beside it).
 """
+import functools
 import sys
 import time
 
@@ -28,15 +29,6 @@ def kept(d: Demonstrations, keep) -> Demonstrations:
     return Demonstrations({k: v[keep] for k, v in d.obs.items()}, d.actions[keep],
                           d.rewards[keep], d.ends[keep], d.seeds, d.returns, d.lengths,
                           d.successes, None if d.labels is None else d.labels[keep])
-
-
-def joined(parts):
-    return Demonstrations(
-        {k: np.concatenate([p.obs[k] for p in parts]) for k in parts[0].obs},
-        np.concatenate([p.actions for p in parts]), np.concatenate([p.rewards for p in parts]),
-        np.concatenate([p.ends for p in parts]), sum([p.seeds for p in parts], []),
-        sum([p.returns for p in parts], []), sum([p.lengths for p in parts], []),
-        sum([p.successes for p in parts], []), np.concatenate([p.labels for p in parts]))
 
 
 def head_accuracy(model, obs, labels) -> float:
@@ -71,7 +63,7 @@ def main():
         rate = np.mean([s for p in parts for s in p.successes])
         print(f"recorded {c + 20} episodes, success {rate:.2f}, {time.time() - t0:.0f} s",
               flush=True)
-    demos = joined(parts)
+    demos = functools.reduce(Demonstrations.joined, parts)
     del parts
     if weight == 0:
         demos.labels = None
