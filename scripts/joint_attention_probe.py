@@ -26,6 +26,12 @@ read from the images alone (the learner's own posture cannot name an episode's l
 ``--env-kwargs`` sets the env's options (JSON), e.g. foveated 64x64 eyes that magnify the
 partner's face at the centre of the view: ``--env-kwargs '{"per_agent": [{"vision": {"width":
 64, "height": 64, "fovea": 4}}, {}]}'``.
+
+``--look face``: the learner does not follow; it looks at its partner's face all the time
+(:class:`~mimo_social.partners.gaze.GazeAtTarget` on the partner's ``head_centre`` site, head
+and eyes, DART noise as above), and every ``--every``-th step at which the partner looks at a
+toy is kept: can the toy be read while the learner watches the face, as an infant checks the
+face before it follows? With a fovea the partner's eyes are then magnified at the centre.
 """
 
 from __future__ import annotations
@@ -33,21 +39,45 @@ from __future__ import annotations
 import argparse
 import time
 
+import mujoco
 import numpy as np
 import torch
 from gymnasium import spaces
 
 from mimo_social.cli._args import env_kwargs
+from mimo_social.partners.gaze import GazeAtTarget
 from mimo_social.train.demonstrations import Demonstrator, demonstrator
 from mimo_social.train.envs import make_env
 from mimo_social.train.encoders import EyesExtractor, image_space_keys
 
 
-def record(env, episodes: int, every: int, noise: float, first: int):
+#: the direction label's scale in the loss (degrees)
+SCALE_DEG = 30.0
+
+
+def watcher():
+    """The learner's gaze held on its partner's face (``--look face``)."""
+    return GazeAtTarget(targets=["infant_1/head_centre"], hold_s=(3600.0, 3600.0),
+                        head_share=1.0)
+
+
+def toy_directions(core) -> np.ndarray:
+    """Each toy's direction (azimuth, elevation; degrees, world frame) from the learner's head
+    centre: where a follower must turn to see it."""
+    data, model = core.world.data, core.world.model
+    head = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, "infant_0/head_centre")
+    d = data.xpos[core.task.toy_bodies] - data.site_xpos[head]
+    return np.degrees(np.stack([np.arctan2(d[:, 1], d[:, 0]),
+                                np.arctan2(d[:, 2], np.hypot(d[:, 0], d[:, 1]))], axis=1))
+
+
+def record(env, episodes: int, every: int, noise: float, first: int, look: str = "follow"):
     """Observations at every ``every``-th step with a target the learner does not look at,
-    their toy and episode."""
-    teacher = Demonstrator(demonstrator("joint_attention"), env, noise)
-    obs_list, labels, episode = [], [], []
+    their toy, episode and every toy's direction (``look``: ``follow``, the scripted follower,
+    or ``face``)."""
+    teacher = Demonstrator(watcher if look == "face" else demonstrator("joint_attention"),
+                           env, noise)
+    obs_list, labels, episode, directions = [], [], [], []
     for k in range(episodes):
         obs, info = env.reset(seed=first + k)
         teacher.reset(env, "infant_0", np.random.default_rng(first + k))
@@ -62,13 +92,14 @@ def record(env, episodes: int, every: int, noise: float, first: int):
                 obs_list.append({key: np.array(v) for key, v in obs.items()})
                 labels.append(int(info["target"]))
                 episode.append(k)
+                directions.append(toy_directions(teacher.core))
         teacher.obs.clear()
         teacher.actions.clear()
     if not obs_list:
         raise SystemExit(f"joint_attention_probe: no labelled step in {episodes} episodes at "
                          f"--every {every}; allowed: more episodes or a smaller --every")
     stacked = {key: np.stack([o[key] for o in obs_list]) for key in obs_list[0]}
-    return stacked, np.array(labels), np.array(episode)
+    return stacked, np.array(labels), np.array(episode), np.array(directions, np.float32)
 
 
 def shift_images(batch: dict[str, torch.Tensor], keys, pad: int,
@@ -110,6 +141,12 @@ def main(argv=None) -> int:
     p.add_argument("--images-only", action="store_true",
                    help="the encoder reads the images only, not the vector")
     p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--label", choices=("toy", "direction"), default="toy",
+                   help="what the head names: the toy (classes), or the direction of the toy "
+                        "(regressed; right when the nearest toy to it is the target)")
+    p.add_argument("--look", choices=("follow", "face"), default="follow",
+                   help="the learner's gaze: the scripted follower's, or held on the partner's "
+                        "face")
     a = p.parse_args(argv)
     torch.set_num_threads(a.threads)
     torch.manual_seed(0)
@@ -118,11 +155,16 @@ def main(argv=None) -> int:
     if a.load:
         with np.load(a.load) as data:
             y, ep = data["labels"], data["episode"]
+            dirs = data["directions"] if "directions" in data.files else None
             obs = {k[4:]: data[k] for k in data.files if k.startswith("obs_")}
     else:
-        obs, y, ep = record(env, a.episodes, a.every, a.noise, a.seed)
+        obs, y, ep, dirs = record(env, a.episodes, a.every, a.noise, a.seed, a.look)
     if a.save:
-        np.savez(a.save, labels=y, episode=ep, **{f"obs_{k}": v for k, v in obs.items()})
+        np.savez(a.save, labels=y, episode=ep, directions=dirs,
+                 **{f"obs_{k}": v for k, v in obs.items()})
+    if a.label == "direction" and dirs is None:
+        raise SystemExit(f"joint_attention_probe: --label direction needs the toys' directions; "
+                         f"{a.load} has none (recorded before they were kept): record again")
     train, test = ep < a.episodes - a.test, ep >= a.episodes - a.test
     print(f"{len(y)} labelled steps ({train.sum()} train, {test.sum()} test) from {a.episodes} "
           f"episodes in {time.time() - t0:.0f} s; toys {np.bincount(y, minlength=4).tolist()}; "
@@ -134,22 +176,37 @@ def main(argv=None) -> int:
         space = spaces.Dict({k: space[k] for k in keep})
         obs = {k: obs[k] for k in keep}
     encoder = EyesExtractor(space, normalize_vector=True, norm_min_std=0.01)
-    head = torch.nn.Linear(encoder.features_dim, 4)
+    regress = a.label == "direction"
+    head = torch.nn.Linear(encoder.features_dim, 2 if regress else 4)
     params = list(encoder.parameters()) + list(head.parameters())
     optimiser = torch.optim.Adam(params, lr=a.lr)
     tensors = {k: torch.as_tensor(v) for k, v in obs.items()}
     target = torch.as_tensor(y)
+    if regress:     # the target toy's direction, scaled; each step's toys to name the nearest
+        toys = torch.as_tensor(dirs) / SCALE_DEG
+        aim = toys[torch.arange(len(y)), target]
     rng = np.random.default_rng(0)
 
-    def accuracy(mask) -> float:
+    def loss_of(out, b):
+        if regress:
+            return torch.nn.functional.mse_loss(out, aim[b])
+        return torch.nn.functional.cross_entropy(out, target[b])
+
+    def accuracy(mask) -> str:
         idx = np.flatnonzero(mask)
-        right = 0
+        right, error = 0, 0.0
         with torch.no_grad():
             for s in range(0, len(idx), 256):
                 b = idx[s:s + 256]
-                logits = head(encoder({k: v[b].float() for k, v in tensors.items()}))
-                right += int((logits.argmax(1) == target[b]).sum())
-        return right / len(idx)
+                out = head(encoder({k: v[b].float() for k, v in tensors.items()}))
+                if regress:     # the nearest toy to the read direction
+                    named = ((toys[b] - out[:, None, :]) ** 2).sum(-1).argmin(1)
+                    error += float((out - aim[b]).norm(dim=1).sum()) * SCALE_DEG
+                else:
+                    named = out.argmax(1)
+                right += int((named == target[b]).sum())
+        return f"{right / len(idx):.2f}" + (f" ({error / len(idx):.1f} deg off)" if regress
+                                              else "")
 
     for epoch in range(a.epochs):
         order = rng.permutation(np.flatnonzero(train))
@@ -158,13 +215,12 @@ def main(argv=None) -> int:
             batch = {k: v[b].float() for k, v in tensors.items()}
             if a.augment:
                 batch = shift_images(batch, encoder.image_keys, a.augment, rng)
-            logits = head(encoder(batch))
-            loss = torch.nn.functional.cross_entropy(logits, target[b])
+            loss = loss_of(head(encoder(batch)), b)
             optimiser.zero_grad()
             loss.backward()
             optimiser.step()
-        print(f"epoch {epoch + 1}: train accuracy {accuracy(train):.2f}, test (new placements) "
-              f"{accuracy(test):.2f}, {time.time() - t0:.0f} s", flush=True)
+        print(f"epoch {epoch + 1}: train accuracy {accuracy(train)}, test (new placements) "
+              f"{accuracy(test)}, {time.time() - t0:.0f} s", flush=True)
     return 0
 
 

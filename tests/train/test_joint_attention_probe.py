@@ -6,6 +6,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import torch
 
@@ -35,3 +36,34 @@ def test_both_eyes_of_a_step_shift_together_and_the_vector_does_not():
         assert len(hits) == 1
         shifted += hits[0] != (pad, pad)
     assert shifted >= n - 1
+
+
+def test_watching_the_face_keeps_steps_with_every_toys_direction():
+    """``--look face``: the learner watches its partner's face; every kept step has the toy the
+    partner looks at and each toy's direction from the learner's head, the toys apart by more
+    than the direction label's errors that still name the right one."""
+    from itertools import combinations
+
+    from mimo_social.train.envs import make_env
+    probe = _probe()
+    env = make_env("joint_attention", per_agent=[{"vision": {"width": 16, "height": 16}}, {}])
+    try:
+        obs, labels, episode, directions = probe.record(env, 1, 25, 0.0, 1000, look="face")
+        core = env.unwrapped.parallel.unwrapped          # at the episode's last step
+        data, cams = core.world.data, list(core.world.agents[0].eye_cameras)
+        origin = data.cam_xpos[cams].mean(axis=0)
+        gaze = -data.cam_xmat[cams].reshape(2, 3, 3)[:, :, 2].sum(axis=0)
+        face = data.site_xpos[mujoco.mj_name2id(core.world.model, mujoco.mjtObj.mjOBJ_SITE,
+                                                "infant_1/head_centre")] - origin
+        off = np.degrees(np.arccos(gaze @ face / np.linalg.norm(gaze) / np.linalg.norm(face)))
+    finally:
+        env.close()
+    assert off < 10.0                     # the learner's gaze on its partner's face
+    n = len(labels)
+    assert n > 5 and set(np.unique(episode)) == {0}
+    assert obs["eye_left"].shape[0] == n and directions.shape == (n, 4, 2)
+    assert set(labels.tolist()) <= {0, 1, 2, 3} and len(set(labels.tolist())) >= 2
+    apart = [np.linalg.norm(directions[:, a] - directions[:, b], axis=1)
+             for a, b in combinations(range(4), 2)]
+    assert np.min(apart) > 20.0          # degrees between any two toys, as seen by the learner
+    assert np.all(directions[:, :, 1] < 0.0)          # on the floor: below the learner's head
