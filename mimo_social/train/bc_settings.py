@@ -11,7 +11,7 @@ from ..envs.catalog import entry
 from .auxiliary import AUX_DEFAULTS, check_aux
 from .tasks import TrainInputError
 
-__all__ = ["BC_DEFAULTS", "BC_LOSSES", "BC_ALGOS", "check_bc"]
+__all__ = ["BC_DEFAULTS", "BC_LOSSES", "BC_ALGOS", "KEEP_UNTIL_MAX", "check_bc"]
 
 #: the settings of ``bc_kwargs`` and their defaults (``epochs``: ``bc_epochs``)
 BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None,
@@ -19,6 +19,9 @@ BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_s
                "dagger_episodes": 50, "controller": None, "noise": 0.0, **AUX_DEFAULTS}
 BC_LOSSES = ("mse", "nll")
 BC_ALGOS = ("ppo", "sac")
+#: ``keep_until``'s largest value: the kept cloning falls to 0 at this many runs' lengths (at 2
+#: it is at half strength at the run's end; at 1000 all but constant)
+KEEP_UNTIL_MAX = 1000.0
 
 
 def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
@@ -96,9 +99,10 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
     if isinstance(ku, bool) or not isinstance(ku, int) or ku < 0:
         raise TrainInputError(f"bc_kwargs: keep_updates={ku!r}; allowed: an integer >= 0 "
                               "(behaviour-cloning minibatches after each RL update; 0: none)")
-    if isinstance(kt, bool) or not isinstance(kt, (int, float)) or not 0 < kt <= 1:
-        raise TrainInputError(f"bc_kwargs: keep_until={kt!r}; allowed: a number in (0, 1] (the "
-                              "share of the run over which keep_updates falls to 0)")
+    if isinstance(kt, bool) or not isinstance(kt, (int, float)) or not 0 < kt <= KEEP_UNTIL_MAX:
+        raise TrainInputError(f"bc_kwargs: keep_until={kt!r}; allowed: a number in (0, "
+                              f"{KEEP_UNTIL_MAX:g}] (the share of the run over which "
+                              "keep_updates falls to 0; beyond 1 it is still on at the end)")
     ck = s["controller"]
     if ck is not None:
         if not isinstance(ck, Mapping) or not all(isinstance(k, str) for k in ck):

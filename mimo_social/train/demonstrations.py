@@ -41,8 +41,9 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
 * ``keep_updates`` (default 0: none) and ``keep_until`` (0.5): the cloning goes on during RL
   (:class:`KeepCloning`, an SB3 callback): after each of the algorithm's updates, that many
   minibatches of the same cloning loss (its own Adam, ``lr``), falling linearly with the run's
-  progress to none at ``keep_until`` of its steps; the demonstrations hold the policy near the
-  controller while RL's first, noisy updates would pull it away (the regularisation of
+  progress to none at ``keep_until`` of its steps (beyond 1: still on at the run's end, at
+  ``1 - 1 / keep_until`` of the first updates' number); the demonstrations hold the policy near
+  the controller while RL's first, noisy updates would pull it away (the regularisation of
   demonstration-augmented policy gradient, Rajeswaran et al. 2018, as alternating updates).
 
 * ``dagger_rounds`` (default 0: none) and ``dagger_episodes`` (50): DAgger after the cloning

@@ -156,7 +156,9 @@ def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_pa
      ["critic_epochs=3", "with ppo only"]),
     ({"bc_episodes": 2, "bc_kwargs": {"critic_epochs": -1}}, ["critic_epochs=-1", ">= 0"]),
     ({"bc_episodes": 2, "bc_kwargs": {"keep_updates": 1.5}}, ["keep_updates=1.5", ">= 0"]),
-    ({"bc_episodes": 2, "bc_kwargs": {"keep_until": 0}}, ["keep_until=0", "(0, 1]"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"keep_until": 0}}, ["keep_until=0", "(0, 1000]"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"keep_until": 1001}}, ["keep_until=1001", "(0, 1000]"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"keep_until": True}}, ["keep_until=True", "(0, 1000]"]),
     ({"bc_episodes": 2, "normalize_reward": True, "bc_kwargs": {"critic_epochs": 2}},
      ["critic_epochs with --normalize-reward"]),
     ({"bc_episodes": 2, "algo": "recurrent_ppo"}, ["recurrent_ppo", "ppo, sac"]),
@@ -251,6 +253,13 @@ def test_keep_cloning_pulls_the_policy_back_to_the_demonstrations_and_fades():
             cb.on_rollout_start()
         # none before the first update; then 40 x (1 - t / 500): 32, 20, then none
         assert cb.updates == 32 + 20 and loss() < before / 2
+        late = keep_cloning(ppo, demos, {**settings, "keep_until": 2.0}, 1000, 0)
+        late.init_callback(ppo)
+        for t in (0, 500, 1000):
+            ppo.num_timesteps = t
+            late.on_rollout_start()
+        # beyond 1: 40 x (1 - t / 2000), still on at the run's end: 30, then 20
+        assert late.updates == 30 + 20
     finally:
         env.close()
 
