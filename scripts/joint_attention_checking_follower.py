@@ -1,0 +1,130 @@
+"""Can a follower that must watch its partner's face to read it do joint attention? (issue 30)
+
+The scripted follower (``GazeFollowController``) reads the partner's gaze from the world every
+step, wherever it looks itself: a learner cannot. The probe (``joint_attention_probe.py --look
+face``) found the partner's toy readable from the learner's foveated eyes while the learner
+watches the partner's face (99 % of held-out steps), far less from the follower's own view. A
+learner would then do what infants do: watch the face, turn to the toy the partner looks at,
+look back to the face to see whether the partner has moved on. This script measures that
+strategy's ceiling with the reading given (from the world, as the scripted follower's), in
+the task's success terms:
+
+* ``face``: the follower looks at its partner's face (head and eyes, the scripted follower's PD
+  law) until the partner's gaze has rested on one toy for ``--settle-s`` while the follower's
+  own gaze is on the face (within ``--on-face-deg``);
+* ``toy``: it turns to that toy and looks at it for ``--look-s``, then back to ``face``;
+  with ``--peripheral DEG`` it goes back earlier when the partner's head turns by more than DEG
+  from where it was at the reading (a head turn is visible out of the corner of the eye; the
+  partner's eyes are not).
+
+    OMP_NUM_THREADS=1 python3 scripts/joint_attention_checking_follower.py --episodes 20 \
+        --look-s 0.5 1 2 --peripheral 0 5
+
+Prints per setting the success rate and the mean share of target steps on target (the task's
+success needs 0.6) on seeds 1000.. (the task's baselines' seeds), the scripted follower first.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+
+import numpy as np
+
+from mimo_social.tasks.joint_attention.controller import GazeFollowController
+from mimo_social.train.demonstrations import Demonstrator
+from mimo_social.train.envs import make_env
+
+
+class CheckingFollower(GazeFollowController):
+    """Watches the face, follows the read toy for ``look_s``, watches again (module docstring)."""
+
+    def __init__(self, look_s: float = 1.0, settle_s: float = 0.1, on_face_deg: float = 5.0,
+                 peripheral_deg: float = 0.0):
+        super().__init__()
+        self.look_s, self.settle_s = float(look_s), float(settle_s)
+        self.on_face_deg, self.peripheral_deg = float(on_face_deg), float(peripheral_deg)
+
+    def reset(self, env, agent, rng):
+        super().reset(env, agent, rng)
+        self._face = len(self._found)
+        self._found = list(self._found) + [("site", self._head_site)]
+        self._own_cams = np.asarray(env.world.agents[self._geo_agent(env, agent)].eye_cameras)
+        self.mode, self._steps, self._read, self._seen_head = "face", 0, None, None
+        self.target = self._face
+
+    @staticmethod
+    def _geo_agent(env, agent) -> int:
+        return list(env.possible_agents).index(agent)
+
+    def on_face(self, d) -> bool:
+        origin = d.cam_xpos[self._own_cams].mean(axis=0)
+        gaze = -d.cam_xmat[self._own_cams].reshape(2, 3, 3)[:, :, 2].sum(axis=0)
+        face = d.site_xpos[self._head_site] - origin
+        cos = gaze @ face / np.linalg.norm(gaze) / np.linalg.norm(face)
+        return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))) <= self.on_face_deg
+
+    def _head_dir(self, d) -> np.ndarray:
+        return d.xmat[self._head_body].reshape(3, 3)[:, 0].copy()
+
+    def act(self, env, agent, observation):
+        d, dt = env.world.data, float(env.dt)
+        held, self.target = self.target, None     # the reading alone: None between toys
+        read = GazeFollowController.read_target(self, env)
+        self.target = held
+        if self.mode == "face":
+            if read is not None and read == self._read and self.on_face(d):
+                self._steps += 1
+            else:
+                self._steps = 0
+            self._read = read
+            if self._read is not None and self._steps * dt >= self.settle_s:
+                self.mode, self.target = "toy", self._read
+                self._steps, self._seen_head = 0, self._head_dir(d)
+        else:
+            self._steps += 1
+            turned = np.degrees(np.arccos(np.clip(self._head_dir(d) @ self._seen_head, -1, 1)))
+            if self._steps * dt >= self.look_s or (
+                    self.peripheral_deg and turned > self.peripheral_deg):
+                self.mode, self.target, self._steps, self._read = "face", self._face, 0, None
+        self._left = 1 << 30
+        return super(GazeFollowController, self).act(env, agent, observation)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--episodes", type=int, default=20)
+    p.add_argument("--seed", type=int, default=1000)
+    p.add_argument("--look-s", type=float, nargs="+", default=[0.5, 1.0, 2.0])
+    p.add_argument("--settle-s", type=float, default=0.1)
+    p.add_argument("--peripheral", type=float, nargs="+", default=[0.0])
+    a = p.parse_args(argv)
+    # the learner's eyes are not read here: 8x8 images keep the rendering cheap
+    env = make_env("joint_attention", per_agent=[{"vision": {"width": 8, "height": 8}}, {}])
+    rows = [("scripted follower", GazeFollowController)]
+    rows += [(f"checking: look {look:g} s, settle {a.settle_s:g} s, peripheral {per:g} deg",
+              functools.partial(CheckingFollower, look_s=look, settle_s=a.settle_s,
+                                peripheral_deg=per))
+             for per in a.peripheral for look in a.look_s]
+    for name, cls in rows:
+        teacher, success, share = Demonstrator(cls, env), [], []
+        for k in range(a.episodes):
+            obs, info = env.reset(seed=a.seed + k)
+            teacher.reset(env, "infant_0", np.random.default_rng(a.seed + k))
+            done = False
+            while not done:
+                obs, _, term, trunc, info = env.step(teacher.act(env, "infant_0", obs))
+                done = term or trunc
+            teacher.obs.clear()
+            teacher.actions.clear()
+            success.append(bool(info["is_success"]))
+            share.append(float(info["on_target_fraction"]))
+        print(f"{name}: success {np.mean(success):.0%} of {a.episodes}, on target "
+              f"{np.mean(share):.2f} of the target steps (min {np.min(share):.2f}, max "
+              f"{np.max(share):.2f})", flush=True)
+    env.close()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
