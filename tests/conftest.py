@@ -1,6 +1,11 @@
 import mimo_social  # noqa: F401  (chooses the headless GL backend before mujoco is imported)
 
+import importlib.util  # noqa: E402
+from pathlib import Path  # noqa: E402
+
 import pytest  # noqa: E402
+
+SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
 
 
 def pytest_configure(config):
@@ -23,3 +28,15 @@ def _text_infos_where_marked(request, monkeypatch):
     def init(self, *args, info_text=True, **kwargs):
         made(self, *args, info_text=info_text, **kwargs)
     monkeypatch.setattr(MimoParallelEnv, "__init__", init)
+
+
+@pytest.fixture
+def load_script():
+    """``load_script(name)``: the module of ``scripts/<name>.py`` (the research scripts are no
+    package; their tests load them by path)."""
+    def load(name: str):
+        spec = importlib.util.spec_from_file_location(name, SCRIPTS / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+    return load

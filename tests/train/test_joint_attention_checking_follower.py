@@ -5,26 +5,14 @@ look back it does the task (issue 30's measure of the strategy a seeing learner 
 from __future__ import annotations
 
 import functools
-import importlib.util
-from pathlib import Path
 
 import numpy as np
 
 from mimo_social.train.demonstrations import Demonstrator
 from mimo_social.train.envs import make_env
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "joint_attention_checking_follower.py"
-
-
-def _script():
-    spec = importlib.util.spec_from_file_location("joint_attention_checking_follower", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_it_alternates_between_the_face_and_the_toy_and_succeeds():
-    script = _script()
+def test_it_alternates_between_the_face_and_the_toy_and_succeeds(load_script):
+    script = load_script("joint_attention_checking_follower")
     env = make_env("joint_attention", per_agent=[{"vision": {"width": 8, "height": 8}}, {}])
     teacher = Demonstrator(functools.partial(script.CheckingFollower, look_s=2.0,
                                              peripheral_deg=3.0), env)

@@ -1,27 +1,15 @@
-"""The joint-attention probe's image shift (scripts/joint_attention_probe.py ``--augment``):
-both eyes of a step move by the same offset, edges replicated, nothing else changes."""
+"""The joint-attention probe (scripts/joint_attention_probe.py): its image shift (``--augment``:
+both eyes of a step move by the same offset, edges replicated, nothing else changes) and its
+face-watching recording (``--look face``, with every toy's direction for ``--label direction``)."""
 
 from __future__ import annotations
-
-import importlib.util
-from pathlib import Path
 
 import mujoco
 import numpy as np
 import torch
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "joint_attention_probe.py"
-
-
-def _probe():
-    spec = importlib.util.spec_from_file_location("joint_attention_probe", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_both_eyes_of_a_step_shift_together_and_the_vector_does_not():
-    probe = _probe()
+def test_both_eyes_of_a_step_shift_together_and_the_vector_does_not(load_script):
+    probe = load_script("joint_attention_probe")
     n, pad = 6, 3
     left = torch.arange(n * 3 * 16 * 16, dtype=torch.float32).reshape(n, 3, 16, 16)
     batch = {"left_eye": left, "right_eye": left + 1.0, "vector": torch.ones(n, 5)}
@@ -38,14 +26,14 @@ def test_both_eyes_of_a_step_shift_together_and_the_vector_does_not():
     assert shifted >= n - 1
 
 
-def test_watching_the_face_keeps_steps_with_every_toys_direction():
+def test_watching_the_face_keeps_steps_with_every_toys_direction(load_script):
     """``--look face``: the learner watches its partner's face; every kept step has the toy the
     partner looks at and each toy's direction from the learner's head, the toys apart by more
     than the direction label's errors that still name the right one."""
     from itertools import combinations
 
     from mimo_social.train.envs import make_env
-    probe = _probe()
+    probe = load_script("joint_attention_probe")
     env = make_env("joint_attention", per_agent=[{"vision": {"width": 16, "height": 16}}, {}])
     try:
         obs, labels, episode, directions = probe.record(env, 1, 25, 0.0, 1000, look="face")
