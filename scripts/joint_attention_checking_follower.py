@@ -31,6 +31,7 @@ import functools
 
 import numpy as np
 
+from mimo_social.partners.base import agent_index
 from mimo_social.tasks.joint_attention.controller import GazeFollowController
 from mimo_social.train.demonstrations import Demonstrator
 from mimo_social.train.envs import make_env
@@ -49,13 +50,9 @@ class CheckingFollower(GazeFollowController):
         super().reset(env, agent, rng)
         self._face = len(self._found)
         self._found = list(self._found) + [("site", self._head_site)]
-        self._own_cams = np.asarray(env.world.agents[self._geo_agent(env, agent)].eye_cameras)
+        self._own_cams = np.asarray(env.world.agents[agent_index(env, agent)].eye_cameras)
         self.mode, self._steps, self._read, self._seen_head = "face", 0, None, None
         self.target = self._face
-
-    @staticmethod
-    def _geo_agent(env, agent) -> int:
-        return list(env.possible_agents).index(agent)
 
     def on_face(self, d) -> bool:
         origin = d.cam_xpos[self._own_cams].mean(axis=0)
@@ -69,9 +66,7 @@ class CheckingFollower(GazeFollowController):
 
     def act(self, env, agent, observation):
         d, dt = env.world.data, float(env.dt)
-        held, self.target = self.target, None     # the reading alone: None between toys
-        read = GazeFollowController.read_target(self, env)
-        self.target = held
+        read = self.read_now(env)
         if self.mode == "face":
             if read is not None and read == self._read and self.on_face(d):
                 self._steps += 1

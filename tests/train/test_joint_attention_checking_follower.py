@@ -11,6 +11,7 @@ import numpy as np
 from mimo_social.train.demonstrations import Demonstrator
 from mimo_social.train.envs import make_env
 
+
 def test_it_alternates_between_the_face_and_the_toy_and_succeeds(load_script):
     script = load_script("joint_attention_checking_follower")
     env = make_env("joint_attention", per_agent=[{"vision": {"width": 8, "height": 8}}, {}])

@@ -4,9 +4,14 @@ face-watching recording (``--look face``, with every toy's direction for ``--lab
 
 from __future__ import annotations
 
+from itertools import combinations
+
 import mujoco
 import numpy as np
 import torch
+
+from mimo_social.train.envs import make_env
+
 
 def test_both_eyes_of_a_step_shift_together_and_the_vector_does_not(load_script):
     probe = load_script("joint_attention_probe")
@@ -30,9 +35,6 @@ def test_watching_the_face_keeps_steps_with_every_toys_direction(load_script):
     """``--look face``: the learner watches its partner's face; every kept step has the toy the
     partner looks at and each toy's direction from the learner's head, the toys apart by more
     than the direction label's errors that still name the right one."""
-    from itertools import combinations
-
-    from mimo_social.train.envs import make_env
     probe = load_script("joint_attention_probe")
     env = make_env("joint_attention", per_agent=[{"vision": {"width": 16, "height": 16}}, {}])
     try:

@@ -94,7 +94,13 @@ class GazeFollowController(GazeAtTarget):
         return origin, direction / np.linalg.norm(direction)
 
     def read_target(self, env) -> int | None:
-        """The toy the partner looks at, as this reader sees it (None: none yet)."""
+        """The toy the partner looks at, as this reader sees it; between toys the last one read
+        (None: none yet)."""
+        toy = self.read_now(env)
+        return self.target if toy is None else toy
+
+    def read_now(self, env) -> int | None:
+        """The toy the partner looks at now, as this reader sees it (None: between toys)."""
         d = env.world.data
         origin, direction = self._ray(d)
         to_toy = d.xpos[self._toys] - origin
@@ -103,8 +109,8 @@ class GazeFollowController(GazeAtTarget):
         angle = np.rad2deg(np.arccos(np.clip(cos[best], -1.0, 1.0)))
         if self.read == "head":
             turned = np.rad2deg(np.arccos(np.clip(direction @ self._rest, -1.0, 1.0)))
-            return best if turned >= self.min_head_deg else self.target
-        return best if angle <= self.max_angle_deg else self.target
+            return best if turned >= self.min_head_deg else None
+        return best if angle <= self.max_angle_deg else None
 
     def act(self, env, agent, observation):
         if getattr(self, "_toys", None) is None:
