@@ -42,6 +42,8 @@ def main(argv=None) -> int:
     p.add_argument("task")
     p.add_argument("--controller", type=json.loads, default={},
                    help="JSON keyword arguments of the task's controller")
+    p.add_argument("--demonstrator", default=None,
+                   help="one of the task's named controllers (bc_kwargs demonstrator)")
     p.add_argument("--episodes", type=int, default=20, help="demonstrations cloned")
     p.add_argument("--noise", type=float, default=0.0, help="DART noise on the demonstrator")
     p.add_argument("--epochs", type=int, default=20)
@@ -59,13 +61,15 @@ def main(argv=None) -> int:
     policy, kw = policy_for(venv.observation_space, {}, a.normalize_obs,
                             min_std=a.obs_min_std if a.normalize_obs else 0.0)
     model = PPO(policy, venv, seed=0, device="cpu", **kw)
-    demos = record_demonstrations(a.task, env, a.episodes, 20_000, a.controller, a.noise)
+    demos = record_demonstrations(a.task, env, a.episodes, 20_000, a.controller, a.noise,
+                                  demonstrator_name=a.demonstrator)
     fit = clone(model, demos, a.epochs, lr=a.lr, seed=0)
     print(f"{a.task}: {len(demos)} pairs from {a.episodes} episodes (noise {a.noise}), "
           f"{a.epochs} epochs at lr {a.lr:g}: {fit['loss']} loss {fit['loss_before']:.4g} -> "
           f"{fit['loss_after']:.4g}; normalize_obs {a.normalize_obs}, obs_min_std "
           f"{a.obs_min_std}", flush=True)
-    controller = demonstrator(a.task, {"controller": a.controller})
+    controller = demonstrator(a.task, {"controller": a.controller,
+                                       "demonstrator": a.demonstrator})
     wins = 0
     for seed in range(a.seed, a.seed + a.play):
         lab = Labeller(controller, env, model)

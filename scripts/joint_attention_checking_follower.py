@@ -7,7 +7,9 @@ watches the partner's face (99 % of held-out steps), far less from the follower'
 learner would then do what infants do: watch the face, turn to the toy the partner looks at,
 look back to the face to see whether the partner has moved on. This script measures that
 strategy's ceiling with the reading given (from the world, as the scripted follower's), in
-the task's success terms:
+the task's success terms; the follower is the package's
+:class:`~mimo_social.tasks.joint_attention.checking.CheckingFollowController` (``bc_kwargs``
+``demonstrator = "checking"``):
 
 * ``face``: the follower looks at its partner's face (head and eyes, the scripted follower's PD
   law) until the partner's gaze has rested on one toy for ``--settle-s`` while the follower's
@@ -31,59 +33,9 @@ import functools
 
 import numpy as np
 
-from mimo_social.partners.base import agent_index
-from mimo_social.tasks.joint_attention.controller import GazeFollowController
+from mimo_social.tasks.joint_attention import CheckingFollowController, GazeFollowController
 from mimo_social.train.demonstrations import Demonstrator
 from mimo_social.train.envs import make_env
-
-
-class CheckingFollower(GazeFollowController):
-    """Watches the face, follows the read toy for ``look_s``, watches again (module docstring)."""
-
-    def __init__(self, look_s: float = 1.0, settle_s: float = 0.1, on_face_deg: float = 5.0,
-                 peripheral_deg: float = 0.0):
-        super().__init__()
-        self.look_s, self.settle_s = float(look_s), float(settle_s)
-        self.on_face_deg, self.peripheral_deg = float(on_face_deg), float(peripheral_deg)
-
-    def reset(self, env, agent, rng):
-        super().reset(env, agent, rng)
-        self._face = len(self._found)
-        self._found = list(self._found) + [("site", self._head_site)]
-        self._own_cams = np.asarray(env.world.agents[agent_index(env, agent)].eye_cameras)
-        self.mode, self._steps, self._read, self._seen_head = "face", 0, None, None
-        self.target = self._face
-
-    def on_face(self, d) -> bool:
-        origin = d.cam_xpos[self._own_cams].mean(axis=0)
-        gaze = -d.cam_xmat[self._own_cams].reshape(2, 3, 3)[:, :, 2].sum(axis=0)
-        face = d.site_xpos[self._head_site] - origin
-        cos = gaze @ face / np.linalg.norm(gaze) / np.linalg.norm(face)
-        return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))) <= self.on_face_deg
-
-    def _head_dir(self, d) -> np.ndarray:
-        return d.xmat[self._head_body].reshape(3, 3)[:, 0].copy()
-
-    def act(self, env, agent, observation):
-        d, dt = env.world.data, float(env.dt)
-        read = self.read_now(env)
-        if self.mode == "face":
-            if read is not None and read == self._read and self.on_face(d):
-                self._steps += 1
-            else:
-                self._steps = 0
-            self._read = read
-            if self._read is not None and self._steps * dt >= self.settle_s:
-                self.mode, self.target = "toy", self._read
-                self._steps, self._seen_head = 0, self._head_dir(d)
-        else:
-            self._steps += 1
-            turned = np.degrees(np.arccos(np.clip(self._head_dir(d) @ self._seen_head, -1, 1)))
-            if self._steps * dt >= self.look_s or (
-                    self.peripheral_deg and turned > self.peripheral_deg):
-                self.mode, self.target, self._steps, self._read = "face", self._face, 0, None
-        self._left = 1 << 30
-        return super(GazeFollowController, self).act(env, agent, observation)
 
 
 def main(argv=None) -> int:
@@ -98,7 +50,7 @@ def main(argv=None) -> int:
     env = make_env("joint_attention", per_agent=[{"vision": {"width": 8, "height": 8}}, {}])
     rows = [("scripted follower", GazeFollowController)]
     rows += [(f"checking: look {look:g} s, settle {a.settle_s:g} s, peripheral {per:g} deg",
-              functools.partial(CheckingFollower, look_s=look, settle_s=a.settle_s,
+              functools.partial(CheckingFollowController, look_s=look, settle_s=a.settle_s,
                                 peripheral_deg=per))
              for per in a.peripheral for look in a.look_s]
     for name, cls in rows:

@@ -22,11 +22,14 @@ from . import (catch_v0, contingency_v0, free_play_v0, handover_v0, high_five_v0
                joint_attention_v0, mirror_v0, reach_v0, rollover_v0, selfbody_v0, social_touch_v0,
                standup_v0, still_face_v0, turn_taking_v0)
 
-__all__ = ["EnvEntry", "CATALOG", "KINDS", "entry", "names", "make_gym", "register_envs"]
+__all__ = ["EnvEntry", "CATALOG", "KINDS", "DEFAULT_DEMONSTRATOR", "entry", "names", "make_gym",
+           "register_envs"]
 
 #: what an entry is: a sandbox without a goal, a one-agent task of the paper, or a social task
 #: (two learners, or one learner and a scripted partner)
 KINDS = ("sandbox", "one-agent", "social")
+#: the name of a task's default controller among its demonstrators
+DEFAULT_DEMONSTRATOR = "scripted"
 
 
 @dataclass(frozen=True)
@@ -54,6 +57,26 @@ class EnvEntry:
     #: ``task_options`` as pairs too (the entry stays hashable); the user's ``task_options`` are
     #: merged over the variant's
     gym_variants: tuple = ()
+    #: further controllers that solve the task another way, by name: ``(name, class)`` pairs
+    #: (``bc_kwargs`` ``demonstrator`` picks one to clone; the default, ``controller``, is
+    #: :data:`DEFAULT_DEMONSTRATOR`)
+    demonstrators: tuple = ()
+
+    def demonstrator_names(self) -> tuple[str, ...]:
+        """The names ``controller_class`` takes: the default controller's, then the others'."""
+        return (DEFAULT_DEMONSTRATOR, *(n for n, _ in self.demonstrators)) \
+            if self.controller is not None else ()
+
+    def controller_class(self, name: str | None = None) -> type:
+        """The controller ``name`` (None: the default ``controller``); a ValueError naming the
+        allowed names otherwise."""
+        if name in (None, DEFAULT_DEMONSTRATOR) and self.controller is not None:
+            return self.controller
+        others = dict(self.demonstrators)
+        if name not in others:
+            raise ValueError(f"task {self.name!r}: demonstrator={name!r} not allowed; allowed: "
+                             f"{list(self.demonstrator_names()) or 'none (no controller)'}")
+        return others[name]
 
     @property
     def gym_ids(self) -> tuple[str, ...]:
@@ -142,7 +165,8 @@ CATALOG: tuple[EnvEntry, ...] = (
              controller=mirror.MirrorController),
     EnvEntry("joint_attention", joint_attention_v0, "mimo_social/JointAttention-v0", "social",
              "follow the partner's gaze to one of four toys",
-             controller=joint_attention.GazeFollowController),
+             controller=joint_attention.GazeFollowController,
+             demonstrators=(("checking", joint_attention.CheckingFollowController),)),
     EnvEntry("social_touch", social_touch_v0, "mimo_social/SocialTouch-v0", "social",
              "touch a named part of the partner's body",
              controller=social_touch.SocialTouchController),

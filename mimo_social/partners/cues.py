@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.kinematics import hand_geoms
+from ..core.kinematics import gaze_rays, hand_geoms
 from ..expressions.faces import EXPRESSIONS
 from ..util.names import reject_old_names
 
@@ -72,11 +72,7 @@ def _index(env, name: str, what: str) -> int:
 
 def gaze_line(world, i: int) -> tuple[np.ndarray, np.ndarray]:
     """Agent ``i``'s line of sight: (origin between its eyes, unit direction), world frame."""
-    d = world.data
-    cams = world.agents[i].eye_cameras
-    origin = d.cam_xpos[cams].mean(axis=0)
-    axis = -d.cam_xmat[cams].reshape(-1, 3, 3)[:, :, 2].sum(axis=0)
-    return origin, axis / np.linalg.norm(axis)
+    return gaze_rays(world.data, world.agents[i].eye_cameras)
 
 
 def _hand_mask(world, i: int) -> np.ndarray:

@@ -16,7 +16,8 @@ __all__ = ["BC_DEFAULTS", "BC_LOSSES", "BC_ALGOS", "KEEP_UNTIL_MAX", "check_bc"]
 #: the settings of ``bc_kwargs`` and their defaults (``epochs``: ``bc_epochs``)
 BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None,
                "critic_epochs": 0, "keep_updates": 0, "keep_until": 0.5, "dagger_rounds": 0,
-               "dagger_episodes": 50, "controller": None, "noise": 0.0, **AUX_DEFAULTS}
+               "dagger_episodes": 50, "demonstrator": None, "controller": None,
+               "noise": 0.0, **AUX_DEFAULTS}
 BC_LOSSES = ("mse", "nll")
 BC_ALGOS = ("ppo", "sac")
 #: ``keep_until``'s largest value: the kept cloning falls to 0 at this many runs' lengths (at 2
@@ -103,13 +104,19 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
         raise TrainInputError(f"bc_kwargs: keep_until={kt!r}; allowed: a number in (0, "
                               f"{KEEP_UNTIL_MAX:g}] (the share of the run over which "
                               "keep_updates falls to 0; beyond 1 it is still on at the end)")
+    dn = s["demonstrator"]
+    if dn is not None and (not isinstance(dn, str) or dn not in entry(task).demonstrator_names()):
+        raise TrainInputError(f"bc_kwargs: demonstrator={dn!r}; allowed for {task}: None (the "
+                              f"task's controller) or one of "
+                              f"{list(entry(task).demonstrator_names())}")
+    cls = entry(task).controller_class(dn)
     ck = s["controller"]
     if ck is not None:
         if not isinstance(ck, Mapping) or not all(isinstance(k, str) for k in ck):
             raise TrainInputError(f"bc_kwargs: controller={ck!r}; allowed: None or a dict of "
-                                  f"{entry(task).controller.__name__}'s keyword arguments")
+                                  f"{cls.__name__}'s keyword arguments")
         try:
-            entry(task).controller(**ck)
+            cls(**ck)
         except (TypeError, ValueError) as e:
             raise TrainInputError(f"bc_kwargs: controller={dict(ck)!r} not allowed: {e}") from None
         s["controller"] = dict(ck)

@@ -60,6 +60,12 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
   from 97 % to 67 % (0.06: 57 %); at 6 Hz 97 % to 83 % (0.06: 80 %). Checked by making the
   controller once (its own error, named).
 
+* ``demonstrator`` (default None: the catalogue entry's ``controller``): another controller of
+  the task by name (the entry's ``demonstrators``), e.g. joint attention's ``"checking"``
+  (:class:`~mimo_social.tasks.joint_attention.checking.CheckingFollowController`: reads the
+  partner only while it watches the partner's face, as a learner's eyes must); ``controller``'s
+  keyword arguments are then that one's.
+
 * ``aux_label`` (default None: none) and ``aux_weight`` (1.0, PPO): each pair keeps the step's
   ``info[aux_label]`` (an integer class) and every cloning minibatch adds the cross-entropy of
   a linear head on the actor's last hidden layer naming it (:mod:`~mimo_social.train.auxiliary`): the
@@ -96,7 +102,7 @@ from gymnasium import spaces
 
 from ..core.episodes import run_episode
 from ..core.wrappers import ActionDecoder
-from ..envs.catalog import entry
+from ..envs.catalog import DEFAULT_DEMONSTRATOR, entry
 from .auxiliary import aux_head, features_and_distribution, label_of
 from .bc_settings import BC_ALGOS, BC_DEFAULTS, BC_LOSSES, check_bc
 from .tasks import TrainInputError
@@ -112,9 +118,10 @@ DEMO_SEED = 20_000
 
 
 def demonstrator(task: str, settings: Mapping[str, Any] | None = None):
-    """The task's controller class, or a factory of it with ``settings["controller"]``'s
-    keyword arguments (``bc_kwargs`` ``controller``)."""
-    cls = entry(task).controller
+    """The task's controller class (``settings["demonstrator"]``: one of the catalogue entry's
+    named ones, ``bc_kwargs`` ``demonstrator``), or a factory of it with
+    ``settings["controller"]``'s keyword arguments (``bc_kwargs`` ``controller``)."""
+    cls = entry(task).controller_class((settings or {}).get("demonstrator"))
     kw = (settings or {}).get("controller")
     return functools.partial(cls, **kw) if kw else cls
 
@@ -243,16 +250,18 @@ def play(recorder: Demonstrator, env, first: int, episodes: int) -> Demonstratio
 
 def record_demonstrations(task: str, env, episodes: int, seed: int,
                           controller: Mapping[str, Any] | None = None,
-                          noise: float = 0.0, aux_label: str | None = None) -> Demonstrations:
-    """``episodes`` episodes of the task's controller (made with the keyword arguments
-    ``controller``, if given) on the learner's env ``env`` (seeds ``seed, seed+1, ...``; the
+                          noise: float = 0.0, aux_label: str | None = None,
+                          demonstrator_name: str | None = None) -> Demonstrations:
+    """``episodes`` episodes of the task's controller (``demonstrator_name``: one of the catalogue
+    entry's named ones; made with the keyword arguments ``controller``, if given) on the
+    learner's env ``env`` (seeds ``seed, seed+1, ...``; the
     controller reset with each episode's seed), the executed actions perturbed by ``noise``
     (``bc_kwargs``, DART) and the controller's own recorded; ``aux_label``: each pair's label
     (the step's info under that key)."""
     if entry(task).controller is None:
         raise TrainInputError(f"{task} has no scripted controller")
-    return play(Demonstrator(demonstrator(task, {"controller": controller}), env, noise,
-                             aux_label), env, seed, episodes)
+    cls = demonstrator(task, {"controller": controller, "demonstrator": demonstrator_name})
+    return play(Demonstrator(cls, env, noise, aux_label), env, seed, episodes)
 
 
 def returns_to_go(rewards: np.ndarray, ends: np.ndarray, gamma: float) -> np.ndarray:
@@ -501,7 +510,7 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
     t0 = time.perf_counter()
     demos = record_demonstrations(task, env, int(settings["episodes"]), DEMO_SEED + int(seed),
                                   settings.get("controller"), settings.get("noise", 0.0),
-                                  settings.get("aux_label"))
+                                  settings.get("aux_label"), settings.get("demonstrator"))
     t1 = time.perf_counter()
     res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
                 float(settings["lr"]), str(settings["loss"]), int(seed), settings["log_std"],
@@ -509,7 +518,9 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
     if int(settings["critic_epochs"]):
         res.update(fit_critic(model, demos, int(settings["critic_epochs"]),
                               int(settings["batch_size"]), float(settings["lr"]), int(seed)))
-    return {**demos.summary(), "controller": entry(task).controller.__name__,
+    name = settings.get("demonstrator")
+    return {**demos.summary(), "controller": entry(task).controller_class(name).__name__,
+            "demonstrator": name or DEFAULT_DEMONSTRATOR,
             "controller_kwargs": settings.get("controller") or {},
             "noise": float(settings.get("noise", 0.0)),
             "aux_label": settings.get("aux_label"),

@@ -130,6 +130,7 @@ def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_pa
     bc = json.loads((out / "config.json").read_text())["bc"]
     assert bc["episodes"] == 6 and bc["seeds"] == [20_000, 20_005] and bc["epochs"] == 3
     assert bc["success_rate"] == 1.0 and bc["controller"] == "ReachController"
+    assert bc["demonstrator"] == "scripted"
     assert bc["loss_after"] < bc["loss_before"] and bc["log_std"] == -1.0
     assert bc["batch_size"] == 32 and bc["samples"] > 0
     with open(out / "progress.csv", newline="") as f:
@@ -169,6 +170,14 @@ def test_a_run_records_the_warm_start_and_evaluates_it_before_any_rl_step(tmp_pa
     ({"bc_episodes": 2, "bc_kwargs": {"controller": [6.0]}},
      ["controller=[6.0]", "ReachController's keyword arguments"]),
     ({"bc_episodes": 2, "task": "high_five"}, ["--mode shared", "one learner"]),
+    ({"bc_episodes": 2, "bc_kwargs": {"demonstrator": "checking"}},
+     ["demonstrator='checking'", "allowed for reach", "['scripted']"]),
+    ({"bc_episodes": 2, "task": "joint_attention", "mode": "scripted",
+      "bc_kwargs": {"demonstrator": 3}},
+     ["demonstrator=3", "['scripted', 'checking']"]),
+    ({"bc_episodes": 2, "task": "joint_attention", "mode": "scripted",
+      "bc_kwargs": {"demonstrator": "checking", "controller": {"read": "head"}}},
+     ["controller={'read': 'head'}", "read"]),
     ({"bc_episodes": 2, "bc_kwargs": {"noise": 1.5}}, ["noise=1.5", "[0, 1]"]),
     ({"bc_episodes": 2, "bc_kwargs": {"noise": "some"}}, ["noise='some'", "[0, 1]"]),
 ])
@@ -200,6 +209,30 @@ def test_the_demonstrator_takes_the_controller_settings_given():
     s = check_bc("reach", "ppo", None, 2, 1, {"controller": {"frequency": 8.0}})
     assert demonstrator("reach", s)().frequency == 8.0
     assert check_bc("reach", "ppo", None, 2, 1, {})["controller"] is None
+
+
+def test_a_named_demonstrator_records_its_own_episodes():
+    """bc_kwargs demonstrator: joint attention's checking follower first looks at the partner's
+    face (the scripted follower waits, the zero action, until the partner looks at a toy); the
+    settings pick it and its keyword arguments."""
+    from mimo_social.tasks.joint_attention import CheckingFollowController
+    from mimo_social.train.demonstrations import check_bc, demonstrator
+    env = make_env("joint_attention", max_steps=30,
+                   per_agent=[{"vision": {"width": 8, "height": 8}}, {}])
+    try:
+        scripted = record_demonstrations("joint_attention", env, 1, 20_000)
+        checking = record_demonstrations("joint_attention", env, 1, 20_000,
+                                         demonstrator_name="checking")
+    finally:
+        env.close()
+    assert np.array_equal(scripted.obs["vector"][0], checking.obs["vector"][0])
+    assert not np.any(scripted.actions[:5])                  # waiting for the partner's look
+    assert np.abs(checking.actions[:5]).max() > 0.05         # turning to the partner's face
+    s = check_bc("joint_attention", "ppo", "scripted", 2, 1,
+                 {"demonstrator": "checking", "controller": {"look_s": 3.0}})
+    made = demonstrator("joint_attention", s)()
+    assert isinstance(made, CheckingFollowController) and made.look_s == 3.0
+    assert check_bc("joint_attention", "ppo", None, 2, 1, {})["demonstrator"] is None
 
 
 def test_returns_to_go_stop_at_each_episode_end():

@@ -74,8 +74,11 @@ baselines:
     scripted `GazeFollowController` (reads the partner's eyes from the world) 20/20, 369.3 +- 28.8
     (the same with 64x64 eyes rendered, `mimo-social baselines`), success from step 125 on average;
     hacks: always the red ball 1/20, 108.5 +- 114.6; head-only reader (`read="head"`) 3/20, 143.8 +-
-    131.1 (tests/tasks/test_joint_attention.py, slow variant). PPO, `--normalize-obs`, 32x32 eyes, 2
-    seeds, 51k steps (13 min wall for both): success 0/20 each, return -37.2 +- 19.1 and -51.3 +-
+    131.1 (tests/tasks/test_joint_attention.py, slow variant); `CheckingFollowController` (reads
+    the partner only while it watches the partner's face, looks back at the partner's head turn:
+    what a learner's eyes allow) 20/20 (`scripts/joint_attention_checking_follower.py`). PPO,
+    `--normalize-obs`, 32x32 eyes, 2 seeds, 51k steps (13 min wall for both): success 0/20
+    each, return -37.2 +- 19.1 and -51.3 +-
     4.9 (above random, not above zero for seed 1); 64x64 eyes, 2 seeds, 100k steps (18 min wall for
     both): 0/20 each, -49.0 +- 12.6 and -47.0 +- 12.9 (the zero action's level): PPO does not follow
     the partner's gaze in these budgets (commands, curves and machine in
@@ -109,6 +112,7 @@ reward).
 
 from .task import (parallel_env, env, scripted_env, JointAttention, JointAttentionOptions)
 from .controller import GazeFollowController
+from .checking import CheckingFollowController
 
 __all__ = ["parallel_env", "env", "scripted_env", "JointAttention", "GazeFollowController",
-           "JointAttentionOptions"]
+           "CheckingFollowController", "JointAttentionOptions"]

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...core.kinematics import gaze_rays
 from ...util.checks import check_choice, check_number
 from ...partners.base import agent_index, zero_action
 from ...partners.gaze import GazeAtTarget
@@ -89,9 +90,7 @@ class GazeFollowController(GazeAtTarget):
     def _ray(self, d) -> tuple[np.ndarray, np.ndarray]:
         if self.read == "head":
             return d.site_xpos[self._head_site], d.xmat[self._head_body].reshape(3, 3)[:, 0]
-        origin = d.cam_xpos[self._cams].mean(axis=0)
-        direction = -d.cam_xmat[self._cams].reshape(2, 3, 3)[:, :, 2].sum(axis=0)
-        return origin, direction / np.linalg.norm(direction)
+        return gaze_rays(d, self._cams)
 
     def read_target(self, env) -> int | None:
         """The toy the partner looks at, as this reader sees it; between toys the last one read

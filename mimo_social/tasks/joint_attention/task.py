@@ -10,6 +10,7 @@ from gymnasium import spaces
 
 from ...body.joint_groups import GAZE_JOINTS, held_posture
 from ...body.postures import posture_joints
+from ...core.kinematics import gaze_rays
 from ...core.task import Plot, Task, TaskOptions
 from ...core.world import AgentSetup, Prop
 from ..common import face_to_face
@@ -43,11 +44,7 @@ class GazeRays:
 
     def rays(self, data) -> tuple[np.ndarray, np.ndarray]:
         """Origins (n, 3) and unit directions (n, 3); a camera looks along its frame's -z."""
-        origin = data.cam_xpos[self.cams].mean(axis=1)
-        axes = -data.cam_xmat[self.cams].reshape(*self.cams.shape, 3, 3)[..., 2]
-        direction = axes.sum(axis=1)
-        direction /= np.linalg.norm(direction, axis=1, keepdims=True)
-        return origin, direction
+        return gaze_rays(data, self.cams)
 
     def angles(self, data) -> tuple[np.ndarray, np.ndarray]:
         """Angle (rad) from each agent's ray to each toy centre (n, k), and each toy's angular
