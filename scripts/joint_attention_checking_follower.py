@@ -17,7 +17,9 @@ the task's success terms; the follower is the package's
 * ``toy``: it turns to that toy and looks at it for ``--look-s``, then back to ``face``;
   with ``--peripheral DEG`` it goes back earlier when the partner's head turns by more than DEG
   from where it was at the reading (a head turn is visible out of the corner of the eye; the
-  partner's eyes are not).
+  partner's eyes are not); ``--seen in_view`` (the default) counts the turn only while the
+  partner's head is inside the follower's eye images (``--field-of-view`` degrees, the eyes'
+  vertical field; 60 by default), ``--seen anywhere`` wherever it is.
 
     OMP_NUM_THREADS=1 python3 scripts/joint_attention_checking_follower.py --episodes 20 \
         --look-s 0.5 1 2 --peripheral 0 5
@@ -34,6 +36,7 @@ import functools
 import numpy as np
 
 from mimo_social.tasks.joint_attention import CheckingFollowController, GazeFollowController
+from mimo_social.tasks.joint_attention.checking import HEAD_TURN_SEEN
 from mimo_social.train.demonstrations import Demonstrator
 from mimo_social.train.envs import make_env
 
@@ -45,30 +48,47 @@ def main(argv=None) -> int:
     p.add_argument("--look-s", type=float, nargs="+", default=[0.5, 1.0, 2.0])
     p.add_argument("--settle-s", type=float, default=0.1)
     p.add_argument("--peripheral", type=float, nargs="+", default=[0.0])
+    p.add_argument("--seen", nargs="+", default=["in_view"], choices=HEAD_TURN_SEEN,
+                   help="where the partner's head turn is seen (head_turn_seen)")
+    p.add_argument("--field-of-view", type=float, nargs="+", default=[60.0],
+                   help="the follower's eyes' vertical field of view, degrees")
     a = p.parse_args(argv)
-    # the learner's eyes are not read here: 8x8 images keep the rendering cheap
-    env = make_env("joint_attention", per_agent=[{"vision": {"width": 8, "height": 8}}, {}])
-    rows = [("scripted follower", GazeFollowController)]
-    rows += [(f"checking: look {look:g} s, settle {a.settle_s:g} s, peripheral {per:g} deg",
-              functools.partial(CheckingFollowController, look_s=look, settle_s=a.settle_s,
-                                peripheral_deg=per))
-             for per in a.peripheral for look in a.look_s]
-    for name, cls in rows:
-        teacher, success, share = Demonstrator(cls, env), [], []
-        for k in range(a.episodes):
-            obs, info = env.reset(seed=a.seed + k)
-            teacher.reset(env, "infant_0", np.random.default_rng(a.seed + k))
-            done = False
-            while not done:
-                obs, _, term, trunc, info = env.step(teacher.act(env, "infant_0", obs))
-                done = term or trunc
-            teacher.obs.clear()
-            teacher.actions.clear()
-            success.append(bool(info["is_success"]))
-            share.append(float(info["on_target_fraction"]))
-        print(f"{name}: success {np.mean(success):.0%} of {a.episodes}, on target "
-              f"{np.mean(share):.2f} of the target steps (min {np.min(share):.2f}, max "
-              f"{np.max(share):.2f})", flush=True)
+    for fov in a.field_of_view:
+        # the follower's eyes are not read here: 8x8 images keep the rendering cheap
+        vision = {"width": 8, "height": 8, "field_of_view": fov}
+        env = make_env("joint_attention", per_agent=[{"vision": vision}, {}])
+        rows = [("scripted follower", GazeFollowController)] if fov == a.field_of_view[0] else []
+        rows += [(f"checking: look {look:g} s, settle {a.settle_s:g} s, peripheral {per:g} deg"
+                  + (f" seen {seen}, field of view {fov:g} deg" if per else ""),
+                  functools.partial(CheckingFollowController, look_s=look, settle_s=a.settle_s,
+                                    peripheral_deg=per, head_turn_seen=seen))
+                 for per in a.peripheral for seen in (a.seen if per else a.seen[:1])
+                 for look in a.look_s]
+        if fov != a.field_of_view[0]:   # on a timer or seen anywhere it does not matter
+            rows = [r for r in rows if "seen in_view" in r[0]]
+        for name, cls in rows:
+            play(env, name, cls, a)
+        env.close()
+    return 0
+
+
+def play(env, name: str, cls, a) -> None:
+    """``a.episodes`` episodes of the follower ``cls`` on ``env``; prints one line."""
+    teacher, success, share = Demonstrator(cls, env), [], []
+    for k in range(a.episodes):
+        obs, info = env.reset(seed=a.seed + k)
+        teacher.reset(env, "infant_0", np.random.default_rng(a.seed + k))
+        done = False
+        while not done:
+            obs, _, term, trunc, info = env.step(teacher.act(env, "infant_0", obs))
+            done = term or trunc
+        teacher.obs.clear()
+        teacher.actions.clear()
+        success.append(bool(info["is_success"]))
+        share.append(float(info["on_target_fraction"]))
+    print(f"{name}: success {np.mean(success):.0%} of {a.episodes}, on target "
+          f"{np.mean(share):.2f} of the target steps (min {np.min(share):.2f}, max "
+          f"{np.max(share):.2f})", flush=True)
     env.close()
     return 0
 

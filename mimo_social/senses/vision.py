@@ -2,7 +2,14 @@
 
 Each eye body carries a camera (``right_eye`` / ``left_eye``, 60 degree vertical field of view,
 looking along the eye's +x) that moves with the eye joints (+-45 deg horizontal, -47..33
-vertical, +-8 torsional). Observation keys per agent with vision on:
+vertical, +-8 torsional). ``field_of_view`` (degrees, vertical; 10 to 160) widens or narrows
+both eyes of the agent (the cameras' ``cam_fovy`` in the compiled model, set when its vision is
+built; a pickled copy keeps it): 60 degrees is a small part of an 18-month-old's field (kinetic
+perimetry finds it near adult size around 17 months, Dobson et al. 1998, Vision Res. 38:2743),
+and a partner's head above a toy on the floor is out of a 60-degree view that fixates the toy
+(docs/training/issue30/pilots/joint_attention_head_turn). A wide perspective image spends its
+pixels on the periphery; a ``fovea`` gives the centre back its detail. Observation keys per
+agent with vision on:
 
 * ``eye_left``, ``eye_right``: ``Box(0, 255, (height, width, 3), uint8)``, row 0 at the top;
 * with ``depth=True`` also ``depth_left``, ``depth_right``: ``Box(0, inf, (height, width),
@@ -53,7 +60,7 @@ from gymnasium import spaces
 
 from ..render.eye_renderer import Tile, TileRenderer
 from ..render.png import write_png
-from ..util.checks import check_bool, check_int
+from ..util.checks import check_bool, check_int, check_number
 from ..util.names import reject_old_names
 from .acuity import acuity_blur, check_acuity, cutoff_for
 from .base import SenseEntry
@@ -67,7 +74,8 @@ EYES = ("left", "right")
 
 @dataclass(frozen=True)
 class VisionConfig:
-    """Two eye cameras (60 degree field of view) rendering RGB images, optionally depth."""
+    """Two eye cameras (60 degree field of view, or ``field_of_view``) rendering RGB images,
+    optionally depth."""
 
     width: int = 256        # pixels, each eye
     height: int = 256       # pixels, each eye
@@ -79,6 +87,8 @@ class VisionConfig:
     # rendered render_scale (1 to 8, default: the strength rounded up) times larger and warped
     # to width x height, centre magnified, the whole field of view kept (docs/senses.md)
     fovea: FoveaConfig | float | dict | None = None
+    # The eyes' vertical field of view in degrees, 10 to 160 (None: the body's 60)
+    field_of_view: float | None = None
 
     def __post_init__(self):
         for key in ("width", "height"):
@@ -87,6 +97,10 @@ class VisionConfig:
         object.__setattr__(self, "every", check_int("vision", "every", self.every, 1, 1000))
         object.__setattr__(self, "acuity", check_acuity(self.acuity))
         object.__setattr__(self, "fovea", check_fovea(self.fovea, self.width, self.height))
+        if self.field_of_view is not None:
+            object.__setattr__(self, "field_of_view", check_number(
+                "vision", "field_of_view", self.field_of_view, 10.0, 160.0,
+                "degrees, vertical; None: the body's 60"))
 
 
 class VisionSystem:
@@ -103,6 +117,8 @@ class VisionSystem:
             cfg = self.configs[i]
             right, left = (int(c) for c in world.agents[i].eye_cameras)
             self.cameras[i] = {"left": left, "right": right}
+            if cfg.field_of_view is not None:
+                world.model.cam_fovy[[left, right]] = cfg.field_of_view
             self.cutoffs[i] = cutoff_for(cfg.acuity, world.agent_setups[i].config.age)
             # with a fovea: rendered k times larger, blurred there (in degrees), then warped
             k = cfg.fovea.render_scale if cfg.fovea else 1

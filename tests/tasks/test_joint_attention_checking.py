@@ -7,23 +7,22 @@ from __future__ import annotations
 
 import functools
 
+import mujoco
 import numpy as np
 import pytest
 
+from mimo_social.core.kinematics import LookAt
 from mimo_social.envs.catalog import entry
 from mimo_social.tasks.joint_attention import CheckingFollowController, GazeFollowController
 from mimo_social.train.demonstrations import Demonstrator
 from mimo_social.train.envs import make_env
 from mimo_social.util.checks import ConfigError
 
-TINY_EYES = {"per_agent": [{"vision": {"width": 8, "height": 8}}, {}]}
-
-
-def play(seed: int, max_steps: int | None = None, **kwargs):
-    """One episode of the checking follower: per step its mode, its gaze's angle to the face,
-    whether the partner's gaze was read there, and the last info."""
-    env = make_env("joint_attention", **TINY_EYES,
-                   **({"max_steps": max_steps} if max_steps else {}))
+def play(seed: int, fov: float | None = None, **kwargs):
+    """One episode of the checking follower (eyes of ``fov`` degrees, None: 60): per step its
+    mode, its gaze's angle to the face, the toy read from the partner's gaze, and the last info."""
+    vision = {"width": 8, "height": 8, "field_of_view": fov}
+    env = make_env("joint_attention", per_agent=[{"vision": vision}, {}])
     teacher = Demonstrator(functools.partial(CheckingFollowController, **kwargs), env)
     modes, to_face, read = [], [], []
     try:
@@ -72,8 +71,40 @@ def test_on_a_timer_alone_each_look_at_a_toy_lasts_look_s_and_a_head_turn_ends_i
     timer, *_ , dt = play(1002, look_s=1.0, peripheral_deg=0.0)
     looks = runs(timer, "toy")
     assert looks and all(n == round(1.0 / dt) for n in looks)
-    cued, *_ = play(1002, look_s=1.0, peripheral_deg=3.0)
+    cued, *_ = play(1002, look_s=1.0, peripheral_deg=3.0, head_turn_seen="anywhere")
     assert min(runs(cued, "toy")) < round(1.0 / dt)      # back at the partner's head turn
+    # seen only in view: out of a 60-degree eye's view while it looks at a toy, as the timer
+    unseen, *_ = play(1002, look_s=1.0, peripheral_deg=3.0)
+    assert np.array_equal(unseen, timer)
+    wide, *_ = play(1002, fov=150.0, look_s=1.0, peripheral_deg=3.0)
+    assert min(runs(wide, "toy")) < round(1.0 / dt)      # a 150-degree eye sees it
+
+
+def test_the_partner_s_head_is_in_view_on_the_face_and_out_of_a_60_degree_view_on_a_toy():
+    env = make_env("joint_attention", per_agent=[{"vision": {"width": 8, "height": 8}}, {}])
+    c = CheckingFollowController()
+    seen = {}
+    try:
+        env.reset(seed=1000)
+        core = env.unwrapped.parallel.unwrapped
+        w = core.world
+        m, d = w.model, w.data
+        look, start = LookAt(w, 0), d.qpos.copy()
+        for fov in (60.0, 150.0):
+            m.cam_fovy[list(w.agents[0].eye_cameras)] = fov     # as field_of_view sets it
+            c.reset(core, "infant_0", np.random.default_rng(0))
+            for name, kind, obj in [("face", "site", int(w.agents[1].head_site))] + [
+                    (f"toy {k}", "body", int(t)) for k, t in enumerate(core.task.toy_bodies)]:
+                d.qpos[:] = start
+                d.qpos[look.qpos] = look(m, d, kind, obj)
+                mujoco.mj_forward(m, d)
+                seen[fov, name] = c.head_in_view(d)
+    finally:
+        env.close()
+    toys = [k for k in seen if k[1] != "face"]
+    assert seen[60.0, "face"] and seen[150.0, "face"]
+    assert not any(seen[k] for k in toys if k[0] == 60.0), seen
+    assert any(seen[k] for k in toys if k[0] == 150.0), seen
 
 
 def test_the_checking_follower_is_the_task_s_named_demonstrator():
@@ -95,6 +126,7 @@ def test_the_checking_follower_is_the_task_s_named_demonstrator():
     ({"on_face_deg": float("nan")}, ["on_face_deg=nan", "0.5 to 45"]),
     ({"peripheral_deg": 100}, ["peripheral_deg=100", "0 to 90", "no early look back"]),
     ({"look_s": True}, ["look_s=True"]),
+    ({"head_turn_seen": "near"}, ["head_turn_seen='near'", "in_view", "anywhere"]),
 ])
 def test_bad_settings_are_refused_with_the_setting_named(kwargs, words):
     with pytest.raises(ConfigError) as info:
