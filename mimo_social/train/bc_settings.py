@@ -17,12 +17,35 @@ __all__ = ["BC_DEFAULTS", "BC_LOSSES", "BC_ALGOS", "KEEP_UNTIL_MAX", "check_bc"]
 BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_std": None,
                "critic_epochs": 0, "keep_updates": 0, "keep_until": 0.5, "dagger_rounds": 0,
                "dagger_episodes": 50, "demonstrator": None, "controller": None,
-               "noise": 0.0, **AUX_DEFAULTS}
+               "noise": 0.0, "seq_len": 128, "seq_batch": 4, **AUX_DEFAULTS}
 BC_LOSSES = ("mse", "nll")
-BC_ALGOS = ("ppo", "sac")
+BC_ALGOS = ("ppo", "sac", "recurrent_ppo")
+#: the settings a recurrent policy's cloning (by sequences) refuses: they work pair by pair
+PAIRWISE = ("keep_updates", "dagger_rounds", "critic_epochs", "aux_label")
 #: ``keep_until``'s largest value: the kept cloning falls to 0 at this many runs' lengths (at 2
 #: it is at half strength at the run's end; at 1000 all but constant)
 KEEP_UNTIL_MAX = 1000.0
+
+
+def check_sequences(algo: str, kwargs: Mapping[str, Any]) -> None:
+    """``seq_len`` and ``seq_batch`` (with recurrent_ppo only, integers >= 1) and, with
+    recurrent_ppo, none of :data:`PAIRWISE` set; a TrainInputError naming the key otherwise."""
+    for key, lo in (("seq_len", 2), ("seq_batch", 1)):
+        if key not in kwargs:
+            continue
+        v = kwargs[key]
+        if algo != "recurrent_ppo":
+            raise TrainInputError(f"bc_kwargs: {key}={v!r} with algo {algo!r}; allowed: with "
+                                  "recurrent_ppo only (its LSTM policy is cloned by sequences)")
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            raise TrainInputError(f"bc_kwargs: {key}={v!r}; allowed: an integer >= {lo}")
+    if algo == "recurrent_ppo":
+        for key in PAIRWISE:
+            if kwargs.get(key) not in (None, 0, BC_DEFAULTS[key]):
+                raise TrainInputError(
+                    f"bc_kwargs: {key}={kwargs[key]!r} with recurrent_ppo; allowed: "
+                    f"{BC_DEFAULTS[key]!r} (it works pair by pair; the LSTM policy is cloned by "
+                    "sequences)")
 
 
 def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
@@ -49,8 +72,8 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
                               f"{', '.join(k for k in BC_DEFAULTS if k != 'epochs')} (the "
                               "epochs: bc_epochs)")
     if algo not in BC_ALGOS:
-        raise TrainInputError(f"bc_episodes with algo {algo!r}; allowed: {', '.join(BC_ALGOS)} "
-                              "(a recurrent policy is cloned over whole sequences: not here)")
+        raise TrainInputError(f"bc_episodes with algo {algo!r}; allowed: {', '.join(BC_ALGOS)}")
+    check_sequences(algo, kwargs)
     if mode not in (None, "scripted"):
         raise TrainInputError(f"bc_episodes with --mode {mode}; allowed: one learner (a "
                               "one-agent task, or --mode scripted): the controller drives one "
@@ -70,11 +93,11 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
         raise TrainInputError(f"bc_kwargs: loss={s['loss']!r}; allowed with {algo}: {allowed}")
     ls = s["log_std"]
     values = ls if isinstance(ls, (list, tuple)) else [ls]
-    if ls is not None and (algo != "ppo" or not values or any(
+    if ls is not None and (algo not in ("ppo", "recurrent_ppo") or not values or any(
             isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
             for v in values)):
-        raise TrainInputError(f"bc_kwargs: log_std={ls!r}; allowed: None, or with ppo a finite "
-                              "number or a non-empty list of them, one per action dimension "
+        raise TrainInputError(f"bc_kwargs: log_std={ls!r}; allowed: None, or with ppo (or "
+                              "recurrent_ppo) a finite number or a non-empty list of them, one per action dimension "
                               "(the Gaussian's log-std after cloning)")
     if isinstance(ls, tuple):
         s["log_std"] = list(ls)

@@ -78,7 +78,12 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
   spawned from its seed). The clone then sees the states just off the controller's path and
   the way back from them, where a clone of clean episodes has no data (its errors compound).
 
-``RecurrentPPO`` is refused (its policy needs the LSTM states over whole sequences).
+* ``seq_len`` (default 128) and ``seq_batch`` (4), ``--algo recurrent_ppo`` only: the LSTM
+  policy is cloned by consecutive sequences of ``seq_len`` steps of each episode, ``seq_batch``
+  of them a minibatch, the LSTM state zero at each sequence's start
+  (:mod:`~mimo_social.train.sequence_cloning`); ``keep_updates``, DAgger, ``critic_epochs`` and
+  ``aux_label`` are refused with it (they work pair by pair).
+
 ``config.json["bc"]`` records the episodes, their seeds, the demonstrations' success rate and
 mean return, the samples, the settings, the loss before and after cloning and the time taken;
 an evaluation right after cloning (before any RL step) is the first row of ``progress.csv``
@@ -105,6 +110,7 @@ from ..core.wrappers import ActionDecoder
 from ..envs.catalog import DEFAULT_DEMONSTRATOR, entry
 from .auxiliary import aux_head, features_and_distribution, label_of
 from .bc_settings import BC_ALGOS, BC_DEFAULTS, BC_LOSSES, check_bc
+from .sequence_cloning import clone_sequences, is_recurrent
 from .tasks import TrainInputError
 
 __all__ = ["BC_DEFAULTS", "BC_ALGOS", "BC_LOSSES", "DEMO_SEED", "Demonstrations", "Demonstrator",
@@ -440,7 +446,12 @@ def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: f
           aux_weight: float = 1.0) -> dict:
     """Trains ``model``'s policy on ``demos`` (module docstring); returns the mean loss over
     all pairs before and after, the updates made and the kind of loss (with an auxiliary label:
-    the head's accuracy on the labelled pairs after)."""
+    the head's accuracy on the labelled pairs after). A recurrent policy is cloned by sequences
+    (:func:`~mimo_social.train.sequence_cloning.clone_sequences`, ``batch_size`` steps a
+    minibatch: ``batch_size // 128`` sequences of 128)."""
+    if is_recurrent(model.policy):
+        return clone_sequences(model, demos, epochs, 128, max(1, int(batch_size) // 128), lr,
+                               loss, seed, log_std)
     cloner = Cloner(model, demos, lr, loss, aux_weight)
     before = cloner.mean_loss()
     rng = np.random.default_rng(seed)
@@ -512,9 +523,14 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
                                   settings.get("controller"), settings.get("noise", 0.0),
                                   settings.get("aux_label"), settings.get("demonstrator"))
     t1 = time.perf_counter()
-    res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
-                float(settings["lr"]), str(settings["loss"]), int(seed), settings["log_std"],
-                float(settings.get("aux_weight", 1.0)))
+    if is_recurrent(model.policy):
+        res = clone_sequences(model, demos, int(settings["epochs"]), int(settings["seq_len"]),
+                              int(settings["seq_batch"]), float(settings["lr"]),
+                              str(settings["loss"]), int(seed), settings["log_std"])
+    else:
+        res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
+                    float(settings["lr"]), str(settings["loss"]), int(seed),
+                    settings["log_std"], float(settings.get("aux_weight", 1.0)))
     if int(settings["critic_epochs"]):
         res.update(fit_critic(model, demos, int(settings["critic_epochs"]),
                               int(settings["batch_size"]), float(settings["lr"]), int(seed)))

@@ -1,8 +1,8 @@
 """Pilot (issue 30, twelfth session): clone a joint-attention demonstrator into foveated eyes.
 
 Arguments: demonstrator (``scripted`` or ``checking``), episodes, k (every k-th pair kept),
-epochs, DART noise, episodes played, fovea (README.md beside it). The learner's eyes: 96x96 with
-the given fovea; the demonstrations' seeds 20000.., the clone's mean action plays 1000.. while
+epochs, DART noise, episodes played, fovea and, optionally, the eyes' field of view in degrees
+(default 60; README.md beside it). The learner's eyes: 96x96 with the given fovea; the demonstrations' seeds 20000.., the clone's mean action plays 1000.. while
 the demonstrator labels every state. Per episode: success, the share of target steps on target,
 the action error (mean absolute) in each of the labeller's modes and, in ``face`` mode, how
 often the clone's gaze is within 5 degrees of the partner's face.
@@ -41,8 +41,10 @@ class ModeLabeller(Labeller):
 def main():
     name, episodes, every, epochs = sys.argv[1], *map(int, sys.argv[2:5])
     noise, play, fovea = float(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
+    fov = float(sys.argv[8]) if len(sys.argv) > 8 else None
     task = "joint_attention"
-    kwargs = {"per_agent": [{"vision": {"width": 96, "height": 96, "fovea": fovea}}, {}]}
+    vision = {"width": 96, "height": 96, "fovea": fovea, "field_of_view": fov}
+    kwargs = {"per_agent": [{"vision": vision}, {}]}
     torch.set_num_threads(1)
     env = make_env(task, **kwargs)
     venv = DummyVecEnv([lambda: make_env(task, **kwargs)])
