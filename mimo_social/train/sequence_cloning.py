@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .log_std import set_log_std
+
 __all__ = ["is_recurrent", "sequences", "SequenceCloner", "clone_sequences"]
 
 
@@ -112,8 +114,6 @@ def clone_sequences(model, demos, epochs: int, seq_len: int = 128, seq_batch: in
     """Trains a recurrent ``model``'s policy on ``demos`` by sequences (module docstring);
     returns what :func:`~mimo_social.train.demonstrations.clone` returns, with the sequences'
     count and length."""
-    from .demonstrations import set_log_std
-
     cloner = SequenceCloner(model, demos, seq_len, lr, loss)
     before = cloner.mean_loss(seq_batch)
     rng = np.random.default_rng(seed)
