@@ -2,7 +2,8 @@
 foveated eyes, by sequences; the clone plays.
 
 Arguments: demonstrator (``checking`` or ``scripted``), episodes, epochs, seq_len, seq_batch,
-DART noise, episodes played, fovea, field of view (degrees) (README.md beside it). The learner:
+DART noise, episodes played, fovea, field of view (degrees) and, optionally, the
+demonstrator's keyword arguments as JSON (README.md beside it). The learner:
 RecurrentPPO's ``MultiInputLstmPolicy`` (the package's CNN before the LSTM, observations
 normalised with the scale floored at 0.01), every step of every demonstration kept
 (seeds 20000..), cloned at lr 3e-4 by sequences (``SequenceCloner`` of
@@ -11,6 +12,7 @@ clone's mean action plays seeds 1000.. (its LSTM state carried through each epis
 demonstrator labels every state. Per episode as the feed-forward pilot prints
 (``../joint_attention_checking_clone/ja_checking_clone.py``).
 """
+import json
 import sys
 import time
 
@@ -52,6 +54,7 @@ class RecurrentLabeller(Labeller):
 def main():
     name, episodes, epochs, seq_len, seq_batch = sys.argv[1], *map(int, sys.argv[2:6])
     noise, play, fovea, fov = float(sys.argv[6]), int(sys.argv[7]), *map(float, sys.argv[8:10])
+    ck = json.loads(sys.argv[10]) if len(sys.argv) > 10 else None
     task = "joint_attention"
     vision = {"width": 96, "height": 96, "fovea": fovea, "field_of_view": fov}
     kwargs = {"per_agent": [{"vision": vision}, {}]}
@@ -63,7 +66,7 @@ def main():
     t0 = time.time()
     demos = None
     for c in range(0, episodes, 10):
-        d = record_demonstrations(task, env, min(10, episodes - c), 20_000 + c, None, noise,
+        d = record_demonstrations(task, env, min(10, episodes - c), 20_000 + c, ck, noise,
                                   demonstrator_name=name)
         demos = d if demos is None else demos.joined(d)
         print(f"recorded {c + len(d.seeds)} episodes, success {np.mean(demos.successes):.2f}, "
@@ -86,7 +89,7 @@ def main():
               f"{time.time() - t0:.0f} s", flush=True)
     print(f"loss after {cloner.mean_loss(seq_batch):.4g}, {time.time() - t0:.0f} s", flush=True)
     model.policy.set_training_mode(False)
-    controller = demonstrator(task, {"demonstrator": name})
+    controller = demonstrator(task, {"demonstrator": name, "controller": ck})
     wins = []
     for seed in range(1000, 1000 + play):
         lab = RecurrentLabeller(controller, env, model)
