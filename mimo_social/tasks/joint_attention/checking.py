@@ -108,9 +108,6 @@ class CheckingFollowController(GazeFollowController):
                                       axis=1)
         return bool(np.any(inside))
 
-    def _head_dir(self, data) -> np.ndarray:
-        return data.xmat[self._head_body].reshape(3, 3)[:, 0].copy()
-
     def act(self, env, agent, observation):
         if getattr(self, "_own_cams", None) is None:
             raise RuntimeError("CheckingFollowController.act() before reset(); reset the env "
@@ -124,10 +121,10 @@ class CheckingFollowController(GazeFollowController):
             self._read = read
             if read is not None and watching and self._steps * dt >= self.settle_s:
                 self.mode, self.target = "toy", read
-                self._steps, self._seen_head = 0, self._head_dir(d)
+                self._steps, self._seen_head = 0, self.head_direction(d)
         else:
             self._steps += 1
-            turned = np.degrees(np.arccos(np.clip(self._head_dir(d) @ self._seen_head,
+            turned = np.degrees(np.arccos(np.clip(self.head_direction(d) @ self._seen_head,
                                                   -1.0, 1.0)))
             seen = self.head_turn_seen == "anywhere" or self.head_in_view(d)
             if self._steps * dt >= self.look_s or (

@@ -83,13 +83,17 @@ class GazeFollowController(GazeAtTarget):
         self._toys = np.asarray(env.task.toy_bodies, dtype=np.intp)
         # the partner's head at rest faces the follower: its facing direction then
         d = w.data
-        self._rest = d.xmat[self._head_body].reshape(3, 3)[:, 0].copy()
+        self._rest = self.head_direction(d)
         self._zero = zero_action(env.action_space(agent))
         self.target = None
 
+    def head_direction(self, d) -> np.ndarray:
+        """The partner's head's facing direction (its frame's x axis, world frame; a copy)."""
+        return d.xmat[self._head_body].reshape(3, 3)[:, 0].copy()
+
     def _ray(self, d) -> tuple[np.ndarray, np.ndarray]:
         if self.read == "head":
-            return d.site_xpos[self._head_site], d.xmat[self._head_body].reshape(3, 3)[:, 0]
+            return d.site_xpos[self._head_site], self.head_direction(d)
         return gaze_rays(d, self._cams)
 
     def read_target(self, env) -> int | None:
