@@ -53,19 +53,21 @@ def main(argv=None) -> int:
     p.add_argument("--field-of-view", type=float, nargs="+", default=[60.0],
                    help="the follower's eyes' vertical field of view, degrees")
     a = p.parse_args(argv)
-    for fov in a.field_of_view:
+    for k, fov in enumerate(a.field_of_view):
         # the follower's eyes are not read here: 8x8 images keep the rendering cheap
         vision = {"width": 8, "height": 8, "field_of_view": fov}
         env = make_env("joint_attention", per_agent=[{"vision": vision}, {}])
-        rows = [("scripted follower", GazeFollowController)] if fov == a.field_of_view[0] else []
+        # the field of view matters only to a head turn seen in view: the scripted follower, the
+        # timer alone (peripheral 0) and "anywhere" play with the first field of view only
+        settings = [(per, seen) for per in a.peripheral
+                    for seen in (a.seen if per else a.seen[:1])
+                    if k == 0 or (per and seen == "in_view")]
+        rows = [("scripted follower", GazeFollowController)] if k == 0 else []
         rows += [(f"checking: look {look:g} s, settle {a.settle_s:g} s, peripheral {per:g} deg"
                   + (f" seen {seen}, field of view {fov:g} deg" if per else ""),
                   functools.partial(CheckingFollowController, look_s=look, settle_s=a.settle_s,
                                     peripheral_deg=per, head_turn_seen=seen))
-                 for per in a.peripheral for seen in (a.seen if per else a.seen[:1])
-                 for look in a.look_s]
-        if fov != a.field_of_view[0]:   # on a timer or seen anywhere it does not matter
-            rows = [r for r in rows if "seen in_view" in r[0]]
+                 for per, seen in settings for look in a.look_s]
         for name, cls in rows:
             play(env, name, cls, a)
         env.close()

@@ -97,8 +97,8 @@ def check_bc(task: str, algo: str, mode: str | None, episodes, epochs,
             isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
             for v in values)):
         raise TrainInputError(f"bc_kwargs: log_std={ls!r}; allowed: None, or with ppo (or "
-                              "recurrent_ppo) a finite number or a non-empty list of them, one per action dimension "
-                              "(the Gaussian's log-std after cloning)")
+                              "recurrent_ppo) a finite number or a non-empty list of them, one "
+                              "per action dimension (the Gaussian's log-std after cloning)")
     if isinstance(ls, tuple):
         s["log_std"] = list(ls)
     ce = s["critic_epochs"]

@@ -414,15 +414,15 @@ class Cloner:
 
 def clone(model, demos: Demonstrations, epochs: int, batch_size: int = 64, lr: float = 1e-3,
           loss: str = "mse", seed: int = 0, log_std: float | list | None = None,
-          aux_weight: float = 1.0) -> dict:
+          aux_weight: float = 1.0, seq_len: int = 128, seq_batch: int = 4) -> dict:
     """Trains ``model``'s policy on ``demos`` (module docstring); returns the mean loss over
     all pairs before and after, the updates made and the kind of loss (with an auxiliary label:
     the head's accuracy on the labelled pairs after). A recurrent policy is cloned by sequences
-    (:func:`~mimo_social.train.sequence_cloning.clone_sequences`, ``batch_size`` steps a
-    minibatch: ``batch_size // 128`` sequences of 128)."""
+    (:func:`~mimo_social.train.sequence_cloning.clone_sequences`: ``seq_batch`` sequences of
+    ``seq_len`` steps a minibatch; ``batch_size`` and ``aux_weight`` are for pairs)."""
     if is_recurrent(model.policy):
-        return clone_sequences(model, demos, epochs, 128, max(1, int(batch_size) // 128), lr,
-                               loss, seed, log_std)
+        return clone_sequences(model, demos, epochs, seq_len, seq_batch, lr, loss, seed,
+                               log_std)
     cloner = Cloner(model, demos, lr, loss, aux_weight)
     before = cloner.mean_loss()
     rng = np.random.default_rng(seed)
@@ -494,14 +494,10 @@ def warm_start(model, task: str, env, settings: Mapping[str, Any],
                                   settings.get("controller"), settings.get("noise", 0.0),
                                   settings.get("aux_label"), settings.get("demonstrator"))
     t1 = time.perf_counter()
-    if is_recurrent(model.policy):
-        res = clone_sequences(model, demos, int(settings["epochs"]), int(settings["seq_len"]),
-                              int(settings["seq_batch"]), float(settings["lr"]),
-                              str(settings["loss"]), int(seed), settings["log_std"])
-    else:
-        res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
-                    float(settings["lr"]), str(settings["loss"]), int(seed),
-                    settings["log_std"], float(settings.get("aux_weight", 1.0)))
+    res = clone(model, demos, int(settings["epochs"]), int(settings["batch_size"]),
+                float(settings["lr"]), str(settings["loss"]), int(seed), settings["log_std"],
+                float(settings.get("aux_weight", 1.0)), int(settings["seq_len"]),
+                int(settings["seq_batch"]))
     if int(settings["critic_epochs"]):
         res.update(fit_critic(model, demos, int(settings["critic_epochs"]),
                               int(settings["batch_size"]), float(settings["lr"]), int(seed)))

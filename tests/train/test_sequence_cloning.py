@@ -79,7 +79,7 @@ def test_an_lstm_clone_carries_a_cue_seen_at_the_first_step_and_a_feed_forward_o
     demos = cue_demonstrations(64, 12, np.random.default_rng(0))
     lstm = RecurrentPPO("MlpLstmPolicy", CueEnv(), seed=0, device="cpu",
                         policy_kwargs={"lstm_hidden_size": 16})
-    fit = clone(lstm, demos, 150, batch_size=8 * 128, lr=3e-3, seed=0)
+    fit = clone(lstm, demos, 150, lr=3e-3, seed=0, seq_len=128, seq_batch=8)
     assert fit["loss"] == "mse, by sequences" and fit["sequences"] == 64
     assert fit["loss_after"] < 0.1 * fit["loss_before"]
     cues = np.array([1.0, -1.0, -1.0, 1.0])
