@@ -19,15 +19,17 @@ from ._args import non_negative_float, output_dir, positive_float, positive_int,
 __all__ = ["NAME", "add_parser", "run"]
 
 NAME = "train-gpu"
-TASKS = ("reach", "high_five")
+TASKS = ("reach", "high_five", "selfbody")
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
-        NAME, help="PPO on MuJoCo Warp's batched worlds, on the device (reach, high five)",
+        NAME, help="PPO on MuJoCo Warp's batched worlds, on the device (reach, high five, "
+             "self-body)",
         description="PPO (TorchRL's ClipPPOLoss and GAE) on N batched MuJoCo Warp worlds of "
-                    "reach or of the high five with its scripted partner, collected and "
-                    "learnt on the device: a GPU when Warp sees one, else Warp's CPU device.")
+                    "reach, of self-body or of the high five with its scripted partner, "
+                    "collected and learnt on the device: a GPU when Warp sees one, else Warp's "
+                    "CPU device.")
     parser.add_argument("--task", choices=TASKS, required=True, help="the task to learn")
     parser.add_argument("--worlds", type=positive_int, default=64,
                         help="worlds stepped together (default 64)")

@@ -16,8 +16,9 @@ __all__ = ["BatchedContacts"]
 
 class BatchedContacts:
     """The contact buffer of a batched env's data as tensors (views, no copy): ``geom``
-    ``(naconmax, 2)``, ``dist``, ``frame`` ``(naconmax, 3, 3)`` (row 0: the normal, from
-    geom 0 to geom 1), ``worldid``; ``nacon`` ``(1,)``."""
+    ``(naconmax, 2)``, ``dist``, ``pos`` ``(naconmax, 3)`` (the contact point, world frame),
+    ``frame`` ``(naconmax, 3, 3)`` (row 0: the normal, from geom 0 to geom 1), ``worldid``;
+    ``nacon`` ``(1,)``."""
 
     def __init__(self, model, data, mjm, nworld: int, wp, mjw, torch, on_device):
         c = data.contact
@@ -27,6 +28,7 @@ class BatchedContacts:
         self.ngeom = int(mjm.ngeom)
         self.geom = wp.to_torch(c.geom)
         self.dist = wp.to_torch(c.dist)
+        self.pos = wp.to_torch(c.pos)
         self.frame = wp.to_torch(c.frame)
         self.worldid = wp.to_torch(c.worldid)
         self.nacon = wp.to_torch(data.nacon)

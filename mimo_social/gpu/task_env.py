@@ -161,7 +161,9 @@ class BatchedTaskEnv:
         return obs, rew, terminated, truncated, infos
 
     def _learner_obs(self, obs: dict) -> dict:
-        return {a: obs[a] for a in self.learners}
+        """The learners' senses and the task's own observations (self-body: its target)."""
+        task = self.task.observe()
+        return {a: {**obs[a], **task[self.agents.index(a)]} for a in self.learners}
 
     def _infos(self, task_infos: dict) -> dict:
         t = self.torch

@@ -16,7 +16,13 @@ are read from it) and the :class:`~mimo_social.gpu.batched.BatchedEnv` made of i
 * ``evaluate()``: ``(rewards (nworld, n_agents), terminated (nworld,), infos)``, infos a dict
   of the CPU task's info keys to ``(nworld,)`` tensors (``(nworld, n_agents)`` for per-agent
   ones), reading the step's data (positions and contacts of the last physics step's start, as
-  the CPU task reads ``MjData`` after ``mj_step``).
+  the CPU task reads ``MjData`` after ``mj_step``);
+* ``observed`` and ``observe()``: the task's own observation keys (self-body: the one-hot
+  ``target``) and, per agent, a dict of them to ``(nworld, size)`` tensors, as the CPU task's
+  ``observe`` gives them (new tensors: a later reset does not change what was returned).
+
+:class:`BatchedTask` holds the defaults (no per-world fields, nothing captured, no hook, no
+task observation).
 """
 
 from __future__ import annotations
@@ -27,10 +33,51 @@ from ..core.kinematics import hand_geoms
 from ..tasks.common import right_hand_parts
 from ..tasks.high_five.task import PALM_COS
 
-__all__ = ["TASKS", "BatchedReach", "BatchedHighFive", "batched_task", "task_class"]
+__all__ = ["TASKS", "BatchedTask", "BatchedFreePlay", "BatchedReach", "BatchedHighFive",
+           "BatchedSelfBody", "batched_task", "task_class"]
 
 
-class BatchedReach:
+class BatchedTask:
+    """The defaults of the batched task logic (the module's protocol)."""
+
+    name = ""
+    batch_fields: tuple[str, ...] = ()
+    info_keys: tuple[str, ...] = ()
+    per_agent_infos: tuple[str, ...] = ()
+    observed: tuple[str, ...] = ()
+
+    def __init__(self, env, batched):
+        self.batched = batched
+        self.n_agents = len(env.world.agents)
+
+    def capture(self, env) -> dict:
+        return {}
+
+    def load(self, idx, captured) -> None:
+        return None
+
+    def before_physics(self) -> None:
+        return None
+
+    def observe(self) -> list[dict]:
+        return [{} for _ in range(self.n_agents)]
+
+
+class BatchedFreePlay(BatchedTask):
+    """Free play (:class:`mimo_social.tasks.free_play.FreePlay`): no reward (0 for every
+    agent), no termination (truncation at the env's time limit), no infos."""
+
+    name = "free_play"
+
+    def evaluate(self):
+        t = self.batched.torch
+        dev = self.batched.qpos.device
+        n = self.batched.nworld
+        return (t.zeros((n, self.n_agents), dtype=t.float32, device=dev),
+                t.zeros(n, dtype=t.bool, device=dev), {})
+
+
+class BatchedReach(BatchedTask):
     """Reach (:class:`mimo_social.tasks.reach.Reach`): ``+success_reward`` on the step a
     geom of the right hand touches the ball (``dist <= 0``), else minus the right fingertips'
     distance to the ball's centre; success ends the episode. The reset's ball (the model's
@@ -44,11 +91,11 @@ class BatchedReach:
     per_agent_infos = ()
 
     def __init__(self, env, batched):
+        super().__init__(env, batched)
         torch = batched.torch
         w = env.world
         m = w.model
         a = w.agents[0]
-        self.batched = batched
         self.contacts = batched.contacts
         self.success_reward = float(env.task.options.success_reward)
         self.hand = self.contacts.mask(hand_geoms(w, 0))
@@ -85,7 +132,7 @@ class BatchedReach:
         return reward[:, None], touched, {"is_success": touched, "distance": dist}
 
 
-class BatchedHighFive:
+class BatchedHighFive(BatchedTask):
     """High five (:class:`mimo_social.tasks.high_five.HighFive`), ``success="palms"`` or
     ``"touch"``: each step, both right hands feel the other agent (a contact of the other's
     geoms with the hand, ``dist <= 0``, and one of a skinned right-hand part with a geom of the
@@ -97,12 +144,12 @@ class BatchedHighFive:
     head turned to the partner's hand every step) is not batched: refused."""
 
     name = "high_five"
-    batch_fields = ()
     info_keys = ("is_success", "hands_touching", "hand_feels_partner", "hand_distance",
                  "palm_contact", "palm_contact_time")
     per_agent_infos = ("hand_feels_partner",)
 
     def __init__(self, env, batched):
+        super().__init__(env, batched)
         torch = batched.torch
         opts = env.task.options
         if opts.assisted_gaze:
@@ -112,7 +159,7 @@ class BatchedHighFive:
         w = env.world
         m = w.model
         c = batched.contacts
-        self.batched, self.contacts = batched, c
+        self.contacts = c
         self.touch_bonus = float(opts.touch_bonus)
         self.end_on_touch = bool(opts.end_on_touch)
         self.shaping = bool(opts.shaping)
@@ -143,14 +190,8 @@ class BatchedHighFive:
         self.hand_bodies = torch.as_tensor([int(m.site_bodyid[p]) for p in palms], device=dev)
         self.held = torch.zeros(batched.nworld, dtype=torch.int64, device=dev)
 
-    def capture(self, env) -> dict:
-        return {}
-
     def load(self, idx, captured) -> None:
         self.held[idx] = 0
-
-    def before_physics(self) -> None:
-        return None
 
     def _feels(self, i: int, normal):
         """Whether agent i's right hand feels the other agent, per world."""
@@ -194,8 +235,107 @@ class BatchedHighFive:
         return t.stack([r, r], dim=1), terminated, infos
 
 
+class BatchedSelfBody(BatchedTask):
+    """Self-body (:class:`mimo_social.tasks.selfbody.SelfBody`): the right hand presses on the
+    body's own primitives (a contact of a right-hand geom with another geom of the infant,
+    ``dist <= 0``, a positive normal force). Success: it presses the episode's target primitive
+    and the target's body part feels a touch by the infant itself (a contact on a skinned geom
+    of that part with another geom of the infant pushing with a positive normal force: the
+    skin's rule, :meth:`~mimo_social.senses.touch.TouchSystem.touched_by`), ending the episode
+    with ``success_reward``; else minus (``other_touch_cost`` + the nearest pressing contact
+    point's distance to the target primitive's centre), or ``miss_reward`` when the hand
+    presses nothing. The target, drawn by the CPU reset, is observed as its one-hot
+    ``target``; infos: ``is_success``, ``target`` (its index in the task's ``targets``),
+    ``distance`` (NaN without a pressing contact, the CPU's None) and ``touched`` (how many
+    primitives the hand presses)."""
+
+    name = "selfbody"
+    info_keys = ("is_success", "target", "distance", "touched")
+    observed = ("target",)
+
+    def __init__(self, env, batched):
+        super().__init__(env, batched)
+        torch = batched.torch
+        task = env.task
+        opts = task.options
+        w = env.world
+        m = w.model
+        a = w.agents[0]
+        c = batched.contacts
+        dev = batched.qpos.device
+        self.contacts = c
+        self.success_reward = float(opts.success_reward)
+        self.miss_reward = float(opts.miss_reward)
+        self.other_touch_cost = float(opts.other_touch_cost)
+        hand = np.zeros(m.ngeom, bool)
+        hand[hand_geoms(w, 0, 0)] = True
+        own = np.zeros(m.ngeom, bool)
+        own[a.geom_ids] = True
+        self.hand = torch.as_tensor(hand, device=dev)
+        self.own = torch.as_tensor(own & ~hand, device=dev)
+        self.agent = torch.as_tensor(own, device=dev)
+        names = [f"{a.name}/{t}" for t in task.targets]
+        geoms = np.array([m.geom(n).id for n in names], np.int64)
+        self.target_geoms = torch.as_tensor(geoms, device=dev)
+        # per target: the skinned geoms of its body part (the skin's sides: touched_by)
+        skin = np.asarray(env.systems["touch"].geom_part[:m.ngeom]) >= 0
+        parts = np.zeros((len(geoms), m.ngeom), bool)
+        for k, g in enumerate(geoms):
+            parts[k] = (np.asarray(m.geom_bodyid) == m.geom_bodyid[g]) & skin
+        self.part_geoms = torch.as_tensor(parts, device=dev)
+        self.ntargets = len(geoms)
+        self.target = torch.zeros(batched.nworld, dtype=torch.int64, device=dev)
+
+    def capture(self, env) -> dict:
+        return {"target": env.task.targets.index(env.task.target)}
+
+    def load(self, idx, captured) -> None:
+        t = self.batched.torch
+        self.target[idx] = t.as_tensor([c["target"] for c in captured], dtype=t.int64,
+                                       device=self.target.device)
+
+    def observe(self) -> list[dict]:
+        t = self.batched.torch
+        return [{"target": t.nn.functional.one_hot(self.target, self.ntargets).to(t.float32)}]
+
+    def evaluate(self):
+        t = self.batched.torch
+        c = self.contacts
+        data = self.batched.tensors
+        n = self.batched.nworld
+        g0, g1 = c.sides()
+        world = c.worldid.long().clamp(0, n - 1)
+        fn = c.normal_forces()
+        h0, h1 = self.hand[g0], self.hand[g1]
+        other = t.where(h0, g1, g0)
+        pressed = (h0 ^ h1) & self.own[other] & c.valid() & (c.dist <= 0.0) & (fn > 0.0)
+        target = self.target[world]
+        on_target = pressed & (other == self.target_geoms[target])
+        felt = c.valid() & (fn > 0.0) & ((self.part_geoms[target, g0] & self.agent[g1])
+                                         | (self.part_geoms[target, g1] & self.agent[g0]))
+        success = c.per_world(on_target) & c.per_world(felt)
+        centre = data["geom_xpos"][world, self.target_geoms[target]]
+        dist = t.linalg.vector_norm(c.pos - centre, dim=1)
+        inf = t.full((n,), float("inf"), dtype=dist.dtype, device=dist.device)
+        nearest = inf.scatter_reduce(0, world, t.where(pressed, dist, t.full_like(dist, inf[0])),
+                                     reduce="amin")
+        any_pressed = t.isfinite(nearest)
+        count = t.zeros(n * c.ngeom, dtype=t.int32, device=dist.device)
+        count.index_add_(0, world * c.ngeom + other, pressed.to(t.int32))
+        touched = (count.reshape(n, c.ngeom) > 0).sum(1)
+        reward = t.where(success, t.full_like(nearest, self.success_reward),
+                         t.where(any_pressed, -(self.other_touch_cost + nearest),
+                                 t.full_like(nearest, self.miss_reward)))
+        distance = t.where(success, t.zeros_like(nearest),
+                           t.where(any_pressed, nearest, t.full_like(nearest, float("nan"))))
+        infos = {"is_success": success, "target": self.target, "distance": distance,
+                 "touched": touched}
+        return reward[:, None], success, infos
+
+
 #: the batched task logic by task name
-TASKS = {"reach": BatchedReach, "high_five": BatchedHighFive}
+TASKS = {"free_play": BatchedFreePlay, "reach": BatchedReach, "high_five": BatchedHighFive,
+         "selfbody": BatchedSelfBody}
 
 
 def task_class(name: str):

@@ -10,7 +10,8 @@ finished step's (every world's rows, ``infos["_final_obs"]`` / ``infos["_final_i
 worlds finished).
 
 Spaces: ``single_observation_space`` is the CPU env's observation Dict for the senses the
-device computes (proprioception, vestibular; touch and vision are left out), and
+device computes (proprioception, vestibular; touch and vision are left out) and the task's
+own observations (self-body's ``target``), and
 ``single_action_space`` the motors' Box (the face and the voice do not move the body: not in
 the batched actions). Observations, rewards and flags are torch tensors on the device, or
 numpy arrays (host copies) with ``numpy=True``. Infos: the task's keys as ``(num_envs,)``
@@ -30,12 +31,12 @@ __all__ = ["GymVectorEnv", "device_spaces"]
 
 
 def device_spaces(tenv: BatchedTaskEnv, agent: str) -> tuple[spaces.Dict, spaces.Box]:
-    """``agent``'s observation Dict (the senses the device computes, in the CPU env's spaces)
-    and its motors' action Box."""
+    """``agent``'s observation Dict (the senses the device computes and the task's own
+    observations, in the CPU env's spaces) and its motors' action Box."""
     inner = tenv.inner
     i = tenv.agents.index(agent)
     cpu = inner.observation_space(agent)
-    keys = [s.name for s in tenv.batched.senses[i]]
+    keys = [s.name for s in tenv.batched.senses[i]] + list(tenv.task.observed)
     obs = spaces.Dict({k: cpu[k] for k in keys})
     act = inner.action_space(agent)
     if isinstance(act, spaces.Dict):

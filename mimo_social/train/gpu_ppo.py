@@ -2,8 +2,9 @@
 pulling every step back to the host (issue 34; ``mimo-social train-gpu``; docs/gpu.md).
 
 The worlds are a :class:`~mimo_social.gpu.GymVectorEnv` (torch tensors on Warp's device: a GPU
-when there is one, else the CPU) of reach or of the high five's one-learner form (``infant_0``
-learns, the scripted partner ``HandOffer`` acts on the device). The learner is built from
+when there is one, else the CPU) of reach, of self-body (its target observed as a one-hot) or
+of the high five's one-learner form (``infant_0`` learns, the scripted partner ``HandOffer``
+acts on the device). The learner is built from
 TorchRL's PPO pieces: a :class:`~torchrl.modules.ProbabilisticActor` with a tanh-normal
 distribution over the motors' Box (an MLP for the mean, a learnt state-independent log std), a
 :class:`~torchrl.modules.ValueOperator` critic MLP, :class:`~torchrl.objectives.value.GAE` and
@@ -47,7 +48,7 @@ from torchrl.modules import MLP, ProbabilisticActor, TanhNormal, ValueOperator
 from torchrl.objectives import ClipPPOLoss
 from torchrl.objectives.value import GAE
 
-from ..envs import high_five_v0, reach_v0
+from ..envs import high_five_v0, reach_v0, selfbody_v0
 from ..gpu import GymVectorEnv
 
 __all__ = ["TASKS", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObsNorm", "make_env",
@@ -55,7 +56,8 @@ __all__ = ["TASKS", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObsNorm", "make_
            "plot_progress"]
 
 #: the tasks the on-device PPO trains: name -> the CPU env with one learner
-TASKS = {"reach": reach_v0.parallel_env, "high_five": high_five_v0.scripted_env}
+TASKS = {"reach": reach_v0.parallel_env, "high_five": high_five_v0.scripted_env,
+         "selfbody": selfbody_v0.parallel_env}
 DEVICES = (None, "cpu", "cuda")
 
 #: the columns of ``progress.csv``, one row per iteration; the episode columns are over the

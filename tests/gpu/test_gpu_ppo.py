@@ -18,6 +18,7 @@ import torch  # noqa: E402
 from tensordict import TensorDict  # noqa: E402
 
 from mimo_social import cli  # noqa: E402
+from mimo_social.envs import selfbody_v0  # noqa: E402
 from mimo_social.train import gpu_ppo  # noqa: E402
 from mimo_social.train.gpu_ppo import (PROGRESS_COLUMNS, GpuPPOConfig,  # noqa: E402
                                        RunningObsNorm, read_progress, train_gpu_ppo)
@@ -89,6 +90,20 @@ def test_gpu_ppo_high_five_learns_beside_its_partner_on_the_device(tmp_path):
     assert meta["observation_size"] == 48 + 6    # proprioception and vestibular
 
 
+def test_gpu_ppo_selfbody_observes_its_target(tmp_path):
+    """Self-body on the device: the policy's input is the arm's proprioception and the one-hot
+    target; the episodes end at the time limit (the untrained arm touches nothing)."""
+    cfg = GpuPPOConfig(task="selfbody", worlds=2, steps=8, rollout=4, minibatch=8,
+                       epochs=1, device="cpu", max_steps=2)
+    train_gpu_ppo(cfg, tmp_path)
+    rows = read_progress(tmp_path / "progress.csv")
+    assert len(rows) == 1 and rows[0]["episodes"] == 4 and np.isfinite(rows[0]["loss_policy"])
+    meta = json.loads((tmp_path / "config.json").read_text())
+    env = selfbody_v0.parallel_env()
+    space = env.observation_space("infant_0")
+    assert meta["observation_size"] == space["proprioception"].shape[0] + 28
+
+
 def test_gpu_ppo_samples_its_actions_while_collecting():
     """The rollout explores: the same observation gives other actions each time (TorchRL's
     actor gives its mode unless told to sample), within the Box; without exploring, the mode."""
@@ -118,7 +133,7 @@ def test_gpu_ppo_running_normalisation_is_the_mean_and_variance_of_all_rows():
 
 
 @pytest.mark.parametrize("setting, value, allowed", [
-    ("task", "catch", "one of reach, high_five"),
+    ("task", "catch", "one of reach, high_five, selfbody"),
     ("worlds", 0, "a positive integer"),
     ("steps", -5, "a positive integer"),
     ("epochs", 1.5, "a positive integer"),

@@ -1,6 +1,13 @@
 """Batched task logic (issue 34) against the CPU env, on Warp's CPU device: the rewards, success
-and terminations of reach and high five on the catalogue's scripted episodes, the high five's
-scripted partner on the device, and the errors for what the device does not run.
+and terminations of reach, high five and self-body on the catalogue's scripted episodes, free
+play's, the high five's scripted partner on the device, self-body's target observed, and the
+errors for what the device does not run.
+
+Self-body's hand presses boxes and capsules of the legs: MuJoCo Warp's collision routines
+give those pairs other contact points than C MuJoCo's (two where C has one, at other places),
+so the nearest contact's distance to the target, the reward, differs by a few millimetres while
+the hand presses, with the state copied before every step too; which primitives are pressed
+and the success agree.
 
 Each world of a :class:`BatchedTaskEnv` and one CPU env reset with the world's seed get the
 same actions (the scripted controller's, and for high five the default partner's, computed on
@@ -21,7 +28,8 @@ import pytest
 pytest.importorskip("mujoco_warp", reason="mujoco_warp cannot be imported: the gpu extra "
                                           "(pip install -e '.[gpu]') is not installed")
 
-from mimo_social.envs import free_play_v0, high_five_v0, reach_v0  # noqa: E402
+from mimo_social.envs import (free_play_v0, high_five_v0, mirror_v0, reach_v0,  # noqa: E402
+                              selfbody_v0)
 from mimo_social.envs.catalog import entry  # noqa: E402
 from mimo_social.gpu import BatchedTaskEnv  # noqa: E402
 from mimo_social.partners import Still  # noqa: E402
@@ -88,7 +96,7 @@ def run_pair(tenv, make_cpu, policies, force=False, steps=500):
     return [np.array(r) for r in records], cpus
 
 
-def check(records, tol):
+def check(records, tol, same_success=True):
     print("largest reward difference per world:",
           [float(np.abs(r[:, 0] - r[:, 1]).max()) for r in records],
           "steps:", [len(r) for r in records])
@@ -96,6 +104,8 @@ def check(records, tol):
         assert rec[-1, 3] == 1.0, f"world {w}: the scripted episode did not succeed on the CPU"
         err = np.abs(rec[:, 0] - rec[:, 1]).max()
         assert err < tol, (w, err)
+        if not same_success:
+            continue
         assert (rec[:, 2] == rec[:, 3]).all(), (w, np.flatnonzero(rec[:, 2] != rec[:, 3]))
         assert (rec[:, 4] == rec[:, 5]).all(), (w, np.flatnonzero(rec[:, 4] != rec[:, 5]))
 
@@ -173,10 +183,114 @@ def test_gpu_high_five_partner_on_the_device_is_the_cpus(high_five_scripted):
     assert all(r[:50, 6].max() < 1e-5 and r[:, 6].max() < 0.1 for r in records)
 
 
+SOLE = {"target": "right_sole"}      # seed 0: the hand presses right_ball (its foot) first
+
+
+def _sole_env(**touch):
+    kw = {"touch": {"density": 0.25, "normal_only": True, **touch}} if touch else {}
+    return selfbody_v0.parallel_env(task_options=SOLE, **kw)
+
+
+def test_gpu_selfbody_task_logic_over_one_step_is_the_cpus():
+    """The state copied from the CPU env before every step: the reach through the air (the
+    miss reward, exactly), the hand pressing the foot's other primitives while the foot feels
+    it (no success: the hand is not on the target), then on the target: success on the CPU's
+    step, the reward within the contact points' difference (module docstring)."""
+    tenv = BatchedTaskEnv(_sole_env(), 1, device="cpu", seed=0)
+    records, cpus = run_pair(tenv, _sole_env, {"infant_0": entry("selfbody").controller},
+                             force=True)
+    check(records, 1e-2)
+    rec = records[0]
+    air = rec[:, 1] == -1.0
+    assert air.sum() > 100 and (rec[air, 0] == -1.0).all()
+    other = (rec[:, 3] == 0.0) & ~air                  # pressing the foot, not the target
+    assert other.sum() >= 2 and (rec[other, 2] == 0.0).all()
+
+
+def test_gpu_selfbody_success_needs_the_target_part_to_feel_the_touch():
+    """The foot without skin (``touch`` ``exclude``): the hand presses right_sole as before
+    (the skin does not move the body) and neither the CPU nor the device counts it."""
+    make = lambda: _sole_env(exclude=("right_foot",))  # noqa: E731
+    tenv = BatchedTaskEnv(make(), 1, device="cpu", seed=0)
+    records, cpus = run_pair(tenv, make, {"infant_0": entry("selfbody").controller},
+                             force=True, steps=180)
+    rec = records[0]
+    assert "right_sole" in cpus[0].unwrapped.task._touched
+    assert (rec[:, 2] == 0.0).all() and (rec[:, 3] == 0.0).all()
+    assert np.abs(rec[:, 0] - rec[:, 1]).max() < 1e-2
+
+
+@pytest.fixture(scope="module")
+def selfbody():
+    return BatchedTaskEnv(selfbody_v0.parallel_env(), len(SEEDS), device="cpu", seed=SEEDS[0])
+
+
+@pytest.mark.slow
+def test_gpu_selfbody_free_running_reaches_its_targets(selfbody):
+    """Free running: the reach through the air is the CPU's in every world; once the hand
+    presses other primitives the contact points differ (module docstring) and the hand slides
+    on another path (seed 0: 4 cm apart); a world whose hand goes to its target directly
+    succeeds on the CPU's step."""
+    records, _ = run_pair(selfbody, selfbody_v0.parallel_env,
+                          {"infant_0": entry("selfbody").controller})
+    for rec in records:
+        first = int(np.flatnonzero(rec[:, 1] != -1.0)[0])
+        assert first > 20 and (rec[:first, 0] == -1.0).all()
+    assert any(rec[-1, 2] == rec[-1, 3] == 1.0 for rec in records)
+
+
+def test_gpu_selfbody_observes_each_worlds_target_and_redraws_it_at_resets(selfbody):
+    """The one-hot target of each world is its CPU reset's (the world's seed); an autoreset
+    draws the next episode's, the finished step's own kept in final_obs."""
+    tenv = selfbody
+    obs, _ = tenv.reset(seed=5)
+    got = obs["infant_0"]["target"].numpy()
+    assert got.shape == (tenv.nworld, len(tenv.inner.task.targets))
+    for w in range(tenv.nworld):
+        cpu = selfbody_v0.parallel_env()
+        o, _ = cpu.reset(seed=tenv.seed_of(w))
+        np.testing.assert_array_equal(got[w], o["infant_0"]["target"])
+    before = got.copy()
+    n = tenv.n_controls("infant_0")
+    done = np.zeros(tenv.nworld, bool)
+    for _ in range(tenv.max_steps):
+        obs, _, term, trunc, infos = tenv.step({"infant_0": np.zeros((tenv.nworld, n),
+                                                                    np.float32)})
+        done = (term | trunc).numpy()
+        if done.any():
+            break
+    assert done.all()                 # the zero action touches nothing: truncated together
+    np.testing.assert_array_equal(infos["final_obs"]["infant_0"]["target"].numpy(), before)
+    after = obs["infant_0"]["target"].numpy()
+    for w in range(tenv.nworld):
+        cpu = selfbody_v0.parallel_env()
+        o, _ = cpu.reset(seed=tenv.seed_of(w))
+        np.testing.assert_array_equal(after[w], o["infant_0"]["target"])
+    assert not np.array_equal(after, before)
+    assert (infos["target"].numpy() == before.argmax(1)).all()
+
+
+def test_gpu_free_play_has_no_reward_and_ends_at_its_time_limit():
+    """Free play of two infants: reward 0 for both, never terminated, truncated at max_steps
+    in every world, the worlds reset by themselves."""
+    tenv = BatchedTaskEnv(free_play_v0.parallel_env(n_agents=2, max_steps=3), 2, device="cpu")
+    assert tenv.learners == ["infant_0", "infant_1"] and tenv.task.info_keys == ()
+    tenv.reset(seed=0)
+    rng = np.random.default_rng(0)
+    for k in range(1, 7):
+        acts = {a: rng.uniform(-1, 1, (2, tenv.n_controls(a))).astype(np.float32)
+                for a in tenv.learners}
+        _, rew, term, trunc, infos = tenv.step(acts)
+        assert all((r.numpy() == 0.0).all() for r in rew.values())
+        assert not term.any() and bool(trunc.all()) == (k % 3 == 0) and trunc.any() == trunc.all()
+        assert (infos["instability"].numpy() == 0.0).all()
+    assert list(tenv._episode) == [2, 2]
+
+
 def test_gpu_task_env_refuses_what_the_device_does_not_run():
-    with pytest.raises(ValueError, match=r"task 'free_play' has no batched task logic .*"
-                                         r"allowed: high_five, reach"):
-        BatchedTaskEnv(free_play_v0.parallel_env(n_agents=1), 1, device="cpu")
+    with pytest.raises(ValueError, match=r"task 'mirror' has no batched task logic .*"
+                                         r"allowed: free_play, high_five, reach, selfbody"):
+        BatchedTaskEnv(mirror_v0.parallel_env(), 1, device="cpu")
     with pytest.raises(ValueError, match=r"high_five: task option assisted_gaze=True does not "
                                          r"run .* allowed: assisted_gaze=False"):
         BatchedTaskEnv(high_five_v0.parallel_env(task_options={"assisted_gaze": True}), 1,
