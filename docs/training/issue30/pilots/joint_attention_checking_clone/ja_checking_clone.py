@@ -38,10 +38,9 @@ class ModeLabeller(Labeller):
         return action
 
 
-def main():
-    name, episodes, every, epochs = sys.argv[1], *map(int, sys.argv[2:5])
-    noise, play, fovea = float(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
-    fov = float(sys.argv[8]) if len(sys.argv) > 8 else None
+def setup(fovea: float, fov: float | None):
+    """The joint-attention env with the learner's 96x96 eyes (``fovea``, ``fov`` degrees) and a
+    fresh PPO model on the recipe's CNN policy."""
     task = "joint_attention"
     vision = {"width": 96, "height": 96, "fovea": fovea, "field_of_view": fov}
     kwargs = {"per_agent": [{"vision": vision}, {}]}
@@ -49,23 +48,28 @@ def main():
     env = make_env(task, **kwargs)
     venv = DummyVecEnv([lambda: make_env(task, **kwargs)])
     policy, kw = policy_for(venv.observation_space, {}, True, min_std=0.01)
-    model = PPO(policy, venv, seed=0, device="cpu", **kw)
-    t0 = time.time()
+    return env, PPO(policy, venv, seed=0, device="cpu", **kw)
+
+
+def record(env, name: str, episodes: int, every: int, noise: float, t0: float):
+    """``episodes`` demonstrations of ``name`` (seeds 20000..), every ``every``-th pair kept."""
     demos = None
     for c in range(0, episodes, 20):
-        d = record_demonstrations(task, env, min(20, episodes - c), 20_000 + c, None, noise,
-                                  demonstrator_name=name)
+        d = record_demonstrations("joint_attention", env, min(20, episodes - c), 20_000 + c,
+                                  None, noise, demonstrator_name=name)
         keep = np.arange(len(d)) % every == (c // 20) % every
         d = type(d)({k: v[keep] for k, v in d.obs.items()}, d.actions[keep], d.rewards[keep],
                     d.ends[keep], d.seeds, d.returns, d.lengths, d.successes)
         demos = d if demos is None else demos.joined(d)
         print(f"recorded {c + len(d.seeds)} episodes, success {np.mean(demos.successes):.2f}, "
               f"{len(demos)} pairs, {time.time() - t0:.0f} s", flush=True)
-    for e in range(epochs):
-        fit = clone(model, demos, 1, lr=3e-4, seed=e)
-        print(f"epoch {e + 1}: {len(demos)} pairs, loss {fit['loss_before']:.4g} -> "
-              f"{fit['loss_after']:.4g}, {time.time() - t0:.0f} s", flush=True)
-    controller = demonstrator(task, {"demonstrator": name})
+    return demos
+
+
+def evaluate(model, env, name: str, play: int) -> int:
+    """The clone's mean action on seeds 1000.. with ``name`` labelling every state; a line per
+    episode; the successes."""
+    controller = demonstrator("joint_attention", {"demonstrator": name})
     wins = []
     for seed in range(1000, 1000 + play):
         lab = ModeLabeller(controller, env, model)
@@ -85,7 +89,22 @@ def main():
         print(f"  seed {seed}: success {won}, on target {on:.2f},"
               f" return {float(next(iter(ep.returns.values()))):.1f}, modes {share}, action "
               f"error per mode {per_mode}{watch}", flush=True)
-    print(f"clone of {name}: {sum(wins)} / {play}, {time.time() - t0:.0f} s")
+    return sum(wins)
+
+
+def main():
+    name, episodes, every, epochs = sys.argv[1], *map(int, sys.argv[2:5])
+    noise, play, fovea = float(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
+    fov = float(sys.argv[8]) if len(sys.argv) > 8 else None
+    env, model = setup(fovea, fov)
+    t0 = time.time()
+    demos = record(env, name, episodes, every, noise, t0)
+    for e in range(epochs):
+        fit = clone(model, demos, 1, lr=3e-4, seed=e)
+        print(f"epoch {e + 1}: {len(demos)} pairs, loss {fit['loss_before']:.4g} -> "
+              f"{fit['loss_after']:.4g}, {time.time() - t0:.0f} s", flush=True)
+    wins = evaluate(model, env, name, play)
+    print(f"clone of {name}: {wins} / {play}, {time.time() - t0:.0f} s")
 
 
 if __name__ == "__main__":
