@@ -80,27 +80,27 @@ def test_gpu_ppo_is_deterministic_under_a_seed(reach_run, tmp_path):
     assert _same(other) != _same(first)
 
 
-def test_gpu_ppo_high_five_learns_beside_its_partner_on_the_device(tmp_path):
-    cfg = GpuPPOConfig(task="high_five", worlds=2, steps=8, rollout=4, minibatch=8,
+def _tiny_run(task, out) -> dict:
+    """Two worlds, one iteration of 4 steps, episodes of 2 steps: 4 episodes end; returns the
+    run's config.json."""
+    cfg = GpuPPOConfig(task=task, worlds=2, steps=8, rollout=4, minibatch=8,
                        epochs=1, device="cpu", max_steps=2)
-    train_gpu_ppo(cfg, tmp_path)
-    rows = read_progress(tmp_path / "progress.csv")
+    train_gpu_ppo(cfg, out)
+    rows = read_progress(out / "progress.csv")
     assert len(rows) == 1 and rows[0]["episodes"] == 4 and np.isfinite(rows[0]["loss_policy"])
-    meta = json.loads((tmp_path / "config.json").read_text())
+    return json.loads((out / "config.json").read_text())
+
+
+def test_gpu_ppo_high_five_learns_beside_its_partner_on_the_device(tmp_path):
+    meta = _tiny_run("high_five", tmp_path)
     assert meta["observation_size"] == 48 + 6    # proprioception and vestibular
 
 
 def test_gpu_ppo_selfbody_observes_its_target(tmp_path):
     """Self-body on the device: the policy's input is the arm's proprioception and the one-hot
     target; the episodes end at the time limit (the untrained arm touches nothing)."""
-    cfg = GpuPPOConfig(task="selfbody", worlds=2, steps=8, rollout=4, minibatch=8,
-                       epochs=1, device="cpu", max_steps=2)
-    train_gpu_ppo(cfg, tmp_path)
-    rows = read_progress(tmp_path / "progress.csv")
-    assert len(rows) == 1 and rows[0]["episodes"] == 4 and np.isfinite(rows[0]["loss_policy"])
-    meta = json.loads((tmp_path / "config.json").read_text())
-    env = selfbody_v0.parallel_env()
-    space = env.observation_space("infant_0")
+    meta = _tiny_run("selfbody", tmp_path)
+    space = selfbody_v0.parallel_env().observation_space("infant_0")
     assert meta["observation_size"] == space["proprioception"].shape[0] + 28
 
 

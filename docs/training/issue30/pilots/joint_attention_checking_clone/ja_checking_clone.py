@@ -66,6 +66,14 @@ def record(env, name: str, episodes: int, every: int, noise: float, t0: float):
     return demos
 
 
+def clone_epochs(model, demos, epochs: int, t0: float) -> None:
+    """``epochs`` epochs of cloning at lr 3e-4 (epoch e seeded e), a line each."""
+    for e in range(epochs):
+        fit = clone(model, demos, 1, lr=3e-4, seed=e)
+        print(f"epoch {e + 1}: {len(demos)} pairs, loss {fit['loss_before']:.4g} -> "
+              f"{fit['loss_after']:.4g}, {time.time() - t0:.0f} s", flush=True)
+
+
 def evaluate(model, env, name: str, play: int) -> int:
     """The clone's mean action on seeds 1000.. with ``name`` labelling every state; a line per
     episode; the successes."""
@@ -99,10 +107,7 @@ def main():
     env, model = setup(fovea, fov)
     t0 = time.time()
     demos = record(env, name, episodes, every, noise, t0)
-    for e in range(epochs):
-        fit = clone(model, demos, 1, lr=3e-4, seed=e)
-        print(f"epoch {e + 1}: {len(demos)} pairs, loss {fit['loss_before']:.4g} -> "
-              f"{fit['loss_after']:.4g}, {time.time() - t0:.0f} s", flush=True)
+    clone_epochs(model, demos, epochs, t0)
     wins = evaluate(model, env, name, play)
     print(f"clone of {name}: {wins} / {play}, {time.time() - t0:.0f} s")
 

@@ -16,11 +16,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "joint_attention_checking_clone"))
 
-from ja_checking_clone import evaluate, record, setup  # noqa: E402
+from ja_checking_clone import clone_epochs, evaluate, record, setup  # noqa: E402
 
 from mimo_social.train.bc_settings import BC_DEFAULTS  # noqa: E402
 from mimo_social.train.dagger import dagger  # noqa: E402
-from mimo_social.train.demonstrations import clone  # noqa: E402
 
 
 def main():
@@ -30,10 +29,7 @@ def main():
     env, model = setup(fovea, fov)
     t0 = time.time()
     demos = record(env, name, episodes, every, noise, t0)
-    for e in range(epochs):
-        fit = clone(model, demos, 1, lr=3e-4, seed=e)
-        print(f"epoch {e + 1}: {len(demos)} pairs, loss {fit['loss_before']:.4g} -> "
-              f"{fit['loss_after']:.4g}, {time.time() - t0:.0f} s", flush=True)
+    clone_epochs(model, demos, epochs, t0)
     tag = f"{name}_fov{fov:g}_fovea{fovea:g}"
     model.save(f"/tmp/ja_dagger_{tag}_clone.zip")
     wins = evaluate(model, env, name, play)
