@@ -14,14 +14,16 @@ from .device import describe, has_gpu, pick_device, require
 from .partners import BatchedHandOffer, batched_partner
 from .proprioception import BatchedProprioception
 from .task_env import BatchedTaskEnv
-from .tasks import TASKS, BatchedHighFive, BatchedReach, batched_task
+from .tasks import (TASKS, BatchedFreePlay, BatchedHighFive, BatchedReach, BatchedSelfBody,
+                    BatchedTask, batched_task)
 from .touch import BatchedTouch
 from .vector import GymVectorEnv, device_spaces
 from .vestibular import BatchedVestibular
 
 __all__ = ["BatchedEnv", "BatchedTaskEnv", "GymVectorEnv", "TorchRLEnv", "AgentControls",
-           "BatchedContacts", "BatchedHandOffer", "BatchedHighFive", "BatchedProprioception",
-           "BatchedReach", "BatchedTouch", "BatchedVestibular", "DERIVED_FIELDS", "STATE_FIELDS",
+           "BatchedContacts", "BatchedFreePlay", "BatchedHandOffer", "BatchedHighFive",
+           "BatchedProprioception", "BatchedReach", "BatchedSelfBody", "BatchedTask",
+           "BatchedTouch", "BatchedVestibular", "DERIVED_FIELDS", "STATE_FIELDS",
            "SUPPORTED", "TASKS", "batched_partner", "batched_task", "check_actuation", "describe",
            "device_spaces", "has_gpu", "pick_device", "require"]
 
