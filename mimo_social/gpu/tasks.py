@@ -279,9 +279,8 @@ class BatchedSelfBody(BatchedTask):
         self.target_geoms = torch.as_tensor(geoms, device=dev)
         # per target: the skinned geoms of its body part (the skin's sides: touched_by)
         skin = np.asarray(env.systems["touch"].geom_part[:m.ngeom]) >= 0
-        parts = np.zeros((len(geoms), m.ngeom), bool)
-        for k, g in enumerate(geoms):
-            parts[k] = (np.asarray(m.geom_bodyid) == m.geom_bodyid[g]) & skin
+        body = np.asarray(m.geom_bodyid)
+        parts = (body[None, :] == body[geoms][:, None]) & skin
         self.part_geoms = torch.as_tensor(parts, device=dev)
         self.ntargets = len(geoms)
         self.target = torch.zeros(batched.nworld, dtype=torch.int64, device=dev)
@@ -316,9 +315,9 @@ class BatchedSelfBody(BatchedTask):
         success = c.per_world(on_target) & c.per_world(felt)
         centre = data["geom_xpos"][world, self.target_geoms[target]]
         dist = t.linalg.vector_norm(c.pos - centre, dim=1)
-        inf = t.full((n,), float("inf"), dtype=dist.dtype, device=dist.device)
-        nearest = inf.scatter_reduce(0, world, t.where(pressed, dist, t.full_like(dist, inf[0])),
-                                     reduce="amin")
+        inf = float("inf")
+        nearest = t.full((n,), inf, dtype=dist.dtype, device=dist.device).scatter_reduce(
+            0, world, dist.masked_fill(~pressed, inf), reduce="amin")
         any_pressed = t.isfinite(nearest)
         count = t.zeros(n * c.ngeom, dtype=t.int32, device=dist.device)
         count.index_add_(0, world * c.ngeom + other, pressed.to(t.int32))
