@@ -7,7 +7,9 @@ infants, the task's defaults), reset, stepped ``warmup`` control steps (kernel l
 GPU the capture of the CUDA graph), then ``steps`` control steps are timed on the wall clock
 with the device synchronised at both ends. Each step draws every agent's actions uniformly in
 [-1, 1] on the device, maps them to controls, advances ``frame_skip`` physics steps and reads
-every agent's proprioception and vestibular sense: what a learner on the device pays per step.
+every agent's proprioception, vestibular sense and hand skin (the task's default touch;
+``touch=False`` / ``--no-touch`` leaves the skin out): what a learner on the device pays per
+step.
 With ``with_task=True`` (``mimo-social bench gpu --with-task``) the worlds are a
 :class:`~mimo_social.gpu.BatchedTaskEnv`: the task's rewards, success and terminations on the
 device too, and the finished worlds reset from their seeds' CPU resets (host work, counted in
@@ -29,17 +31,17 @@ WORLDS = (1, 64, 1024, 4096)
 
 
 def measure_one(nworld: int, steps: int, warmup: int = 2, device: str | None = None,
-                make_env=None, with_task: bool = False) -> dict:
+                make_env=None, with_task: bool = False, touch: bool = True) -> dict:
     """One number of worlds: build, warm up, time ``steps`` control steps (see the module)."""
     _, _, torch = require()
     t0 = time.perf_counter()
     env = (make_env or high_five_v0.parallel_env)()
     if with_task:
-        tenv = BatchedTaskEnv(env, nworld, device=device, seed=0)
+        tenv = BatchedTaskEnv(env, nworld, device=device, seed=0, touch=touch)
         tenv.reset()
         batched = tenv.batched
     else:
-        batched = BatchedEnv(env, nworld, device=device, seed=0)
+        batched = BatchedEnv(env, nworld, device=device, seed=0, touch=touch)
         batched.reset()
     build = time.perf_counter() - t0
     dev = batched.tensors["qpos"].device
@@ -75,22 +77,24 @@ def measure_one(nworld: int, steps: int, warmup: int = 2, device: str | None = N
             "world_steps_per_s": nworld * steps / seconds,
             "physics_steps_per_s": nworld * steps * batched.frame_skip / seconds,
             "build_s": build, "warmup_s": warm, "warmup_steps": warmup,
-            "unstable_resets": unstable, "task": bool(with_task), "resets": resets[0]}
+            "unstable_resets": unstable, "task": bool(with_task), "resets": resets[0],
+            "touch": batched.skin is not None}
 
 
 def measure(worlds=WORLDS, steps: int = 100, warmup: int = 2, device: str | None = None,
-            progress=None, with_task: bool = False) -> dict:
+            progress=None, with_task: bool = False, touch: bool = True) -> dict:
     """Every number of worlds in ``worlds`` (:func:`measure_one`), with the device and the
     machine; ``progress``: called with each result as it comes; ``with_task``: the task's
-    logic and autoresets in each step too."""
+    logic and autoresets in each step too; ``touch``: the hand skins read each step."""
     dev = pick_device(device)
     results = []
     for n in worlds:
-        results.append(measure_one(int(n), steps, warmup, dev, with_task=with_task))
+        results.append(measure_one(int(n), steps, warmup, dev, with_task=with_task,
+                                   touch=touch))
         if progress is not None:
             progress(results[-1])
-    task = "high_five_v0, 2 infants" + (", with the task's logic and resets" if with_task
-                                        else "")
+    task = ("high_five_v0, 2 infants" + (", hand skins" if touch else ", no touch")
+            + (", with the task's logic and resets" if with_task else ""))
     return {"device": dev, "device_name": describe(dev), "task": task,
             "machine": machine_info(), "results": results}
 

@@ -43,7 +43,8 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         name, **kw,
         description="Agent-steps per second of two-infant high five on MuJoCo Warp, N worlds "
-                    "stepped together (random actions, proprioception read each step; with "
+                    "stepped together (random actions, proprioception, vestibular sense and hand "
+                    "skins read each step; with "
                     "--with-task the task's rewards, success, terminations and resets too). "
                     "Runs on a GPU when Warp sees one, else on Warp's CPU device, and says "
                     "which.")
@@ -58,6 +59,8 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
     parser.add_argument("--with-task", action="store_true",
                         help="time the task's logic and the autoresets of finished worlds "
                              "(BatchedTaskEnv) with the physics")
+    parser.add_argument("--no-touch", dest="touch", action="store_false",
+                        help="leave the hand skins out (default: read on the device each step)")
     parser.add_argument("--json", default=None, type=output_file, help="write all results here")
     parser.set_defaults(func=run)
     return parser
@@ -69,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     device = None if args.device == "auto" else args.device
     try:
         out = gpu.measure(args.worlds, args.steps, args.warmup, device,
-                          with_task=args.with_task,
+                          with_task=args.with_task, touch=args.touch,
                           progress=lambda r: print(f"  {r['worlds']} worlds: "
                                                    f"{r['agent_steps_per_s']:.1f} agent-steps/s",
                                                    flush=True))

@@ -52,6 +52,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                         help="episode length (default: the task's)")
     parser.add_argument("--entropy-coeff", type=non_negative_float, default=0.0,
                         help="the entropy bonus' weight (default 0)")
+    parser.add_argument("--no-touch", dest="touch", action="store_false",
+                        help="leave the touch skin out of the learner's observation (default: "
+                             "observed where the task's env has touch: self-body, high five)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto",
                         help="auto (default): a GPU when Warp sees one, else the CPU")
     parser.set_defaults(func=run)
@@ -64,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     config = GpuPPOConfig(task=args.task, worlds=args.worlds, steps=args.steps, seed=args.seed,
                           learning_rate=args.lr, epochs=args.epochs, minibatch=args.minibatch,
                           rollout=args.rollout, max_steps=args.max_steps,
-                          entropy_coeff=args.entropy_coeff,
+                          entropy_coeff=args.entropy_coeff, touch=args.touch,
                           device=None if args.device == "auto" else args.device)
 
     def show(row):

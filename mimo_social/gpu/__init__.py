@@ -4,7 +4,8 @@ device; with a task's logic, partners and autoreset
 (:class:`~mimo_social.gpu.task_env.BatchedTaskEnv`), as a Gymnasium vector env
 (:class:`~mimo_social.gpu.vector.GymVectorEnv`) or a TorchRL env
 (:class:`~mimo_social.gpu.torchrl_env.TorchRLEnv`, imported on first use: it needs torchrl);
-touch per body part (:class:`~mimo_social.gpu.touch.BatchedTouch`).
+touch per body part (:class:`~mimo_social.gpu.touch.BatchedTouch`) and the skin's points, the
+learners' ``touch`` (:class:`~mimo_social.gpu.skin.BatchedSkin`).
 Needs the ``gpu`` extra; what runs on the device and what does not: docs/gpu.md."""
 
 from .batched import DERIVED_FIELDS, STATE_FIELDS, BatchedEnv
@@ -13,6 +14,7 @@ from .controls import SUPPORTED, AgentControls, check_actuation
 from .device import describe, has_gpu, pick_device, require
 from .partners import BatchedHandOffer, batched_partner
 from .proprioception import BatchedProprioception
+from .skin import BatchedSkin, BatchedTouchSense
 from .task_env import BatchedTaskEnv
 from .tasks import (TASKS, BatchedFreePlay, BatchedHighFive, BatchedReach, BatchedSelfBody,
                     BatchedTask, batched_task)
@@ -22,10 +24,11 @@ from .vestibular import BatchedVestibular
 
 __all__ = ["BatchedEnv", "BatchedTaskEnv", "GymVectorEnv", "TorchRLEnv", "AgentControls",
            "BatchedContacts", "BatchedFreePlay", "BatchedHandOffer", "BatchedHighFive",
-           "BatchedProprioception", "BatchedReach", "BatchedSelfBody", "BatchedTask",
-           "BatchedTouch", "BatchedVestibular", "DERIVED_FIELDS", "STATE_FIELDS",
-           "SUPPORTED", "TASKS", "batched_partner", "batched_task", "check_actuation", "describe",
-           "device_spaces", "has_gpu", "pick_device", "require"]
+           "BatchedProprioception", "BatchedReach", "BatchedSelfBody", "BatchedSkin",
+           "BatchedTask", "BatchedTouch", "BatchedTouchSense", "BatchedVestibular",
+           "DERIVED_FIELDS", "STATE_FIELDS", "SUPPORTED", "TASKS", "batched_partner",
+           "batched_task", "check_actuation", "describe", "device_spaces", "has_gpu",
+           "pick_device", "require"]
 
 
 def __getattr__(name):

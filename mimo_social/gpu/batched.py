@@ -14,7 +14,10 @@ was written, docs/gpu.md). :meth:`BatchedEnv.snapshot` and :meth:`BatchedEnv.loa
 state of the CPU env, reset with another seed, into chosen worlds (the task env's resets:
 :mod:`mimo_social.gpu.task_env`).
 
-What stays on the CPU (docs/gpu.md): the other senses (touch, vision, audition), muscles,
+Touch: every agent's skin on the device (:mod:`mimo_social.gpu.skin`), in the CPU sense's
+layout, where the CPU env has touch on (``touch=False`` leaves it out).
+Muscles: torques in torch before every physics step (:mod:`mimo_social.gpu.muscles`).
+What stays on the CPU (docs/gpu.md): the other senses (vision, audition),
 expressions and voice (visual and auditory only: the batched actions are the motors). The
 task's logic is not here: :class:`~mimo_social.gpu.task_env.BatchedTaskEnv` adds it (reach,
 high five); a plain :class:`BatchedEnv` restarts every world from the one reset state.
@@ -31,6 +34,7 @@ from .controls import AgentControls
 from .device import describe, pick_device, require
 from .contacts import BatchedContacts
 from .proprioception import BatchedProprioception
+from .skin import BatchedSkin, BatchedTouchSense, contact_rows
 from .vestibular import BatchedVestibular
 
 __all__ = ["BatchedEnv", "STATE_FIELDS", "DERIVED_FIELDS"]
@@ -41,7 +45,8 @@ STATE_FIELDS = ("time", "qpos", "qvel", "act", "history", "qacc_warmstart", "ctr
                 "userdata")
 #: the fields read each step (as tensors, no copy)
 READ_FIELDS = ("qpos", "qvel", "qacc", "ctrl", "qfrc_actuator", "actuator_force", "qfrc_bias",
-               "qfrc_spring", "sensordata", "site_xpos", "xpos", "xmat", "geom_xpos", "geom_xmat")
+               "qfrc_spring", "sensordata", "site_xpos", "xpos", "xmat", "geom_xpos", "geom_xmat",
+               "cdof", "subtree_com")
 #: the derived fields a world's reset copies from the CPU env beside its state: what the
 #: observations, the partners and the next step read before the physics recomputes them, and
 #: the poses of the geoms fixed to the world (MuJoCo Warp computes those only once, when the
@@ -59,13 +64,18 @@ class BatchedEnv:
     reset state, with room to spare); a step that needs more raises a RuntimeError naming
     the setting to raise. Steps are checked for divergence as the CPU world checks them
     (:attr:`World.VEL_LIMIT`, :attr:`World.ACC_LIMIT`), once per control step: a world past
-    them is put back to the reset state and flagged in the step's ``unstable``.
+    them is put back to the reset state and flagged in the step's ``unstable``. ``touch``:
+    the agents' touch skins on the device (:mod:`mimo_social.gpu.skin`: the ``touch``
+    observation of every agent that has touch in ``env``), or False to leave touch out.
     """
 
     def __init__(self, env, nworld: int, device: str | None = None, seed: int | None = 0,
                  nconmax: int | None = None, njmax: int | None = None,
-                 batch_fields: tuple[str, ...] = ()):
+                 batch_fields: tuple[str, ...] = (), touch: bool = True):
         wp, mjw, torch = require()
+        if not isinstance(touch, bool):
+            raise ValueError(f"touch={touch!r} not allowed; allowed: True (the agents' touch "
+                             f"skins on the device, where the CPU env has them) or False")
         if isinstance(nworld, bool) or not isinstance(nworld, (int, np.integer)) or nworld < 1:
             raise ValueError(f"nworld={nworld!r} not allowed; allowed: an integer >= 1")
         self.nworld = int(nworld)
@@ -97,13 +107,20 @@ class BatchedEnv:
                        and getattr(self.data, f).size}
         self._start = {f: t[0].clone() for f, t in self._state.items()}
         tdev = self.tensors["qpos"].device
+        system = env.systems.get("touch") if touch else None
+        #: the agents' skins on the device (None: no agent has touch, or ``touch=False``)
+        self.skin = None if system is None else BatchedSkin(system, mjm, self.nworld, torch,
+                                                            tdev)
+        if self.skin is not None:
+            self.skin.set_start(system)
+            self.skin.reset()
         self.controls, self.senses = [], []
         for i, name in enumerate(self.agents):
             act = env.actuation[i]
             delays = env.delay_steps(name)
             observed = _positional_reset_u(act, mjm, mjd)
             c = AgentControls(name, act, delays["motor"], env.controls[i], self.nworld,
-                              torch, tdev, reset_observed=observed)
+                              torch, tdev, reset_observed=observed, model=mjm)
             self.controls.append(c)
             senses = []
             for s in env.senses[i]:
@@ -112,8 +129,13 @@ class BatchedEnv:
                                                         self.nworld, torch, tdev))
                 elif s.name == "vestibular":
                     senses.append(BatchedVestibular(s, torch, tdev))
+                elif s.name == "touch" and self.skin is not None:
+                    senses.append(BatchedTouchSense(self.skin, s, delays["touch"], self.nworld,
+                                                    torch, tdev))
             self.senses.append(senses)
         self._graph = None
+        #: muscles update before every physics step (torch): no CUDA graph then
+        self._muscles = [c for c in self.controls if c.muscle is not None]
         self.steps = 0
 
     # -- sizes -----------------------------------------------------------------------------------
@@ -143,6 +165,8 @@ class BatchedEnv:
             t[mask] = self._start[f]
         for c in self.controls:
             c.reset(None if worlds is None else mask)
+        if self.skin is not None:
+            self.skin.reset(None if worlds is None else mask)
         with self._on_device():
             self._mjw.forward(self.model, self.data)
         if worlds is None:
@@ -172,6 +196,11 @@ class BatchedEnv:
                      for f in self.model_tensors})
         snap["controls"] = [np.array(c, dtype=np.float64) for c in env.controls]
         snap["observed"] = [_positional_reset_u(act, mjm, mjd) for act in env.actuation]
+        snap["muscles"] = [(np.array(act.activation), np.array(act.force))
+                           if c.muscle is not None else None
+                           for act, c in zip(env.actuation, self.controls)]
+        if self.skin is not None:
+            snap["touch"] = BatchedSkin.reading(env.system("touch"))
         return snap
 
     def load(self, worlds, snaps) -> dict:
@@ -197,6 +226,11 @@ class BatchedEnv:
             observed = [s["observed"][i] for s in snaps]
             c.reset(mask, np.stack([s["controls"][i] for s in snaps]),
                     None if observed[0] is None else np.stack(observed), idx)
+            if c.muscle is not None:
+                c.muscle.reset(idx, np.stack([s["muscles"][i][0] for s in snaps]),
+                               np.stack([s["muscles"][i][1] for s in snaps]))
+        if self.skin is not None:
+            self.skin.load(idx, np.stack([s["touch"] for s in snaps]))
         return self._reset_obs(mask)
 
     def step(self, actions, reset_unstable: bool = True) -> tuple[dict, object]:
@@ -217,6 +251,8 @@ class BatchedEnv:
         self.steps += 1
         self._check_overflow()
         unstable = self._unstable()
+        if self.skin is not None:
+            self.skin.feel(contact_rows(self), self.tensors)
         obs = {a: {s.name: s.observe(self.tensors) for s in senses}
                for a, senses in zip(self.agents, self.senses)}
         if reset_unstable and bool(unstable.any()):
@@ -230,7 +266,7 @@ class BatchedEnv:
         """``frame_skip`` physics steps of every world; on a GPU replayed as one CUDA graph."""
         wp = self._wp
         with self._on_device() as stream:
-            if stream is None:
+            if stream is None or self._muscles:
                 self._steps()
                 return
             if self._graph is None:
@@ -245,6 +281,8 @@ class BatchedEnv:
         integration), as the CPU world does after its steps (``mj_kinematics``); the contacts
         stay those of the last step's start, as on the CPU."""
         for _ in range(self.frame_skip):
+            for c in self._muscles:
+                c.substep(self.tensors)
             self._mjw.step(self.model, self.data)
         self._mjw.kinematics(self.model, self.data)
 

@@ -17,7 +17,8 @@ __all__ = ["BatchedContacts"]
 class BatchedContacts:
     """The contact buffer of a batched env's data as tensors (views, no copy): ``geom``
     ``(naconmax, 2)``, ``dist``, ``pos`` ``(naconmax, 3)`` (the contact point, world frame),
-    ``frame`` ``(naconmax, 3, 3)`` (row 0: the normal, from geom 0 to geom 1), ``worldid``;
+    ``frame`` ``(naconmax, 3, 3)`` (row 0: the normal, from geom 0 to geom 1), ``worldid``,
+    ``efc_address`` ``(naconmax, nmaxpyramid)`` (-1: left out of the constraints);
     ``nacon`` ``(1,)``."""
 
     def __init__(self, model, data, mjm, nworld: int, wp, mjw, torch, on_device):
@@ -31,6 +32,7 @@ class BatchedContacts:
         self.pos = wp.to_torch(c.pos)
         self.frame = wp.to_torch(c.frame)
         self.worldid = wp.to_torch(c.worldid)
+        self.efc_address = wp.to_torch(c.efc_address)
         self.nacon = wp.to_torch(data.nacon)
         n = int(c.dist.shape[0])
         device = c.dist.device

@@ -10,28 +10,29 @@ CPU env's :class:`~mimo_social.core.delays.MotorDelay`), then mapped by the actu
 * positional: ``ctrl = lo + (u + 1) (hi - lo) / 2``, the target angle of MuJoCo's servo
   (:class:`~mimo_social.body.actuation.Positional`; the servo gains are in the compiled model).
 
-Muscles compute their torques in Python before every physics step (activation dynamics and the
-force-length-velocity curves): no plain MuJoCo control reproduces them, so they are refused.
+* muscle: the controls are held, and before every physics step the muscles' activations,
+  forces and the joints' torques are computed in torch (:class:`~mimo_social.gpu.muscles.
+  BatchedMuscle`, :meth:`AgentControls.substep`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..body.actuation import Positional, SpringDamper
+from ..body.actuation import Muscle, Positional, SpringDamper
+from .muscles import BatchedMuscle
 
 __all__ = ["AgentControls", "SUPPORTED", "check_actuation"]
 
 #: the actuation models the device reproduces (``AgentConfig.actuation``)
-SUPPORTED = ("spring_damper", "positional")
+SUPPORTED = ("spring_damper", "positional", "muscle")
 
 
 def check_actuation(agent: str, act) -> None:
     """A ValueError naming ``agent`` and its actuation model when the device cannot run it."""
-    if type(act) not in (SpringDamper, Positional):
+    if type(act) not in (SpringDamper, Positional, Muscle):
         raise ValueError(f"{agent}: actuation={getattr(act, 'name', type(act).__name__)!r} does "
-                         f"not run on the GPU backend (muscle torques are computed in Python "
-                         f"before every physics step); allowed: {', '.join(SUPPORTED)}")
+                         f"not run on the GPU backend; allowed: {', '.join(SUPPORTED)}")
 
 
 class AgentControls:
@@ -43,7 +44,7 @@ class AgentControls:
     positional agent reports the targets of the pose it holds, :meth:`Positional.reset`)."""
 
     def __init__(self, agent: str, act, delay: int, reset_controls, nworld: int, torch, device,
-                 reset_observed=None):
+                 reset_observed=None, model=None):
         check_actuation(agent, act)
         self.agent = agent
         self.positional = isinstance(act, Positional)
@@ -54,8 +55,13 @@ class AgentControls:
         as_t = lambda x: torch.as_tensor(np.asarray(x, np.float32), device=device)  # noqa: E731
         self.low, self.high = as_t(act.control_low), as_t(act.control_high)
         self.ids = torch.as_tensor(np.asarray(act.actuator_ids, np.int64), device=device)
+        #: the muscles' state and update (None: no muscles); needs the bound ``model``
+        self.muscle = None if not isinstance(act, Muscle) else BatchedMuscle(
+            act, model, nworld, torch, device)
         if self.positional:
             self.a, self.b = as_t(act.lo), as_t(0.5 * (act.hi - act.lo))
+        elif self.muscle is not None:
+            self.a = self.b = None
         else:
             self.a, self.b = as_t(act.torque_neg), as_t(act.torque_pos)
         self._reset = as_t(reset_controls)
@@ -85,6 +91,9 @@ class AgentControls:
                                                        device=dev)
             self.ring[:, rows] = c
             self.applied[rows] = o
+        if self.muscle is not None:
+            self.muscle.reset(worlds)
+            self.muscle.hold(self.applied)
 
     def check(self, u):
         """``u`` as a float32 tensor ``(nworld, n)`` on the device; a ValueError naming the agent,
@@ -122,7 +131,15 @@ class AgentControls:
             self.applied = self.ring[self._next].clone()
         else:
             self.applied = clipped
+        if self.muscle is not None:      # held; the torques come before each physics step
+            self.muscle.hold(self.applied)
+            return
         ctrl[:, self.ids] = self.map(self.applied).to(ctrl.dtype)
+
+    def substep(self, data_tensors) -> None:
+        """Before each physics step: the muscles' update (nothing for the other models)."""
+        if self.muscle is not None:
+            self.muscle.substep(data_tensors)
 
     def map(self, u):
         """The MuJoCo controls of applied controls ``u`` (see the module)."""
@@ -134,6 +151,8 @@ class AgentControls:
         """The actuation part of proprioception, ``[u, torque]`` per motor: spring-damper the
         applied torque, positional the servo's output (``actuator_force``)."""
         t = self._torch
+        if self.muscle is not None:      # [activations, forces], as the CPU muscle reports
+            return self.muscle.observation()
         if self.positional:
             torque = data_tensors["actuator_force"][:, self.ids]
         else:

@@ -35,7 +35,7 @@ class BatchedTaskEnv:
     takes; ``partners``: the scripted ones (batched)."""
 
     def __init__(self, env, nworld: int, device: str | None = None, seed: int = 0,
-                 nconmax: int | None = None, njmax: int | None = None):
+                 nconmax: int | None = None, njmax: int | None = None, touch: bool = True):
         inner = env.unwrapped
         scripted = dict(getattr(env, "partners", {}) or {})
         self.env, self.inner = env, inner
@@ -43,7 +43,7 @@ class BatchedTaskEnv:
         task = task_class(inner.task.name)   # before the model goes to the device
         env.reset(seed=seed)
         self.batched = BatchedEnv(inner, nworld, device=device, seed=None, nconmax=nconmax,
-                                  njmax=njmax, batch_fields=task.batch_fields)
+                                  njmax=njmax, batch_fields=task.batch_fields, touch=touch)
         self.torch = self.batched.torch
         self.nworld = self.batched.nworld
         self.device_name = self.batched.device_name

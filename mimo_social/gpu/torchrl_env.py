@@ -38,9 +38,10 @@ class TorchRLEnv(EnvBase):
     episodes' seeds (:class:`BatchedTaskEnv`); ``group``: the learners' group name."""
 
     def __init__(self, env, num_envs: int, device: str | None = None, seed: int = 0,
-                 group: str = "agents", nconmax: int | None = None, njmax: int | None = None):
+                 group: str = "agents", nconmax: int | None = None, njmax: int | None = None,
+                 touch: bool = True):
         tenv = BatchedTaskEnv(env, num_envs, device=device, seed=seed, nconmax=nconmax,
-                              njmax=njmax)
+                              njmax=njmax, touch=touch)
         if not isinstance(group, str) or not group:
             raise ValueError(f"group={group!r} not allowed; allowed: a non-empty string")
         dev = tenv.batched.qpos.device

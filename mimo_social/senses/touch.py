@@ -105,9 +105,9 @@ class TouchConfig:
         put("cache", check_bool("touch", "cache", self.cache))
 
 
-_SHIFT = 0.5   # a contact is looked up this many spacings outward along its normal
+LOOKUP_SHIFT = 0.5   # a contact is looked up this many spacings outward along its normal
 _SIGN3 = np.array([-1.0, 1.0]).reshape(2, 1, 1)   # per side: geom1, geom2
-_SHIFT_ROW = np.array([-_SHIFT / GRID_CELL, 0.0, 0.0])   # in the contact frame, in cells
+_SHIFT_ROW = np.array([-LOOKUP_SHIFT / GRID_CELL, 0.0, 0.0])   # in the contact frame, in cells
 
 
 class AgentTouch:
@@ -259,14 +259,14 @@ class TouchSystem:
         self.part_nearest = np.array(part_nearest, bool)
         # per part: 1 / spacing, grid origin (3), largest cell (3), cell strides (3), first cell
         self.part_params = np.array(params)
-        # the same for the update, one row a part: numbers (1 / (spacing GRID_CELL), grid
-        # origin, largest cell, in grid cells; 1 for each dof that moves the part, 0 for padding)
-        # and integers (body, root body, cell strides, first cell, the dofs that move the part)
+        # the same for the update (and the device's skin), a row a part: numbers (1 / (spacing
+        # GRID_CELL), grid origin, largest cell, in grid cells; 1 for each dof that moves the
+        # part, 0 for padding), integers (body, root, cell strides, first cell, those dofs)
         dofs, on = body_dofs(m, self.part_body)
-        self._part_grid = np.concatenate(
+        self.part_grid = np.concatenate(
             [self.part_params[:, :7] * ([1.0 / GRID_CELL] * 4 + [1.0] * 3), on], axis=1)
-        self._part_ints = np.concatenate([self.part_body[:, None], self.part_root[:, None],
-                                          self.part_params[:, 7:].astype(np.intp), dofs], axis=1)
+        self.part_ints = np.concatenate([self.part_body[:, None], self.part_root[:, None],
+                                         self.part_params[:, 7:].astype(np.intp), dofs], axis=1)
         # one more entry, -1, so that the geom id -1 of a flex contact reads as "no skin", "world"
         self.geom_part = np.append(geom_part, -1)
         self.geom_agent = np.append(np.asarray(self.world.geom_agent, dtype=np.intp), -1)
@@ -351,8 +351,8 @@ class TouchSystem:
             if not len(sides):
                 return
         S = len(sides)
-        # rows, in the contact frame: the grid look-up's shift (_SHIFT spacings along the normal
-        # n, geom1 -> geom2, in grid cells) and the force on geom2
+        # rows, in the contact frame: the grid look-up's shift (LOOKUP_SHIFT spacings along the
+        # normal n, geom1 -> geom2, in grid cells) and the force on geom2
         F = np.empty((S, 2, 3))
         F[:, 0] = _SHIFT_ROW
         efc = data.efc_force
@@ -364,7 +364,7 @@ class TouchSystem:
         else:
             F[:, 1] = f = contact_forces(c, ci, ea, efc, pyramidal, self._all_dim3)
         part = gp.take(sides)
-        ints = self._part_ints.take(part, 0)             # body, root, cell strides, first cell
+        ints = self.part_ints.take(part, 0)             # body, root, cell strides, first cell
         body = ints[:, 0]
         # the same rows in the world frame, for the touched side: geom2 feels +F and its skin's
         # outward normal is -n, geom1 feels -F and has +n: the contact frame times the sign
@@ -373,7 +373,7 @@ class TouchSystem:
         V = np.empty((S, 3, 3))                          # point (to be made relative), shift, force
         V[:, 0] = c.pos.take(ci, 0)
         np.matmul(F, frame, out=V[:, 1:])
-        prm = self._part_grid.take(part, 0)
+        prm = self.part_grid.take(part, 0)
         if h > 0.0:
             # carry the contact point along with its body over the last physics step: the
             # bodies moved by h times their velocities of now (semi-implicit Euler), expressed in

@@ -75,7 +75,8 @@ class GpuPPOConfig:
     ``worlds * rollout``); ``device``: Warp's and torch's (None: a GPU when Warp sees one, else
     the CPU); ``reward_scale``: the rewards' factor for the critic and the advantages (the
     progress reports unscaled returns); ``max_steps``: the episodes' length (None: the
-    task's); ``hidden``: the width of both MLPs' two hidden layers."""
+    task's); ``hidden``: the width of both MLPs' two hidden layers; ``touch``: the touch skin
+    in the learner's observation where the task's env has touch (self-body, high five)."""
 
     task: str = "reach"
     worlds: int = 64
@@ -96,6 +97,7 @@ class GpuPPOConfig:
     init_log_std: float = 0.0
     hidden: int = 64
     max_steps: int | None = None
+    touch: bool = True
 
     def __post_init__(self):
         if self.task not in TASKS:
@@ -106,6 +108,8 @@ class GpuPPOConfig:
                 _bad(name, value, "a positive integer")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
             _bad("seed", self.seed, "an integer >= 0")
+        if not isinstance(self.touch, bool):
+            _bad("touch", self.touch, "True or False")
         if self.max_steps is not None and (isinstance(self.max_steps, bool) or not isinstance(
                 self.max_steps, int) or self.max_steps < 1):
             _bad("max_steps", self.max_steps, "None or a positive integer")
@@ -210,7 +214,7 @@ def make_env(config: GpuPPOConfig) -> GymVectorEnv:
     """The batched worlds of ``config.task`` as a Gymnasium vector env of torch tensors."""
     kw = {} if config.max_steps is None else {"max_steps": config.max_steps}
     return GymVectorEnv(TASKS[config.task](**kw), config.worlds, device=config.device,
-                        seed=config.seed)
+                        seed=config.seed, touch=config.touch)
 
 
 def build_networks(n_obs: int, low: torch.Tensor, high: torch.Tensor, config: GpuPPOConfig):
@@ -388,7 +392,9 @@ def evaluate_gpu_ppo(run, worlds: int = 64, seed: int = 1_000_000, explore: bool
     episodes, and what was run."""
     run = Path(run)
     meta = json.loads((run / "config.json").read_text())
-    settings = dict(meta["config"], worlds=int(worlds), seed=int(seed), device=device,
+    # a run written before the device had touch observed none
+    settings = dict({"touch": False}, **meta["config"])
+    settings = dict(settings, worlds=int(worlds), seed=int(seed), device=device,
                     minibatch=1)
     config = GpuPPOConfig(**settings)
     torch.manual_seed(config.seed)

@@ -1,6 +1,6 @@
 """The batched env's interface on Warp's CPU device: actuation models (positional agrees with
-the CPU env, muscles are refused), proprioception in the CPU sense's layout, per-world resets,
-bad actions, overflowing contact buffers, the device chosen, and high five."""
+the CPU env, unknown models are refused), proprioception in the CPU sense's layout, per-world
+resets, bad actions, overflowing contact buffers, the device chosen, and high five."""
 
 from __future__ import annotations
 
@@ -105,11 +105,19 @@ def test_gpu_a_world_reset_starts_over_and_leaves_the_others_going():
             assert np.abs(batched.qpos[w].numpy() - cpus[w].world.data.qpos).max() < 1e-4
 
 
-def test_gpu_muscles_are_refused_by_name():
-    env = free_play_v0.parallel_env(n_agents=1, actuation="muscle")
-    with pytest.raises(ValueError, match=r"infant_0: actuation='muscle' does not run on the "
-                                         r"GPU backend.*allowed: spring_damper, positional"):
-        BatchedEnv(env, 2, device="cpu")
+def test_gpu_an_actuation_model_the_device_does_not_know_is_refused_by_name():
+    """The three models run on the device (muscles: tests/gpu/test_gpu_muscle.py); another
+    object (e.g. a subclass with other dynamics) is refused, naming the agent and the model."""
+    from mimo_social.body.actuation import SpringDamper
+    from mimo_social.gpu import check_actuation
+
+    class Stiffer(SpringDamper):
+        name = "stiffer"
+    act = Stiffer.__new__(Stiffer)
+    with pytest.raises(ValueError, match=r"infant_0: actuation='stiffer' does not run on the "
+                                         r"GPU backend; allowed: spring_damper, positional, "
+                                         r"muscle"):
+        check_actuation("infant_0", act)
 
 
 def test_gpu_bad_actions_and_settings_are_errors_that_say_what_is_allowed():

@@ -26,6 +26,12 @@ def test_gpu_bench_counts_agent_steps_of_every_world():
     text = gpu.format_results(out)
     assert "device: cpu (no GPU: Warp's CPU device)" in text
     assert text.splitlines()[-1].startswith("no GPU: Warp's CPU device")
+    assert all(r["touch"] for r in out["results"]) and "hand skins" in text
+
+
+def test_gpu_bench_leaves_the_skins_out_when_told():
+    out = gpu.measure([2], steps=1, warmup=0, device="cpu", touch=False)
+    assert not out["results"][0]["touch"] and "no touch" in gpu.format_results(out)
 
 
 @pytest.mark.skipif(has_gpu(), reason="checks the output without a GPU")
@@ -37,6 +43,9 @@ def test_gpu_bench_command_says_there_is_no_gpu_and_writes_its_json(tmp_path, ca
     assert "no GPU: Warp's CPU device" in printed and "agent-steps/s" in printed
     saved = json.loads(path.read_text())
     assert saved["device"] == "cpu" and saved["results"][0]["worlds"] == 2
+    assert cli.main(["bench", "gpu", "--worlds", "2", "--steps", "1", "--warmup", "0",
+                     "--no-touch"]) == 0
+    assert "no touch" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("argv, option", [(["--worlds", "0"], "--worlds"),

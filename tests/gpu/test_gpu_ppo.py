@@ -18,7 +18,7 @@ import torch  # noqa: E402
 from tensordict import TensorDict  # noqa: E402
 
 from mimo_social import cli  # noqa: E402
-from mimo_social.envs import selfbody_v0  # noqa: E402
+from mimo_social.envs import high_five_v0, selfbody_v0  # noqa: E402
 from mimo_social.train import gpu_ppo  # noqa: E402
 from mimo_social.train.gpu_ppo import (PROGRESS_COLUMNS, GpuPPOConfig,  # noqa: E402
                                        RunningObsNorm, read_progress, train_gpu_ppo)
@@ -80,11 +80,11 @@ def test_gpu_ppo_is_deterministic_under_a_seed(reach_run, tmp_path):
     assert _same(other) != _same(first)
 
 
-def _tiny_run(task, out) -> dict:
+def _tiny_run(task, out, **kw) -> dict:
     """Two worlds, one iteration of 4 steps, episodes of 2 steps: 4 episodes end; returns the
     run's config.json."""
     cfg = GpuPPOConfig(task=task, worlds=2, steps=8, rollout=4, minibatch=8,
-                       epochs=1, device="cpu", max_steps=2)
+                       epochs=1, device="cpu", max_steps=2, **kw)
     train_gpu_ppo(cfg, out)
     rows = read_progress(out / "progress.csv")
     assert len(rows) == 1 and rows[0]["episodes"] == 4 and np.isfinite(rows[0]["loss_policy"])
@@ -93,15 +93,23 @@ def _tiny_run(task, out) -> dict:
 
 def test_gpu_ppo_high_five_learns_beside_its_partner_on_the_device(tmp_path):
     meta = _tiny_run("high_five", tmp_path)
-    assert meta["observation_size"] == 48 + 6    # proprioception and vestibular
+    hand = high_five_v0.scripted_env().observation_space("infant_0")["touch"].shape[0]
+    assert meta["observation_size"] == 48 + 6 + hand   # proprioception, vestibular, the hand's
+    assert meta["config"]["touch"] is True            # skin
 
 
 def test_gpu_ppo_selfbody_observes_its_target(tmp_path):
-    """Self-body on the device: the policy's input is the arm's proprioception and the one-hot
-    target; the episodes end at the time limit (the untrained arm touches nothing)."""
-    meta = _tiny_run("selfbody", tmp_path)
+    """Self-body on the device: the policy's input is the arm's proprioception, the skin and
+    the one-hot target (``touch=False``: without the skin); the episodes end at the time limit
+    (the untrained arm touches nothing)."""
     space = selfbody_v0.parallel_env().observation_space("infant_0")
+    meta = _tiny_run("selfbody", tmp_path / "touch")
+    assert meta["observation_size"] == (space["proprioception"].shape[0]
+                                        + space["touch"].shape[0] + 28)
+    meta = _tiny_run("selfbody", tmp_path / "none", touch=False)
     assert meta["observation_size"] == space["proprioception"].shape[0] + 28
+    with pytest.raises(ValueError, match="touch=1 not allowed"):
+        GpuPPOConfig(task="selfbody", touch=1)
 
 
 def test_gpu_ppo_samples_its_actions_while_collecting():
@@ -206,3 +214,14 @@ def test_gpu_ppo_evaluates_a_run_on_episodes_it_did_not_train_on(reach_run):
     assert gpu_ppo.evaluate_gpu_ppo(out, worlds=3, device="cpu") == ev
     sampled = gpu_ppo.evaluate_gpu_ppo(out, worlds=3, device="cpu", explore=True)
     assert sampled["return_mean"] != ev["return_mean"]
+
+
+def test_gpu_ppo_evaluates_a_run_written_before_the_device_had_touch(tmp_path):
+    """A run's config.json without ``touch`` (written before the device observed touch) is
+    evaluated without the skin, as it was trained."""
+    meta = _tiny_run("high_five", tmp_path, touch=False)
+    assert meta["observation_size"] == 48 + 6
+    del meta["config"]["touch"]
+    (tmp_path / "config.json").write_text(json.dumps(meta))
+    ev = gpu_ppo.evaluate_gpu_ppo(tmp_path, worlds=2, device="cpu")
+    assert ev["episodes"] == 2 and np.isfinite(ev["return_mean"])

@@ -88,7 +88,9 @@ def test_gpu_vector_env_hands_out_device_tensors():
 
 def test_gpu_vector_env_high_five_with_its_scripted_partner():
     v = GymVectorEnv(high_five_v0.scripted_env(), N, device="cpu", numpy=True)
-    assert list(v.single_observation_space.spaces) == ["proprioception", "vestibular"]
+    cpu = high_five_v0.scripted_env().observation_space("infant_0")
+    assert list(v.single_observation_space.spaces) == ["proprioception", "touch", "vestibular"]
+    assert v.single_observation_space["touch"] == cpu["touch"]       # the hand's skin
     assert v.single_action_space.shape == (8,)
     obs, _ = v.reset(seed=0)
     obs, rew, term, trunc, infos = v.step(v.action_space.sample())
