@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..senses.proprioception import JOINT_OVERSHOOT
+from .delay_ring import DelayRing
 
 __all__ = ["BatchedProprioception"]
 
@@ -45,16 +46,15 @@ class BatchedProprioception:
         self.upper = as_t(1.0 - hi * inv)     # the CPU sense's folded constants
         self.lower = as_t(1.0 + lo * inv)
         self.delay = int(delay)
-        self.ring = torch.zeros((self.delay + 1, nworld, self.size), dtype=torch.float32,
-                                device=device)
-        self._next = 0
+        self.ring = DelayRing(delay, nworld, self.size, torch, device)
+        self.device = device
 
     def read(self, data):
         """This step's reading, ``(nworld, size)`` float32; ``data``: the batched data's
         arrays as tensors by name."""
         t = self._torch
         out = t.empty((data["qpos"].shape[0], self.size), dtype=t.float32,
-                      device=self.ring.device)
+                      device=self.device)
         q = data["qpos"][:, self.qpos_adr].to(t.float64)
         q = t.minimum(t.maximum(q, self.q_lo), self.q_hi)
         for c, sl in self.slices.items():
@@ -74,19 +74,8 @@ class BatchedProprioception:
     def reset(self, data, worlds=None):
         """The reading at reset, in every slot of the delay ring (``worlds``: a bool mask of
         the worlds reset; None: all); returns the observation."""
-        reading = self.read(data)
-        if worlds is None:
-            self.ring[:] = reading
-            self._next = 0
-        else:
-            self.ring[:, worlds] = reading[worlds]
-        return self.ring[self._next].clone()
+        return self.ring.reset(self.read(data), worlds)
 
     def observe(self, data):
         """This step's observation: the reading of ``delay`` steps before."""
-        reading = self.read(data)
-        if not self.delay:
-            return reading
-        self.ring[self._next] = reading
-        self._next = (self._next + 1) % (self.delay + 1)
-        return self.ring[self._next].clone()
+        return self.ring.push(self.read(data))

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..senses.skin import GRID_CELL
 from ..senses.touch import LOOKUP_SHIFT
+from .delay_ring import DelayRing
 
 __all__ = ["BatchedSkin", "BatchedTouchSense", "contact_rows"]
 
@@ -168,9 +169,7 @@ class BatchedTouchSense:
         n = self.stop - self.start
         self.size = n if self.normal_only else 3 * n
         self.delay = int(delay)
-        self.ring = torch.zeros((self.delay + 1, nworld, self.size), dtype=torch.float32,
-                                device=device)
-        self._next = 0
+        self.ring = DelayRing(delay, nworld, self.size, torch, device)
 
     def read(self, data=None):
         """This step's reading, ``(nworld, size)`` float32 (a pressing force is >= 0)."""
@@ -182,19 +181,8 @@ class BatchedTouchSense:
     def reset(self, data, worlds=None):
         """The reading at reset in every slot of the delay ring (``worlds``: a bool mask of the
         worlds reset; None: all); returns the observation."""
-        reading = self.read()
-        if worlds is None:
-            self.ring[:] = reading
-            self._next = 0
-        else:
-            self.ring[:, worlds] = reading[worlds]
-        return self.ring[self._next].clone()
+        return self.ring.reset(self.read(), worlds)
 
     def observe(self, data):
         """This step's observation: the reading of ``delay`` steps before."""
-        reading = self.read()
-        if not self.delay:
-            return reading
-        self.ring[self._next] = reading
-        self._next = (self._next + 1) % (self.delay + 1)
-        return self.ring[self._next].clone()
+        return self.ring.push(self.read())
