@@ -19,6 +19,8 @@ from ._args import non_negative_float, output_dir, positive_float, positive_int,
 __all__ = ["NAME", "add_parser", "run"]
 
 NAME = "train-gpu"
+#: the names of :data:`mimo_social.train.gpu_ppo.TASKS`, spelt out so that building the parser
+#: imports no torch (tests/gpu/test_gpu_ppo.py checks that the two agree)
 TASKS = ("reach", "high_five", "selfbody")
 
 

@@ -225,3 +225,8 @@ def test_gpu_ppo_evaluates_a_run_written_before_the_device_had_touch(tmp_path):
     (tmp_path / "config.json").write_text(json.dumps(meta))
     ev = gpu_ppo.evaluate_gpu_ppo(tmp_path, worlds=2, device="cpu")
     assert ev["episodes"] == 2 and np.isfinite(ev["return_mean"])
+
+
+def test_gpu_ppo_command_offers_every_task_the_learner_trains():
+    from mimo_social.cli import train_gpu
+    assert train_gpu.TASKS == tuple(gpu_ppo.TASKS)
