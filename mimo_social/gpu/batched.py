@@ -111,9 +111,6 @@ class BatchedEnv:
         #: the agents' skins on the device (None: no agent has touch, or ``touch=False``)
         self.skin = None if system is None else BatchedSkin(system, mjm, self.nworld, torch,
                                                             tdev)
-        if self.skin is not None:
-            self.skin.set_start(system)
-            self.skin.reset()
         self.controls, self.senses = [], []
         for i, name in enumerate(self.agents):
             act = env.actuation[i]
@@ -135,7 +132,7 @@ class BatchedEnv:
             self.senses.append(senses)
         self._graph = None
         #: muscles update before every physics step (torch): no CUDA graph then
-        self._muscles = [c for c in self.controls if c.muscle is not None]
+        self._muscles = [c.muscle for c in self.controls if c.muscle is not None]
         self.steps = 0
 
     # -- sizes -----------------------------------------------------------------------------------
@@ -281,8 +278,8 @@ class BatchedEnv:
         integration), as the CPU world does after its steps (``mj_kinematics``); the contacts
         stay those of the last step's start, as on the CPU."""
         for _ in range(self.frame_skip):
-            for c in self._muscles:
-                c.substep(self.tensors)
+            for muscle in self._muscles:
+                muscle.substep(self.tensors)
             self._mjw.step(self.model, self.data)
         self._mjw.kinematics(self.model, self.data)
 

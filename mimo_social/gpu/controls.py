@@ -12,7 +12,7 @@ CPU env's :class:`~mimo_social.core.delays.MotorDelay`), then mapped by the actu
 
 * muscle: the controls are held, and before every physics step the muscles' activations,
   forces and the joints' torques are computed in torch (:class:`~mimo_social.gpu.muscles.
-  BatchedMuscle`, :meth:`AgentControls.substep`).
+  BatchedMuscle`, called by the batched env's physics loop).
 """
 
 from __future__ import annotations
@@ -135,11 +135,6 @@ class AgentControls:
             self.muscle.hold(self.applied)
             return
         ctrl[:, self.ids] = self.map(self.applied).to(ctrl.dtype)
-
-    def substep(self, data_tensors) -> None:
-        """Before each physics step: the muscles' update (nothing for the other models)."""
-        if self.muscle is not None:
-            self.muscle.substep(data_tensors)
 
     def map(self, u):
         """The MuJoCo controls of applied controls ``u`` (see the module)."""

@@ -37,7 +37,6 @@ class _Table:
         self.step = (float(hi) - float(lo)) / (self.n - 1)
         self.values = torch.as_tensor(curve(np.linspace(lo, hi, n)), dtype=torch.float64,
                                       device=device)
-        self._torch = torch
 
     def __call__(self, x):
         s = ((x - self.lo) / self.step).clamp(0.0, self.n - 1.0)

@@ -54,7 +54,6 @@ class BatchedSkin:
         self._torch = torch
         self.nworld = int(nworld)
         self.n_points = int(system.n_points)
-        self.agent_slices = list(system.agent_slices)
         as_t = lambda x, kind=torch.float32: torch.as_tensor(np.asarray(x), dtype=kind,  # noqa
                                                              device=device)
         # the CPU system's concatenated arrays (senses/touch.py, TouchSystem.concatenate)
@@ -68,9 +67,9 @@ class BatchedSkin:
         self.scaled = as_t(system.scaled.T)                        # (N + 1, 3), in grid cells
         self.ngeom = int(model.ngeom)
         self.timestep = float(model.opt.timestep)
-        self.acc = torch.zeros((self.nworld, self.n_points + 1, 4), dtype=torch.float32,
-                               device=device)
-        self.start = self.acc[0].clone()
+        #: the reading of the CPU env's state as given (its reset): what :meth:`reset` puts back
+        self.start = as_t(self.reading(system))
+        self.acc = self.start.expand(self.nworld, -1, -1).clone()
 
     # -- resets ----------------------------------------------------------------------------------
     @staticmethod
@@ -80,11 +79,6 @@ class BatchedSkin:
         n = system.n_points + 1
         acc = np.asarray(system.acc, dtype=np.float64)
         return np.concatenate([acc[:3 * n].reshape(n, 3), acc[3 * n:, None]], axis=1)
-
-    def set_start(self, system) -> None:
-        """The reading of the CPU env's reset state: what :meth:`reset` puts back."""
-        self.start = self._torch.as_tensor(self.reading(system), dtype=self.acc.dtype,
-                                           device=self.acc.device)
 
     def reset(self, worlds=None) -> None:
         """``worlds`` (a bool mask; None: all) back to the reset state's reading."""
