@@ -20,6 +20,7 @@ from ..body.tables import AGE_RANGE, BODY_KINDS, HAND_VERSIONS, SCALE_RANGE, STR
 from ..senses import SENSES
 from ..senses.audition import AuditionConfig
 from ..senses.delays import CHANNELS
+from ..senses.faces import FacesConfig
 from ..senses.proprioception import ProprioceptionConfig
 from ..senses.touch import TouchConfig
 from ..senses.vestibular import VestibularConfig
@@ -30,7 +31,7 @@ from ..util.names import agent_names
 
 __all__ = [
     "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig", "AgentConfig",
-    "AuditionConfig",
+    "AuditionConfig", "FacesConfig",
     "PhysicsConfig", "ConfigError", "resolve_agents", "parse_physics", "ACTUATION_MODELS",
     "POSTURES", "BODIES", "AGE_RANGE", "DELAY_CHANNELS", "DELAY_LIMIT_MS", "env_settings",
     "RENDER_SIZE_RANGE", "MAX_STEPS_LIMIT",
@@ -75,6 +76,9 @@ class AgentConfig:
     # Two ears on the head hearing every agent with voice on: per source its kind, the level
     # at each ear, ILD and ITD (docs/senses.md, "Hearing and voice")
     audition: AuditionConfig | None = None
+    # The other agents' faces while in view: seen, where, turned where, looking where
+    # (docs/senses.md, "Faces"): what a trained face perception reads, not the pixels
+    faces: FacesConfig | None = None
     expressions: bool = True   # the face is part of the action: 7 expressions
     # The voice is part of the action: "voice" (a kind of expressions.voice.SOUNDS: silence,
     # coo, babble, cry, laugh, speech) and "loudness" in [0, 1] (the kind's quietest to

@@ -6,9 +6,10 @@ sense and a shared system are). A new sense is its file (the sense, its config d
 :class:`mimo_social.core.config.AgentConfig`.
 """
 
-from . import audition, proprioception, touch, vestibular, vision
+from . import audition, faces, proprioception, touch, vestibular, vision
 from .audition import AuditionConfig
 from .base import Sense, SenseEntry, SharedSystem
+from .faces import FacesConfig
 from .proprioception import Proprioception, ProprioceptionConfig
 from .touch import TouchConfig
 from .vestibular import Vestibular, VestibularConfig
@@ -21,8 +22,9 @@ SENSES: dict[str, SenseEntry] = {entry.name: entry for entry in (
     touch.SENSE,
     vision.SENSE,
     audition.SENSE,
+    faces.SENSE,
 )}
 
 __all__ = ["SENSES", "Sense", "SenseEntry", "SharedSystem", "Proprioception", "Vestibular",
            "ProprioceptionConfig", "VestibularConfig", "TouchConfig", "VisionConfig",
-           "AuditionConfig"]
+           "AuditionConfig", "FacesConfig"]

@@ -21,7 +21,7 @@ BC_DEFAULTS = {"epochs": 20, "batch_size": 64, "lr": 1e-3, "loss": "mse", "log_s
 BC_LOSSES = ("mse", "nll")
 BC_ALGOS = ("ppo", "sac", "recurrent_ppo")
 #: the settings a recurrent policy's cloning (by sequences) refuses: they work pair by pair
-PAIRWISE = ("keep_updates", "dagger_rounds", "critic_epochs", "aux_label")
+PAIRWISE = ("dagger_rounds", "critic_epochs", "aux_label")
 #: ``keep_until``'s largest value: the kept cloning falls to 0 at this many runs' lengths (at 2
 #: it is at half strength at the run's end; at 1000 all but constant)
 KEEP_UNTIL_MAX = 1000.0

@@ -81,8 +81,9 @@ trained on the pairs for ``E`` epochs (Adam, minibatches), through the policy's 
 * ``seq_len`` (default 128) and ``seq_batch`` (4), ``--algo recurrent_ppo`` only: the LSTM
   policy is cloned by consecutive sequences of ``seq_len`` steps of each episode, ``seq_batch``
   of them a minibatch, the LSTM state zero at each sequence's start
-  (:mod:`~mimo_social.train.sequence_cloning`); ``keep_updates``, DAgger, ``critic_epochs`` and
-  ``aux_label`` are refused with it (they work pair by pair).
+  (:mod:`~mimo_social.train.sequence_cloning`); ``keep_updates`` then draws ``seq_batch``
+  sequences a minibatch; DAgger, ``critic_epochs`` and ``aux_label`` are refused with it (they
+  work pair by pair).
 
 ``config.json["bc"]`` records the episodes, their seeds, the demonstrations' success rate and
 mean return, the samples, the settings, the loss before and after cloning and the time taken;
@@ -111,7 +112,7 @@ from ..envs.catalog import DEFAULT_DEMONSTRATOR, entry
 from .auxiliary import aux_head, features_and_distribution, label_of
 from .bc_settings import BC_ALGOS, BC_DEFAULTS, BC_LOSSES, check_bc
 from .log_std import check_log_std_size, set_log_std
-from .sequence_cloning import clone_sequences, is_recurrent
+from .sequence_cloning import SequenceCloner, clone_sequences, is_recurrent
 from .tasks import TrainInputError
 
 __all__ = ["BC_DEFAULTS", "BC_ALGOS", "BC_LOSSES", "DEMO_SEED", "Demonstrations", "Demonstrator",
@@ -452,11 +453,22 @@ def keep_cloning(model, demos: Demonstrations, settings: Mapping[str, Any], tota
 
     if not int(settings.get("keep_updates", 0)):
         return None
-    cloner = Cloner(model, demos, float(settings["lr"]), str(settings["loss"]),
-                    float(settings.get("aux_weight", 1.0)))
     rng = np.random.default_rng(seed + 2)
     per_update, until = int(settings["keep_updates"]), float(settings["keep_until"])
-    batch = int(settings["batch_size"])
+    if is_recurrent(model.policy):      # by sequences: seq_batch of them a minibatch
+        cloner = SequenceCloner(model, demos, int(settings["seq_len"]), float(settings["lr"]),
+                                str(settings["loss"]))
+        seqs, batch = cloner.seqs, int(settings["seq_batch"])
+
+        def draw():
+            return [seqs[j] for j in rng.integers(0, len(seqs), batch)]
+    else:
+        cloner = Cloner(model, demos, float(settings["lr"]), str(settings["loss"]),
+                        float(settings.get("aux_weight", 1.0)))
+        batch = int(settings["batch_size"])
+
+        def draw():
+            return rng.integers(0, len(demos), batch)
 
     class KeepCloning(BaseCallback):
         updates = 0
@@ -473,7 +485,7 @@ def keep_cloning(model, demos: Demonstrations, settings: Mapping[str, Any], tota
             mode = cloner.policy.training
             cloner.policy.set_training_mode(True)
             for _ in range(n):
-                cloner.step(rng.integers(0, len(demos), batch))
+                cloner.step(draw())
             cloner.policy.set_training_mode(mode)
             self.updates += n
 

@@ -13,8 +13,10 @@ zero at each sequence's first step (truncated back-propagation through time: a m
 per step is the mean action's squared error (``"mse"``) or the negative log-likelihood
 (``"nll"``; a ``Discrete`` action: the cross-entropy), as the feed-forward clone's.
 
-Refused with a recurrent policy (by :func:`~mimo_social.train.bc_settings.check_bc`): cloning
-kept during RL, DAgger, the critic's fit and an auxiliary label, which work pair by pair.
+Cloning kept during RL (``keep_updates``) draws ``seq_batch`` sequences at random a minibatch
+(:func:`~mimo_social.train.demonstrations.keep_cloning`). Refused with a recurrent policy (by
+:func:`~mimo_social.train.bc_settings.check_bc`): DAgger, the critic's fit and an auxiliary
+label, which work pair by pair.
 """
 
 from __future__ import annotations

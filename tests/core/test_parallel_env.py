@@ -123,7 +123,7 @@ def test_senses_come_from_the_registry():
     from mimo_social.core.env import TIMING_KEYS
     from mimo_social.senses import SENSES, Sense, SharedSystem
 
-    assert list(SENSES) == ["proprioception", "vestibular", "touch", "vision", "audition"]
+    assert list(SENSES) == ["proprioception", "vestibular", "touch", "vision", "audition", "faces"]
     assert set(SENSES) <= {f.name for f in fields(AgentConfig)}
     assert set(SENSES) <= set(TIMING_KEYS)
     for name, entry in SENSES.items():

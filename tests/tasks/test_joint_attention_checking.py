@@ -109,10 +109,11 @@ def test_the_partner_s_head_is_in_view_on_the_face_and_out_of_a_60_degree_view_o
 
 def test_the_checking_follower_is_the_task_s_named_demonstrator():
     e = entry("joint_attention")
-    assert e.demonstrator_names() == ("scripted", "checking")
+    assert e.demonstrator_names() == ("scripted", "checking", "sensed")
     assert e.controller_class("checking") is CheckingFollowController
     assert e.controller_class(None) is e.controller_class("scripted") is GazeFollowController
-    with pytest.raises(ValueError, match=r"demonstrator='watch'.*\['scripted', 'checking'\]"):
+    with pytest.raises(ValueError,
+                       match=r"demonstrator='watch'.*\['scripted', 'checking', 'sensed'\]"):
         e.controller_class("watch")
     with pytest.raises(ValueError, match="demonstrator='checking'.*'scripted'"):
         entry("reach").controller_class("checking")

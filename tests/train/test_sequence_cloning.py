@@ -102,3 +102,37 @@ def test_a_recurrent_run_clones_by_sequences_before_any_rl_step(tmp_path):
     assert bc["samples"] / 16 <= bc["sequences"] <= 3 * 3 and bc["sequences"] >= 3
     assert bc["loss_after"] < bc["loss_before"]
     assert bc["updates"] == 2 * -(-bc["sequences"] // 2)   # 2 epochs of 2 sequences a batch
+
+
+def test_kept_cloning_of_a_recurrent_policy_draws_sequences_and_pulls_it_back():
+    from sb3_contrib import RecurrentPPO
+
+    from mimo_social.train.demonstrations import keep_cloning
+    from mimo_social.train.sequence_cloning import SequenceCloner
+
+    demos = cue_demonstrations(32, 12, np.random.default_rng(1))
+    lstm = RecurrentPPO("MlpLstmPolicy", CueEnv(), seed=0, device="cpu",
+                        policy_kwargs={"lstm_hidden_size": 16})
+    settings = {"keep_updates": 60, "keep_until": 1.0, "lr": 3e-3, "loss": "mse",
+                "batch_size": 64, "seq_len": 12, "seq_batch": 8}
+    cb = keep_cloning(lstm, demos, settings, 1000, 0)
+    cb.init_callback(lstm)
+    loss = SequenceCloner(lstm, demos, 12).mean_loss
+    before = loss(8)
+    for t in (0, 0, 0, 0, 0):        # the first rollout's start makes none, then 60 each
+        lstm.num_timesteps = t
+        cb.on_rollout_start()
+    assert cb.updates == 4 * 60
+    assert loss(8) < 0.5 * before
+    assert np.all(np.sign(recalled(lstm, np.array([1.0, -1.0]), 12)) == [1.0, -1.0])
+
+
+def test_a_recurrent_run_keeps_cloning_during_rl_when_asked(tmp_path):
+    out = tmp_path / "run"
+    train("reach", "recurrent_ppo", 512, 0, out, progress=False, eval_episodes=1,
+          algo_kwargs={"n_steps": 128, "n_epochs": 1, "batch_size": 128},
+          env_kwargs={"max_steps": 40}, bc_episodes=3, bc_epochs=2,
+          bc_kwargs={"seq_len": 16, "seq_batch": 2, "keep_updates": 4, "keep_until": 1.0})
+    bc = json.loads((out / "config.json").read_text())["bc"]
+    # after each update 4 x (1 - t / 512) sequences minibatches (t: SB3's timesteps then)
+    assert bc["keep_updates"] == 4 and 1 <= bc["keep_updates_made"] <= 3 + 2 + 1

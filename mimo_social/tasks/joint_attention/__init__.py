@@ -24,7 +24,10 @@ observation:
     `eye_left`, `eye_right` (96x96x3 RGB), `proprioception` (54: its own joints, where its head and
     eyes point); with two learners in "leader" mode also `instruction` (`n_toys`: one-hot of the toy
     the leader is to look at; all zeros for the follower); never the partner's target or joint
-    angles
+    angles. With the agent option `faces` (face perception, docs/senses.md "Faces"; the shipped
+    recipe's learner: eyes off, `faces` with a 160-degree view) also `faces` (10): while the
+    partner's face is in view, turned to it and not hidden, where the partner's head is, where
+    it is turned and its line of sight, in the learner's head frame; zeros otherwise
 partner:
     the scripted `GazeAtTarget` holds each toy 1.5-3 s (then another, never the same twice); per
     gaze shift its head makes a share of the turn drawn uniformly from `partner_head_share` +-
@@ -59,8 +62,9 @@ options:
 privileged cues:
     none for the follower: the partner's head and eye turns reach it only through its own eyes, and
     nothing of the partner's target is in its observation; the leader's `instruction` is its own
-    task, not the partner's state. The shaping term reads the partner's toy from the geometry (the
-    reward, not an observation)
+    task, not the partner's state. `faces` gives the partner's line of sight only while the
+    learner sees the face (not the toy it lands on: the learner finds that itself). The shaping
+    term reads the partner's toy from the geometry (the reward, not an observation)
 two learners:
     `two_learners` "leader" (default): per episode the task draws a leader, which is rewarded for
     looking at the toy of its `instruction` (a new toy every 1.5-3 s, never the same twice), and the
@@ -113,6 +117,7 @@ reward).
 from .task import (parallel_env, env, scripted_env, JointAttention, JointAttentionOptions)
 from .controller import GazeFollowController
 from .checking import CheckingFollowController
+from .sensed import SensedFollowController
 
 __all__ = ["parallel_env", "env", "scripted_env", "JointAttention", "GazeFollowController",
-           "CheckingFollowController", "JointAttentionOptions"]
+           "CheckingFollowController", "SensedFollowController", "JointAttentionOptions"]
