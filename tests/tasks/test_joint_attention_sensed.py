@@ -1,5 +1,5 @@
-"""The sensed follower (``SensedFollowController``, joint attention's third controller): it reads the
-partner's gaze only while its ``faces`` sense sees the partner's face, keeps the toy read while
+"""The sensed follower (``SensedFollowController``, joint attention's third controller): it reads
+the partner's gaze only while its ``faces`` sense sees the partner's face, keeps the toy read while
 the face is out of view, looks back after ``look_back_s``; the demonstrator of the recipe's
 recurrent learner (``bc_kwargs`` ``demonstrator = "sensed"``)."""
 
