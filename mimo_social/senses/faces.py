@@ -141,20 +141,23 @@ class Faces:
     def _unblocked(self, model, data, origin, face, k: int) -> bool:
         """Whether the first geom on the line from ``origin`` to face ``k``'s centre belongs to
         that face (the agent's own head and eyes skipped: the line starts inside them)."""
-        direction = face - origin
         start = origin
         for _ in range(4):      # step past own geoms (the head, each eye) the line starts in
-            body = self._first_body(model, data, start, direction)
+            direction = face - start
+            body, frac = self._first_hit(model, data, start, direction)
             if body is None or body not in self.own_bodies:
                 break
-            start = start + direction * (self._dist + 1e-4)
-            direction = face - start
+            start = start + direction * (frac + 1e-4)
         return body is not None and body in self.face_bodies[k]
 
-    def _first_body(self, model, data, start, direction):
-        self._dist = mujoco.mj_ray(model, data, start, direction, None, 1, -1, self._geomid)
+    def _first_hit(self, model, data, start, direction):
+        """The body of the first geom on the segment ``start`` + t ``direction``, t in [0, 1],
+        and its t (None, -1 when nothing is hit there)."""
+        frac = mujoco.mj_ray(model, data, start, direction, None, 1, -1, self._geomid)
         g = int(self._geomid[0])
-        return None if g < 0 or self._dist > 1.0 + 1e-9 else int(model.geom_bodyid[g])
+        if g < 0 or frac > 1.0 + 1e-9:
+            return None, -1.0
+        return int(model.geom_bodyid[g]), float(frac)
 
     def read(self, model, data) -> np.ndarray:
         out = np.zeros(self.space.shape, np.float32)
