@@ -127,15 +127,18 @@ def test_developmental_delays_follow_the_table_and_shorten_with_age():
     # in control steps of 10 ms: the newborn's eyes lag 26 steps, the 18-month-old's 10
     steps = delay_steps(AgentConfig(age_months=0, delays="developmental"), 0.01)
     assert steps == {"proprioception": 4, "vestibular": 1, "touch": 4, "vision": 26,
-                     "audition": 30, "motor": 2}
+                     "audition": 30, "faces": 29, "motor": 2}
     adult = delay_steps(AgentConfig(body="adult", delays="developmental"), 0.01)
     toddler = delay_steps(AgentConfig(delays="developmental"), 0.01)
     # 18 months = adult rows, but for hearing: the auditory P1 matures into the teens
     assert (adult.pop("audition"), toddler.pop("audition")) == (5, 25)
+    # and for faces: the infant N290 (290 ms) against the adult N170 (170 ms)
+    assert (adult.pop("faces"), toddler.pop("faces")) == (17, 29)
     assert adult == toddler
     env = _env("developmental", touch=False)                            # the published infant
     assert env.delay_steps("infant_0") == {"proprioception": 2, "vestibular": 1, "touch": 2,
-                                           "vision": 10, "audition": 25, "motor": 2}
+                                           "vision": 10, "audition": 25, "faces": 29,
+                                           "motor": 2}
 
 
 def test_milliseconds_round_to_whole_steps():
