@@ -91,28 +91,21 @@ class Faces:
         self.heads = np.array([m.site_bodyid[a.head_site] for a in self.others], dtype=np.intp)
         self.their_cams = np.array([a.eye_cameras for a in self.others], dtype=np.intp)
         # what counts as the face when the line of sight hits it: each partner's head and eyes
-        self.face_bodies = [frozenset([int(m.site_bodyid[a.head_site]),
-                                       *(int(m.cam_bodyid[c]) for c in a.eye_cameras)])
-                            for a in self.others]
+        self.face_bodies = [frozenset([int(h), *(int(m.cam_bodyid[c]) for c in a.eye_cameras)])
+                            for h, a in zip(self.heads, self.others)]
         self.own_bodies = frozenset([self.head_body, *(int(m.cam_bodyid[c]) for c in self.cams)])
-        self.per_face = sum(SIZES[c] for c in config.components)
-        n = len(self.others) * self.per_face
-        low = np.full(n, -np.inf, np.float32)
-        high = np.full(n, np.inf, np.float32)
-        self._slots = {}
-        at = 0
+        self._slots, at = {}, 0
         for c in config.components:
             self._slots[c] = slice(at, at + SIZES[c])
             at += SIZES[c]
-        for f in range(len(self.others)):
-            s = self._slots.get("seen")
-            if s is not None:
-                low[f * self.per_face + s.start], high[f * self.per_face + s.start] = 0.0, 1.0
-            for c in ("head", "gaze"):
-                s = self._slots.get(c)
-                if s is not None:
-                    low[f * self.per_face + s.start:f * self.per_face + s.stop] = -1.0
-                    high[f * self.per_face + s.start:f * self.per_face + s.stop] = 1.0
+        self.per_face = at
+        # one face's bounds (seen in [0, 1], unit vectors in [-1, 1]), repeated per face
+        lo, hi = np.full(at, -np.inf, np.float32), np.full(at, np.inf, np.float32)
+        for c, bound in (("seen", 0.0), ("head", -1.0), ("gaze", -1.0)):
+            if c in self._slots:
+                lo[self._slots[c]], hi[self._slots[c]] = bound, 1.0
+        n = len(self.others) * at
+        low, high = np.tile(lo, len(self.others)), np.tile(hi, len(self.others))
         self.space = spaces.Box(low, high, (n,), np.float32)
         self.spaces = {self.name: self.space}
         self._geomid = np.zeros(1, np.int32)
