@@ -1,5 +1,6 @@
 """Kinematics on the compiled world for tasks and partners: look-at angles of head and eyes,
-inverse kinematics of a site, the geoms of a hand, and an agent's line of sight.
+inverse kinematics of a site and the geoms of a hand (an agent's line of sight:
+:mod:`mimo_social.body.sight`).
 
 :class:`LookAt` is the one computation of the angles that point an agent's head and eyes at a
 world point; :class:`Gaze` (tasks: sets them on the state) and
@@ -16,7 +17,7 @@ import numpy as np
 
 from ..body.joint_groups import GAZE_JOINTS
 
-__all__ = ["LookAt", "Gaze", "gaze_rays", "reach_sites", "hand_geoms", "geoms_collide"]
+__all__ = ["LookAt", "Gaze", "reach_sites", "hand_geoms", "geoms_collide"]
 
 
 class LookAt:
@@ -108,16 +109,6 @@ class Gaze:
         data.qpos[look.qpos] = look(model, data, kind, obj)
         data.qvel[look.dof] = 0.0
         mujoco.mj_kinematics(model, data)
-
-
-def gaze_rays(data, cams) -> tuple[np.ndarray, np.ndarray]:
-    """Lines of sight from eye cameras ``cams`` (shape ``(..., 2)``: each agent's two eyes, e.g.
-    ``AgentSetup.eye_cameras``): the origin between the two eyes and the unit direction along the
-    mean of their viewing axes (a camera looks along its frame's -z), each ``(..., 3)``."""
-    cams = np.asarray(cams, dtype=np.intp)
-    origin = data.cam_xpos[cams].mean(axis=-2)
-    direction = -data.cam_xmat[cams].reshape(*cams.shape, 3, 3)[..., 2].sum(axis=-2)
-    return origin, direction / np.linalg.norm(direction, axis=-1, keepdims=True)
 
 
 def reach_sites(model, data, qpos_adr, dof_adr, lo, hi, site: int, target, iters: int = 60):

@@ -29,7 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.kinematics import gaze_rays, hand_geoms
+from ..body.sight import gaze_rays
+from ..core.kinematics import hand_geoms
 from ..expressions.faces import EXPRESSIONS
 from ..util.names import reject_old_names
 

@@ -38,6 +38,7 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
+from ..body.sight import gaze_rays, in_view
 from ..util.checks import check_bool, check_number
 from .base import SenseEntry, components
 
@@ -112,20 +113,14 @@ class Faces:
 
     def seen(self, model, data) -> np.ndarray:
         """Whether each other agent's face is seen now (module table), shape ``(n_others,)``."""
-        eyes = data.cam_xpos[self.cams]                                          # (2, 3)
-        rot = data.cam_xmat[self.cams].reshape(2, 3, 3)
         faces = data.site_xpos[self.sites]                                       # (k, 3)
-        local = np.einsum("eji,kej->kei", rot, faces[:, None, :] - eyes[None])   # (k, 2, 3)
-        ahead = -local[..., 2]                                 # a camera looks along its -z
-        inside = (ahead > 0) & np.all(np.abs(local[..., :2])
-                                      <= self.half_tan[None, :, None] * ahead[..., None], axis=2)
-        in_view = inside.any(axis=1)
-        origin = eyes.mean(axis=0)
+        seen = in_view(data, self.cams, faces, self.half_tan).any(axis=1)
+        origin = data.cam_xpos[self.cams].mean(axis=0)
         to_me = origin[None] - faces
         forward = data.xmat[self.heads].reshape(-1, 3, 3)[:, :, 0]
         turned = np.einsum("kc,kc->k", forward, to_me) >= (
             self.cos_turn * np.linalg.norm(to_me, axis=1))
-        out = in_view & turned
+        out = seen & turned
         if self.config.occlusion:
             for k in np.flatnonzero(out):
                 out[k] = self._unblocked(model, data, origin, faces[k], k)
@@ -165,10 +160,7 @@ class Faces:
                  "position": (data.site_xpos[self.sites[rows]] - origin) @ head,
                  "head": data.xmat[self.heads[rows]].reshape(-1, 3, 3)[:, :, 0] @ head}
         if "gaze" in self._slots:
-            cams = self.their_cams[rows]
-            gaze = -data.cam_xmat[cams].reshape(len(rows), 2, 3, 3)[..., 2].sum(axis=1)
-            gaze /= np.linalg.norm(gaze, axis=1, keepdims=True)
-            parts["gaze"] = gaze @ head
+            parts["gaze"] = gaze_rays(data, self.their_cams[rows])[1] @ head
         for c, s in self._slots.items():
             block[rows, s] = parts[c]
         return out

@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...core.kinematics import gaze_rays
+from ...body.sight import gaze_rays, in_view
 from ...partners.base import agent_index
 from ...util.checks import check_choice, check_number
 from .controller import GazeFollowController
@@ -101,12 +101,8 @@ class CheckingFollowController(GazeFollowController):
 
     def head_in_view(self, data) -> bool:
         """Whether the partner's head centre is inside one of this follower's eye images."""
-        rel = data.site_xpos[self._head_site] - data.cam_xpos[self._own_cams]     # (2, 3)
-        local = np.einsum("eji,ej->ei", data.cam_xmat[self._own_cams].reshape(-1, 3, 3), rel)
-        ahead = -local[:, 2]                          # a camera looks along its frame's -z
-        inside = (ahead > 0) & np.all(np.abs(local[:, :2]) <= self._half_tan * ahead[:, None],
-                                      axis=1)
-        return bool(np.any(inside))
+        return bool(in_view(data, self._own_cams, data.site_xpos[self._head_site],
+                            self._half_tan).any())
 
     def act(self, env, agent, observation):
         if getattr(self, "_own_cams", None) is None:

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...core.kinematics import gaze_rays
+from ...body.sight import gaze_rays
 from ...util.checks import check_choice, check_number
 from ...partners.base import agent_index, zero_action
 from ...partners.gaze import GazeAtTarget

@@ -10,7 +10,7 @@ from gymnasium import spaces
 
 from ...body.joint_groups import GAZE_JOINTS, held_posture
 from ...body.postures import posture_joints
-from ...core.kinematics import gaze_rays
+from ...body.sight import gaze_rays
 from ...core.task import Plot, Task, TaskOptions
 from ...core.world import AgentSetup, Prop
 from ..common import face_to_face
