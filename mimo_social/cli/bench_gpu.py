@@ -5,6 +5,8 @@ output names (:mod:`mimo_social.bench.gpu`; docs/gpu.md). Needs the ``gpu`` extr
     mimo-social bench gpu                              # 1, 64, 1024, 4096 worlds, 100 steps
     mimo-social bench gpu --worlds 1,64 --steps 20     # what a CPU manages in minutes
     mimo-social bench gpu --with-task                  # the task's logic and resets too
+    mimo-social bench gpu --with-task --reset-bank 4096   # resets from 4096 starts kept
+    mimo-social bench gpu --eyes 64                    # both eyes of each infant, 64x64
 """
 
 from __future__ import annotations
@@ -59,6 +61,12 @@ def add_parser(subparsers, name: str = NAME, **kw) -> argparse.ArgumentParser:
     parser.add_argument("--with-task", action="store_true",
                         help="time the task's logic and the autoresets of finished worlds "
                              "(BatchedTaskEnv) with the physics")
+    parser.add_argument("--reset-bank", type=positive_int, default=None, metavar="K",
+                        help="with --with-task: reset finished worlds from K starts made once "
+                             "and kept (default: a CPU reset per finished world)")
+    parser.add_argument("--eyes", type=positive_int, default=None, metavar="N",
+                        help="render both eyes of each infant on the device each step, N x N "
+                             "pixels (MuJoCo Warp's batch renderer; default: no eyes)")
     parser.add_argument("--no-touch", dest="touch", action="store_false",
                         help="leave the hand skins out (default: read on the device each step)")
     parser.add_argument("--json", default=None, type=output_file, help="write all results here")
@@ -70,9 +78,14 @@ def run(args: argparse.Namespace) -> int:
     from ..bench import gpu
 
     device = None if args.device == "auto" else args.device
+    if args.reset_bank is not None and not args.with_task:
+        print(f"mimo-social bench {NAME}: --reset-bank {args.reset_bank} needs --with-task (the "
+              "resets are the task's)", file=sys.stderr)
+        return 2
     try:
         out = gpu.measure(args.worlds, args.steps, args.warmup, device,
                           with_task=args.with_task, touch=args.touch,
+                          reset_bank=args.reset_bank, eyes=args.eyes,
                           progress=lambda r: print(f"  {r['worlds']} worlds: "
                                                    f"{r['agent_steps_per_s']:.1f} agent-steps/s",
                                                    flush=True))

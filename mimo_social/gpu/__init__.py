@@ -5,15 +5,19 @@ device; with a task's logic, partners and autoreset
 (:class:`~mimo_social.gpu.vector.GymVectorEnv`) or a TorchRL env
 (:class:`~mimo_social.gpu.torchrl_env.TorchRLEnv`, imported on first use: it needs torchrl);
 touch per body part (:class:`~mimo_social.gpu.touch.BatchedTouch`) and the skin's points, the
-learners' ``touch`` (:class:`~mimo_social.gpu.skin.BatchedSkin`).
+learners' ``touch`` (:class:`~mimo_social.gpu.skin.BatchedSkin`); the eyes, MuJoCo Warp's
+batch renderer (:class:`~mimo_social.gpu.eyes.BatchedEyes`); resets from kept starts
+(:class:`~mimo_social.gpu.reset_bank.ResetBank`).
 Needs the ``gpu`` extra; what runs on the device and what does not: docs/gpu.md."""
 
 from .batched import DERIVED_FIELDS, STATE_FIELDS, BatchedEnv
 from .contacts import BatchedContacts
 from .controls import SUPPORTED, AgentControls, check_actuation
 from .device import describe, has_gpu, pick_device, require
+from .eyes import BatchedEyes, BatchedEyeSense
 from .partners import BatchedHandOffer, batched_partner
 from .proprioception import BatchedProprioception
+from .reset_bank import ResetBank
 from .skin import BatchedSkin, BatchedTouchSense
 from .task_env import BatchedTaskEnv
 from .tasks import (TASKS, BatchedFreePlay, BatchedHighFive, BatchedReach, BatchedSelfBody,
@@ -23,12 +27,13 @@ from .vector import GymVectorEnv, device_spaces
 from .vestibular import BatchedVestibular
 
 __all__ = ["BatchedEnv", "BatchedTaskEnv", "GymVectorEnv", "TorchRLEnv", "AgentControls",
-           "BatchedContacts", "BatchedFreePlay", "BatchedHandOffer", "BatchedHighFive",
+           "BatchedContacts", "BatchedEyes", "BatchedEyeSense", "BatchedFreePlay",
+           "BatchedHandOffer", "BatchedHighFive",
            "BatchedProprioception", "BatchedReach", "BatchedSelfBody", "BatchedSkin",
            "BatchedTask", "BatchedTouch", "BatchedTouchSense", "BatchedVestibular",
            "DERIVED_FIELDS", "STATE_FIELDS", "SUPPORTED", "TASKS", "batched_partner",
            "batched_task", "check_actuation", "describe", "device_spaces", "has_gpu",
-           "pick_device", "require"]
+           "pick_device", "require", "ResetBank"]
 
 
 def __getattr__(name):

@@ -17,7 +17,9 @@ state of the CPU env, reset with another seed, into chosen worlds (the task env'
 Touch: every agent's skin on the device (:mod:`mimo_social.gpu.skin`), in the CPU sense's
 layout, where the CPU env has touch on (``touch=False`` leaves it out).
 Muscles: torques in torch before every physics step (:mod:`mimo_social.gpu.muscles`).
-What stays on the CPU (docs/gpu.md): the other senses (vision, audition),
+Eyes: every agent's eye images rendered by MuJoCo Warp's batch renderer
+(:mod:`mimo_social.gpu.eyes`), where the CPU env has vision on (``eyes=False`` leaves them out).
+What stays on the CPU (docs/gpu.md): the other senses (audition, faces),
 expressions and voice (visual and auditory only: the batched actions are the motors). The
 task's logic is not here: :class:`~mimo_social.gpu.task_env.BatchedTaskEnv` adds it (reach,
 high five); a plain :class:`BatchedEnv` restarts every world from the one reset state.
@@ -31,6 +33,7 @@ import numpy as np
 
 from ..core.world import World
 from .controls import AgentControls
+from .eyes import EYES, BatchedEyeSense, BatchedEyes
 from .device import describe, pick_device, require
 from .contacts import BatchedContacts
 from .proprioception import BatchedProprioception
@@ -46,13 +49,13 @@ STATE_FIELDS = ("time", "qpos", "qvel", "act", "history", "qacc_warmstart", "ctr
 #: the fields read each step (as tensors, no copy)
 READ_FIELDS = ("qpos", "qvel", "qacc", "ctrl", "qfrc_actuator", "actuator_force", "qfrc_bias",
                "qfrc_spring", "sensordata", "site_xpos", "xpos", "xmat", "geom_xpos", "geom_xmat",
-               "cdof", "subtree_com")
+               "cdof", "subtree_com", "cam_xpos", "cam_xmat")
 #: the derived fields a world's reset copies from the CPU env beside its state: what the
 #: observations, the partners and the next step read before the physics recomputes them, and
 #: the poses of the geoms fixed to the world (MuJoCo Warp computes those only once, when the
 #: data is made: a task that moves a fixed body at reset, reach's ball, moves them per world)
 DERIVED_FIELDS = ("qacc", "qfrc_actuator", "actuator_force", "qfrc_bias", "qfrc_spring",
-                  "sensordata", "geom_xpos", "geom_xmat")
+                  "sensordata", "geom_xpos", "geom_xmat", "cam_xpos", "cam_xmat")
 
 
 class BatchedEnv:
@@ -67,15 +70,18 @@ class BatchedEnv:
     them is put back to the reset state and flagged in the step's ``unstable``. ``touch``:
     the agents' touch skins on the device (:mod:`mimo_social.gpu.skin`: the ``touch``
     observation of every agent that has touch in ``env``), or False to leave touch out.
+    ``eyes``: the agents' eye images rendered on the device (:mod:`mimo_social.gpu.eyes`:
+    ``eye_left`` / ``eye_right`` of every agent that has vision in ``env``), or False.
     """
 
     def __init__(self, env, nworld: int, device: str | None = None, seed: int | None = 0,
                  nconmax: int | None = None, njmax: int | None = None,
-                 batch_fields: tuple[str, ...] = (), touch: bool = True):
+                 batch_fields: tuple[str, ...] = (), touch: bool = True, eyes: bool = True):
         wp, mjw, torch = require()
-        if not isinstance(touch, bool):
-            raise ValueError(f"touch={touch!r} not allowed; allowed: True (the agents' touch "
-                             f"skins on the device, where the CPU env has them) or False")
+        for key, value, what in (("touch", touch, "touch skins"), ("eyes", eyes, "eye images")):
+            if not isinstance(value, bool):
+                raise ValueError(f"{key}={value!r} not allowed; allowed: True (the agents' "
+                                 f"{what} on the device, where the CPU env has them) or False")
         if isinstance(nworld, bool) or not isinstance(nworld, (int, np.integer)) or nworld < 1:
             raise ValueError(f"nworld={nworld!r} not allowed; allowed: an integer >= 1")
         self.nworld = int(nworld)
@@ -111,6 +117,11 @@ class BatchedEnv:
         #: the agents' skins on the device (None: no agent has touch, or ``touch=False``)
         self.skin = None if system is None else BatchedSkin(system, mjm, self.nworld, torch,
                                                             tdev)
+        vision = env.systems.get("vision") if eyes else None
+        #: the agents' eyes on the device (None: no agent has vision, or ``eyes=False``)
+        self.eyes = None if vision is None else BatchedEyes(
+            vision, mjm, self.model, self.data, self.nworld, dict(enumerate(self.agents)), wp,
+            mjw, torch, tdev, self._on_device)
         self.controls, self.senses = [], []
         for i, name in enumerate(self.agents):
             act = env.actuation[i]
@@ -129,6 +140,9 @@ class BatchedEnv:
                 elif s.name == "touch" and self.skin is not None:
                     senses.append(BatchedTouchSense(self.skin, s, delays["touch"], self.nworld,
                                                     torch, tdev))
+                elif s.name == "vision" and self.eyes is not None:
+                    senses.extend(BatchedEyeSense(self.eyes, i, e, delays["vision"], self.nworld,
+                                                  torch, tdev) for e in EYES)
             self.senses.append(senses)
         self._graph = None
         #: muscles update before every physics step (torch): no CUDA graph then
@@ -166,6 +180,8 @@ class BatchedEnv:
             self.skin.reset(None if worlds is None else mask)
         with self._on_device():
             self._mjw.forward(self.model, self.data)
+        if self.eyes is not None:
+            self.eyes.render(None if worlds is None else mask)
         if worlds is None:
             self.steps = 0
         return self._reset_obs(None if worlds is None else mask)
@@ -228,6 +244,8 @@ class BatchedEnv:
                                np.stack([s["muscles"][i][1] for s in snaps]))
         if self.skin is not None:
             self.skin.load(idx, np.stack([s["touch"] for s in snaps]))
+        if self.eyes is not None:
+            self.eyes.render(mask)
         return self._reset_obs(mask)
 
     def step(self, actions, reset_unstable: bool = True) -> tuple[dict, object]:
@@ -250,6 +268,8 @@ class BatchedEnv:
         unstable = self._unstable()
         if self.skin is not None:
             self.skin.feel(contact_rows(self), self.tensors)
+        if self.eyes is not None:
+            self.eyes.render()
         obs = {a: {s.name: s.observe(self.tensors) for s in senses}
                for a, senses in zip(self.agents, self.senses)}
         if reset_unstable and bool(unstable.any()):

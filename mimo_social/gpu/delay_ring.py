@@ -8,12 +8,13 @@ __all__ = ["DelayRing"]
 
 
 class DelayRing:
-    """``delay`` control steps of ``(nworld, size)`` float32 readings on ``device``."""
+    """``delay`` control steps of ``(nworld, size)`` readings on ``device`` (``dtype``: torch's
+    float32 unless given, e.g. uint8 for images)."""
 
-    def __init__(self, delay: int, nworld: int, size: int, torch, device):
+    def __init__(self, delay: int, nworld: int, size: int, torch, device, dtype=None):
         self.delay = int(delay)
-        self.ring = torch.zeros((self.delay + 1, nworld, size), dtype=torch.float32,
-                                device=device)
+        self.ring = torch.zeros((self.delay + 1, nworld, size),
+                                dtype=torch.float32 if dtype is None else dtype, device=device)
         self._next = 0
 
     def reset(self, reading, worlds=None):

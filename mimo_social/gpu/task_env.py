@@ -14,6 +14,13 @@ state and the draws of the task's reset (reach: the ball, the head and eyes on i
 the arms' start postures; the partner's targets and gains) copied into the world. That is host
 work (a CPU reset per finished world: about 1 to 5 ms each), and the step that resets worlds
 waits for the device to say which; the steps between resets stay on the device.
+
+With ``reset_bank=K`` the ``K`` CPU resets of seeds ``seed`` .. ``seed + K - 1`` are made
+once (at construction and at ``reset(seed=...)``) and kept: the episode that would take seed
+``seed + n`` takes the kept start ``n mod K`` (:meth:`BatchedTaskEnv.seed_of` names it). No
+CPU env is reset while stepping; while fewer than ``K`` episodes have started the episodes are
+those of host resets, after that the starts repeat (``K`` distinct starts in all). The kept
+rows still go from the host to the device at each reset.
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..util.checks import check_int, check_seed
+from .reset_bank import ResetBank
 from .batched import BatchedEnv
 from .partners import batched_partner
 from .tasks import task_class
@@ -31,15 +39,19 @@ __all__ = ["BatchedTaskEnv"]
 class BatchedTaskEnv:
     """``nworld`` worlds of ``env``'s task on the Warp device ``device`` (None: a GPU when
     there is one, else the CPU). ``seed``: the first episodes' seeds (see the module); ``nconmax``
-    / ``njmax``: :class:`BatchedEnv`'s. ``learners``: the agents whose actions :meth:`step`
-    takes; ``partners``: the scripted ones (batched)."""
+    / ``njmax``: :class:`BatchedEnv`'s. ``reset_bank``: None (a CPU reset per finished world)
+    or the number of starts made once and kept (module docstring). ``learners``: the agents
+    whose actions :meth:`step` takes; ``partners``: the scripted ones (batched)."""
 
     def __init__(self, env, nworld: int, device: str | None = None, seed: int = 0,
-                 nconmax: int | None = None, njmax: int | None = None, touch: bool = True):
+                 nconmax: int | None = None, njmax: int | None = None, touch: bool = True,
+                 reset_bank: int | None = None):
         inner = env.unwrapped
         scripted = dict(getattr(env, "partners", {}) or {})
         self.env, self.inner = env, inner
         seed = check_int("BatchedTaskEnv", "seed", seed, 0)
+        if reset_bank is not None:
+            reset_bank = check_int("BatchedTaskEnv", "reset_bank", reset_bank, 1, 10 ** 7)
         task = task_class(inner.task.name)   # before the model goes to the device
         env.reset(seed=seed)
         self.batched = BatchedEnv(inner, nworld, device=device, seed=None, nconmax=nconmax,
@@ -59,11 +71,15 @@ class BatchedTaskEnv:
         self._seed = seed
         self._episode = np.zeros(self.nworld, np.int64)
         self._was_reset = False
+        self.bank = None if reset_bank is None else ResetBank(reset_bank, self._capture)
+        if self.bank is not None:
+            self.bank.fill(seed)
 
     # -- resets ----------------------------------------------------------------------------------
     def seed_of(self, world: int) -> int:
-        """The seed of ``world``'s current episode."""
-        return self._seed + int(world) + int(self._episode[world]) * self.nworld
+        """The seed of ``world``'s current episode (with a reset bank: of the kept start)."""
+        n = int(world) + int(self._episode[world]) * self.nworld
+        return self._seed + (n if self.bank is None else n % self.bank.size)
 
     def reset(self, seed: int | None = None, worlds=None):
         """Reset the worlds ``worlds`` (indices or a bool mask; None: all) with their seeds'
@@ -75,6 +91,8 @@ class BatchedTaskEnv:
                 raise ValueError("reset(seed=...) resets every world; give worlds=None")
             self._seed = check_seed(seed, "BatchedTaskEnv.reset")
             self._episode[:] = 0
+            if self.bank is not None:
+                self.bank.fill(self._seed)
         elif self._was_reset and worlds is None:
             self._episode += 1
         idx = np.arange(self.nworld) if worlds is None else self._indices(worlds)
@@ -95,15 +113,19 @@ class BatchedTaskEnv:
                              f"{self.nworld - 1}")
         return w
 
+    def _capture(self, seed: int) -> tuple:
+        """The CPU env reset with ``seed``: its snapshot, the task's and each partner's draws."""
+        self.env.reset(seed=seed)
+        return (self.batched.snapshot(self.inner), self.task.capture(self.inner),
+                {a: p.capture(self.inner) for a, p in self.partners.items()})
+
     def _load(self, idx: np.ndarray) -> dict:
-        """The CPU env reset with each world's seed, copied into the world (host work)."""
-        snaps, task_caps, partner_caps = [], [], {a: [] for a in self.partners}
-        for w in idx.tolist():
-            self.env.reset(seed=self.seed_of(w))
-            snaps.append(self.batched.snapshot(self.inner))
-            task_caps.append(self.task.capture(self.inner))
-            for a, p in self.partners.items():
-                partner_caps[a].append(p.capture(self.inner))
+        """Each world's start (its seed's CPU reset, or the kept one) copied into the world."""
+        starts = [self.bank.start(self.seed_of(w) - self._seed) if self.bank is not None
+                  else self._capture(self.seed_of(w)) for w in idx.tolist()]
+        snaps = [s[0] for s in starts]
+        task_caps = [s[1] for s in starts]
+        partner_caps = {a: [s[2][a] for s in starts] for a in self.partners}
         obs = self.batched.load(idx, snaps)
         tidx = self.torch.as_tensor(idx, dtype=self.torch.int64, device=self.steps.device)
         if len(idx):

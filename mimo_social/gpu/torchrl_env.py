@@ -32,16 +32,27 @@ from .vector import device_spaces
 __all__ = ["TorchRLEnv"]
 
 
+def _obs_spec(space, lead: tuple, device):
+    """One observation key's spec: images (uint8 Boxes) bounded 0..255 as uint8, the rest
+    unbounded float32."""
+    shape = lead + space.shape
+    if space.dtype == np.uint8:
+        return Bounded(low=0, high=255, shape=shape, dtype=torch.uint8, device=device)
+    return Unbounded(shape=shape, dtype=torch.float32, device=device)
+
+
 class TorchRLEnv(EnvBase):
     """``num_envs`` worlds of ``env`` (a CPU env of the catalogue: the ParallelEnv, every agent
     learning, or a one-learner form) on the Warp device ``device``; ``seed``: the first
-    episodes' seeds (:class:`BatchedTaskEnv`); ``group``: the learners' group name."""
+    episodes' seeds and ``reset_bank`` (:class:`BatchedTaskEnv`); ``group``: the learners'
+    group name."""
 
     def __init__(self, env, num_envs: int, device: str | None = None, seed: int = 0,
                  group: str = "agents", nconmax: int | None = None, njmax: int | None = None,
-                 touch: bool = True):
+                 touch: bool = True, reset_bank: int | None = None):
         tenv = BatchedTaskEnv(env, num_envs, device=device, seed=seed, nconmax=nconmax,
-                              njmax=njmax, touch=touch)
+                              njmax=njmax, touch=touch,
+                              reset_bank=reset_bank)
         if not isinstance(group, str) or not group:
             raise ValueError(f"group={group!r} not allowed; allowed: a non-empty string")
         dev = tenv.batched.qpos.device
@@ -61,9 +72,8 @@ class TorchRLEnv(EnvBase):
         n, k = tenv.nworld, len(self.learners)
         obs_space, act_space = first
         self._keys = list(obs_space.spaces)
-        obs = Composite({key: Unbounded(shape=(n, k) + sp.shape, dtype=torch.float32,
-                                        device=dev) for key, sp in obs_space.spaces.items()},
-                        shape=(n, k), device=dev)
+        obs = Composite({key: _obs_spec(sp, (n, k), dev)
+                         for key, sp in obs_space.spaces.items()}, shape=(n, k), device=dev)
         inner = Composite({"observation": obs}, shape=(n, k), device=dev)
         self.observation_spec = Composite({group: inner}, shape=(n,), device=dev)
         shape = (n, k) + act_space.shape

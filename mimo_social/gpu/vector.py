@@ -49,20 +49,21 @@ class GymVectorEnv(VectorEnv):
     a social task's ``scripted_env()``) on the Warp device ``device``; ``seed``: the first
     episodes' seeds (world ``w``: ``seed + w``, :class:`BatchedTaskEnv`); ``numpy``: hand out
     numpy arrays instead of torch tensors; ``nconmax`` / ``njmax`` / ``touch``:
-    :class:`BatchedEnv`'s."""
+    :class:`BatchedEnv`'s; ``reset_bank``: :class:`BatchedTaskEnv`'s."""
 
     metadata = {"autoreset_mode": AutoresetMode.SAME_STEP, "render_modes": []}
 
     def __init__(self, env, num_envs: int, device: str | None = None, seed: int = 0,
                  numpy: bool = False, nconmax: int | None = None, njmax: int | None = None,
-                 touch: bool = True):
+                 touch: bool = True, reset_bank: int | None = None):
         learners = list(env.possible_agents)
         if len(learners) != 1:
             raise ValueError(f"GymVectorEnv takes one learner; this env has {learners}: give "
                              f"the task's one-learner form (e.g. high_five_v0.scripted_env()), "
                              f"or use TorchRLEnv for several learners")
         self.tenv = BatchedTaskEnv(env, num_envs, device=device, seed=seed, nconmax=nconmax,
-                                   njmax=njmax, touch=touch)
+                                   njmax=njmax, touch=touch,
+                                   reset_bank=reset_bank)
         self.agent = self.tenv.learners[0]
         self.num_envs = self.tenv.nworld
         self.numpy = bool(numpy)
