@@ -6,7 +6,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from mimo_social.core.kinematics import LookAt, gaze_rays
+from mimo_social.body.sight import gaze_rays
+from mimo_social.core.kinematics import LookAt
 from mimo_social.envs import joint_attention_v0
 
 
