@@ -8,20 +8,72 @@ After each control step's physics the cameras' poses are brought up to the state
 (``camlight``), the renderer's bounding volumes refitted to the geoms' poses (``refit_bvh``) and
 every eye of every world rendered in one launch; at a reset, the reset worlds' images are
 rendered from their new state. The images are the CPU's view of the scene with the renderer's
-shading, not its pixels: docs/gpu.md measures the difference. What the device does not render
-is refused with a ValueError naming the agent and the setting: ``acuity`` blur, ``fovea``,
+shading, not its pixels: docs/gpu.md measures the difference. The faces: the renderer maps a
+sphere's texture as a flat longitude-latitude image, while the heads carry cube textures (the
+face on the +x side, :mod:`mimo_social.expressions.switch`), so the renderer is given a copy of
+the model whose cube textures are resampled to longitude-latitude images
+(:func:`ray_traced_textures`); the expression the model shows at build is the one seen (the
+batched actions are the motors: no expression changes on the device). What the device does not
+render is refused with a ValueError naming the agent and the setting: ``acuity`` blur, ``fovea``,
 ``depth`` images, and ``every`` other than 1.
 """
 
 from __future__ import annotations
 
+import copy
+
+import mujoco
+import numpy as np
 
 from .delay_ring import DelayRing
 
-__all__ = ["BatchedEyes", "BatchedEyeSense", "EYES"]
+__all__ = ["BatchedEyes", "BatchedEyeSense", "EYES", "ray_traced_textures"]
 
 #: the eyes, in the CPU sense's order of keys
 EYES = ("left", "right")
+
+
+def _longitude_latitude(cube: np.ndarray, width: int, height: int) -> np.ndarray:
+    """A cube texture (six ``n`` x ``n`` sides stacked, MuJoCo's order +x, -x, +y, -y, +z, -z)
+    as the ``height`` x ``width`` longitude-latitude image the renderer maps onto a sphere
+    (column: the azimuth from +x towards +y, row 0: straight up). The +x side is sampled where
+    the line of sight meets it (direction ``(1, u, v)`` at the side's ``(u, v)``, its stored
+    image turned as MuJoCo shows it: checked against the CPU's images with an asymmetric
+    mark); the other sides, plain skin on the faces, in their mean colour."""
+    n = cube.shape[1]
+    sides = cube.reshape(6, n, n, -1)
+    front = np.rot90(sides[0], 3)
+    az = 2.0 * np.pi * (np.arange(width) + 0.5) / width
+    el = np.pi * (0.5 - (np.arange(height) + 0.5) / height)
+    d = np.stack(np.broadcast_arrays(np.cos(el)[:, None] * np.cos(az)[None],
+                                     np.cos(el)[:, None] * np.sin(az)[None],
+                                     np.sin(el)[:, None] * np.ones_like(az)[None]), axis=-1)
+    big = np.argmax(np.abs(d), axis=-1) * 2 + (np.take_along_axis(
+        d, np.argmax(np.abs(d), axis=-1)[..., None], -1)[..., 0] < 0)    # the side: 0..5
+    out = sides.reshape(6, n * n, -1).mean(axis=1).round().astype(cube.dtype)[big]
+    on = big == 0
+    u, v = d[on, 1] / d[on, 0], d[on, 2] / d[on, 0]
+    col = np.clip(((u + 1.0) / 2.0 * n).astype(int), 0, n - 1)
+    row = np.clip(((1.0 - v) / 2.0 * n).astype(int), 0, n - 1)
+    out[on] = front[row, col]
+    return out
+
+
+def ray_traced_textures(mjm):
+    """A copy of the compiled model ``mjm`` for the batch renderer: every cube texture as a
+    longitude-latitude image of the same bytes (width 3n, height 2n; the renderer samples a
+    sphere's texture so); the other textures unchanged."""
+    out = copy.deepcopy(mjm)
+    for t in np.flatnonzero(mjm.tex_type == mujoco.mjtTexture.mjTEXTURE_CUBE):
+        n, nc, adr = int(mjm.tex_width[t]), int(mjm.tex_nchannel[t]), int(mjm.tex_adr[t])
+        if adr < 0 or int(mjm.tex_height[t]) != 6 * n:
+            continue                 # a texture by reference, or not six sides stacked
+        cube = mjm.tex_data[adr:adr + 6 * n * n * nc].reshape(6 * n, n, nc)
+        image = _longitude_latitude(cube, 3 * n, 2 * n)
+        out.tex_type[t] = mujoco.mjtTexture.mjTEXTURE_2D
+        out.tex_width[t], out.tex_height[t] = 3 * n, 2 * n
+        out.tex_data[adr:adr + image.size] = image.ravel()
+    return out
 
 
 def _check(name: str, cfg, cutoff) -> None:
@@ -55,9 +107,9 @@ class BatchedEyes:
                 cams.append(int(system.cameras[i][e]))
                 res.append((int(cfg.width), int(cfg.height)))
         with on_device():
-            self.rc = mjw.create_render_context(mjm, nworld, cam_res=res, render_rgb=True,
-                                                render_depth=False, render_seg=False,
-                                                cam_active=cams)
+            self.rc = mjw.create_render_context(ray_traced_textures(mjm), nworld, cam_res=res,
+                                                render_rgb=True, render_depth=False,
+                                                render_seg=False, cam_active=cams)
         adr = self.rc.rgb_adr.numpy()
         self._packed = wp.to_torch(self.rc.rgb_data)                    # (nworld, pixels) uint32
         #: per agent and eye: (first pixel, height, width) in the packed rows

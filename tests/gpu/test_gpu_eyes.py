@@ -67,7 +67,7 @@ def test_the_eyes_are_observed_in_the_cpu_layout(pair):
 
 def test_each_eye_sees_what_the_cpu_eye_sees_at_reset_and_after_steps(pair):
     """Both infants' eyes at reset and after 10 steps of the same actions: within 25 of 255 on
-    average (measured 15-18: the renderer's shading) and correlated above 0.9 (0.94); an eye's
+    average (measured 17-19: the renderer's shading) and correlated above 0.9 (0.95); an eye's
     image is more like its own CPU eye's than the other infant's (a like view of a like scene:
     0.86)."""
     b, cpu = pair
@@ -177,3 +177,48 @@ def test_the_vector_envs_hand_out_the_eyes():
     spec = env.observation_spec["agents", "observation", "eye_left"]
     assert spec.dtype == env.tenv.torch.uint8 and spec.shape == (2, 2, 12, 16, 3)
     check_env_specs(env)
+
+
+def test_the_cube_face_textures_become_longitude_latitude_images():
+    """The renderer's copy of the model: each face texture (six sides stacked) as a 3n x 2n
+    longitude-latitude image of the same bytes: straight ahead (+x) the front side's centre,
+    behind the head plain skin; the floor's 2D texture and the model given are unchanged."""
+    import mujoco
+
+    from mimo_social.expressions.faces import SKIN_RGB
+    from mimo_social.gpu.eyes import ray_traced_textures
+    m = _make().unwrapped.world.model
+    before = m.tex_data.copy()
+    r = ray_traced_textures(m)
+    np.testing.assert_array_equal(m.tex_data, before)
+    cube = np.flatnonzero(m.tex_type == mujoco.mjtTexture.mjTEXTURE_CUBE)
+    assert len(cube) == 7 and (r.tex_type[cube] == mujoco.mjtTexture.mjTEXTURE_2D).all()
+    for t in range(m.ntex):
+        n, adr = int(m.tex_width[t]), int(m.tex_adr[t])
+        if t not in cube:
+            assert r.tex_width[t] == n and r.tex_type[t] == m.tex_type[t]
+            continue
+        w, h = int(r.tex_width[t]), int(r.tex_height[t])
+        assert (w, h) == (3 * n, 2 * n)
+        img = r.tex_data[adr:adr + w * h * 3].reshape(h, w, 3)
+        front = m.tex_data[adr:adr + n * n * 3].reshape(n, n, 3)
+        ahead = img[h // 2, 0].astype(int)             # azimuth 0 (+x), elevation 0
+        assert np.abs(ahead - front[n // 2, n // 2]).max() <= 40
+        np.testing.assert_array_equal(img[h // 2, w // 2], SKIN_RGB)    # behind the head
+
+
+def test_the_faces_features_are_rendered():
+    """Zoomed in on the partner's face (20 degree eyes): with the textures resampled the face
+    region shows its features (brows, eyes' outlines, mouth); rendered from the cube textures
+    as they are, the renderer shows a plain head. The two images differ in the face."""
+    import mimo_social.gpu.eyes as eyes_module
+    zoom = {"width": 48, "height": 48, "field_of_view": 20}
+    got = BatchedEnv(_make(vision=zoom), 1, device="cpu").reset()["infant_0"]["eye_left"][0]
+    real = eyes_module.ray_traced_textures
+    try:
+        eyes_module.ray_traced_textures = lambda m: m
+        plain = BatchedEnv(_make(vision=zoom), 1, device="cpu").reset()["infant_0"]["eye_left"][0]
+    finally:
+        eyes_module.ray_traced_textures = real
+    diff = np.abs(got.numpy().astype(int) - plain.numpy()).max(axis=-1)
+    assert (diff > 40).sum() > 30, (diff > 40).sum()
