@@ -33,7 +33,9 @@ state:
 
 It acts only through the agent's own motors (no ``qpos`` writes) and reads what it needs from the
 world (it imports no task). Measured (seeds 0-19, random targets): 20 of 20 episodes, mean return
-334.4; the table of :mod:`mimo_social.tasks.selfbody` has the command.
+330.0 (313.4 on another machine: the plans are chosen by rollouts with contacts, whose floating
+point differs between CPUs, so a start can get another plan there; one machine always gives one
+plan); the table of :mod:`mimo_social.tasks.selfbody` has the command.
 """
 
 from __future__ import annotations
