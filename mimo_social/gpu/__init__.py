@@ -6,7 +6,8 @@ device; with a task's logic, partners and autoreset
 (:class:`~mimo_social.gpu.torchrl_env.TorchRLEnv`, imported on first use: it needs torchrl);
 touch per body part (:class:`~mimo_social.gpu.touch.BatchedTouch`) and the skin's points, the
 learners' ``touch`` (:class:`~mimo_social.gpu.skin.BatchedSkin`); the eyes, MuJoCo Warp's
-batch renderer (:class:`~mimo_social.gpu.eyes.BatchedEyes`); resets from kept starts
+batch renderer (:class:`~mimo_social.gpu.eyes.BatchedEyes`) and the expressions they see
+(:class:`~mimo_social.gpu.faces.BatchedFaces`); resets from kept starts
 (:class:`~mimo_social.gpu.reset_bank.ResetBank`).
 Needs the ``gpu`` extra; what runs on the device and what does not: docs/gpu.md."""
 
@@ -15,6 +16,7 @@ from .contacts import BatchedContacts
 from .controls import SUPPORTED, AgentControls, check_actuation
 from .device import describe, has_gpu, pick_device, require
 from .eyes import BatchedEyes, BatchedEyeSense
+from .faces import BatchedFaces
 from .partners import BatchedHandOffer, batched_partner
 from .proprioception import BatchedProprioception
 from .reset_bank import ResetBank
@@ -27,7 +29,7 @@ from .vector import GymVectorEnv, device_spaces
 from .vestibular import BatchedVestibular
 
 __all__ = ["BatchedEnv", "BatchedTaskEnv", "GymVectorEnv", "TorchRLEnv", "AgentControls",
-           "BatchedContacts", "BatchedEyes", "BatchedEyeSense", "BatchedFreePlay",
+           "BatchedContacts", "BatchedEyes", "BatchedEyeSense", "BatchedFaces", "BatchedFreePlay",
            "BatchedHandOffer", "BatchedHighFive",
            "BatchedProprioception", "BatchedReach", "BatchedSelfBody", "BatchedSkin",
            "BatchedTask", "BatchedTouch", "BatchedTouchSense", "BatchedVestibular",

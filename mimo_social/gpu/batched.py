@@ -34,6 +34,7 @@ import numpy as np
 from ..core.world import World
 from .controls import AgentControls
 from .eyes import EYES, BatchedEyeSense, BatchedEyes
+from .faces import BatchedFaces
 from .device import describe, pick_device, require
 from .contacts import BatchedContacts
 from .proprioception import BatchedProprioception
@@ -97,6 +98,11 @@ class BatchedEnv:
         env.reset(seed=seed)
         mjm, mjd = env.world.model, env.world.data
         self.nconmax, self.njmax = self._sizes(mjm, mjd, len(self.agents), nconmax, njmax)
+        vision = env.systems.get("vision") if eyes else None
+        acting = any(hasattr(env.action_space(a), "spaces")
+                     and "expression" in env.action_space(a).spaces for a in self.agents)
+        if vision is not None and acting and "mat_texid" not in batch_fields:
+            batch_fields = tuple(batch_fields) + ("mat_texid",)   # each world's faces drawn
         with wp.ScopedDevice(self.device):
             self.model = mjw.put_model(mjm, {f: self.nworld for f in batch_fields})
             self.data = mjw.put_data(mjm, mjd, nworld=self.nworld, nconmax=self.nconmax,
@@ -117,7 +123,8 @@ class BatchedEnv:
         #: the agents' skins on the device (None: no agent has touch, or ``touch=False``)
         self.skin = None if system is None else BatchedSkin(system, mjm, self.nworld, torch,
                                                             tdev)
-        vision = env.systems.get("vision") if eyes else None
+        #: every agent's expression in every world (drawn on the faces where eyes render)
+        self.faces = BatchedFaces(env, self.nworld, torch, tdev, self.model_tensors.get("mat_texid"))
         #: the agents' eyes on the device (None: no agent has vision, or ``eyes=False``)
         self.eyes = None if vision is None else BatchedEyes(
             vision, mjm, self.model, self.data, self.nworld, dict(enumerate(self.agents)), wp,
@@ -134,7 +141,8 @@ class BatchedEnv:
             for s in env.senses[i]:
                 if s.name == "proprioception":
                     senses.append(BatchedProprioception(s, delays["proprioception"], c,
-                                                        self.nworld, torch, tdev))
+                                                        self.nworld, torch, tdev,
+                                                        face=self._face_reader(i)))
                 elif s.name == "vestibular":
                     senses.append(BatchedVestibular(s, torch, tdev))
                 elif s.name == "touch" and self.skin is not None:
@@ -178,6 +186,7 @@ class BatchedEnv:
             c.reset(None if worlds is None else mask)
         if self.skin is not None:
             self.skin.reset(None if worlds is None else mask)
+        self.faces.reset(None if worlds is None else mask)
         with self._on_device():
             self._mjw.forward(self.model, self.data)
         if self.eyes is not None:
@@ -185,6 +194,10 @@ class BatchedEnv:
         if worlds is None:
             self.steps = 0
         return self._reset_obs(None if worlds is None else mask)
+
+    def _face_reader(self, i: int):
+        """Agent ``i``'s expression one-hot, read when its proprioception asks."""
+        return lambda: self.faces.one_hot(i)
 
     def _mask(self, worlds):
         torch, dev = self._torch, self.tensors["qpos"].device
@@ -214,6 +227,7 @@ class BatchedEnv:
                            for act, c in zip(env.actuation, self.controls)]
         if self.skin is not None:
             snap["touch"] = BatchedSkin.reading(env.system("touch"))
+        snap["expressions"] = BatchedFaces.shown(env)
         return snap
 
     def load(self, worlds, snaps) -> dict:
@@ -244,13 +258,17 @@ class BatchedEnv:
                                np.stack([s["muscles"][i][1] for s in snaps]))
         if self.skin is not None:
             self.skin.load(idx, np.stack([s["touch"] for s in snaps]))
+        self.faces.reset(mask, [s["expressions"] for s in snaps])
         if self.eyes is not None:
             self.eyes.render(mask)
         return self._reset_obs(mask)
 
-    def step(self, actions, reset_unstable: bool = True) -> tuple[dict, object]:
+    def step(self, actions, reset_unstable: bool = True,
+             expressions: dict | None = None) -> tuple[dict, object]:
         """One control step of every world. ``actions``: agent -> ``(nworld, n_controls)``
-        motor values (torch or numpy; each agent's motor Box, clipped into it). Returns the
+        motor values (torch or numpy; each agent's motor Box, clipped into it);
+        ``expressions``: agent -> ``(nworld,)`` expression ids for agents whose actions carry
+        an expression (:class:`~mimo_social.gpu.faces.BatchedFaces`; None: unchanged). Returns the
         observations (agent -> sense -> ``(nworld, size)``) and ``unstable``, a bool tensor of
         the worlds that diverged (put back to the reset state unless ``reset_unstable`` is
         False: then the caller resets them)."""
@@ -259,6 +277,8 @@ class BatchedEnv:
                              f"agent of {self.agents}; got "
                              f"{sorted(actions) if hasattr(actions, 'keys') else type(actions)}")
         checked = [c.check(actions[a]) for a, c in zip(self.agents, self.controls)]
+        if expressions:
+            self.faces.set(expressions)
         ctrl = self.tensors["ctrl"]
         for c, u in zip(self.controls, checked):
             c.step(u, ctrl)

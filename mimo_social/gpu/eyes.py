@@ -12,9 +12,9 @@ shading, not its pixels: docs/gpu.md measures the difference. The faces: the ren
 sphere's texture as a flat longitude-latitude image, while the heads carry cube textures (the
 face on the +x side, :mod:`mimo_social.expressions.switch`), so the renderer is given a copy of
 the model whose cube textures are resampled to longitude-latitude images
-(:func:`ray_traced_textures`); the expression the model shows at build is the one seen (the
-batched actions are the motors: no expression changes on the device). What the device does not
-render is refused with a ValueError naming the agent and the setting: ``acuity`` blur, ``fovea``,
+(:func:`ray_traced_textures`); each world's expressions are drawn by
+:class:`~mimo_social.gpu.faces.BatchedFaces` (the head materials' texture per world). What the
+device does not render is refused with a ValueError naming the agent and the setting: ``acuity`` blur, ``fovea``,
 ``depth`` images, and ``every`` other than 1.
 """
 
@@ -33,13 +33,21 @@ __all__ = ["BatchedEyes", "BatchedEyeSense", "EYES", "ray_traced_textures"]
 EYES = ("left", "right")
 
 
+#: the front side's coordinates are the line of sight's ``(u, v)`` times this: fitted to the
+#: CPU's images, not derived from MuJoCo's mapping (zoomed on a partner's face, the change each
+#: expression makes to the image correlates 0.66-0.84 between the device and the CPU with it,
+#: -0.15 to 0.25 with 1: tests/gpu/test_gpu_faces.py)
+FRONT_SCALE = float(np.sqrt(1.5))
+
+
 def _longitude_latitude(cube: np.ndarray, width: int, height: int) -> np.ndarray:
     """A cube texture (six ``n`` x ``n`` sides stacked, MuJoCo's order +x, -x, +y, -y, +z, -z)
     as the ``height`` x ``width`` longitude-latitude image the renderer maps onto a sphere
     (column: the azimuth from +x towards +y, row 0: straight up). The +x side is sampled where
-    the line of sight meets it (direction ``(1, u, v)`` at the side's ``(u, v)``, its stored
-    image turned as MuJoCo shows it: checked against the CPU's images with an asymmetric
-    mark); the other sides, plain skin on the faces, in their mean colour."""
+    the line of sight meets it, the direction ``(1, u, v)`` at the side's ``(u, v)`` times
+    :data:`FRONT_SCALE`, its stored image turned as MuJoCo shows it (checked against the CPU's
+    images with an asymmetric mark); the other sides, plain skin on the faces, in their mean
+    colour."""
     n = cube.shape[1]
     sides = cube.reshape(6, n, n, -1)
     front = np.rot90(sides[0], 3)
@@ -52,7 +60,7 @@ def _longitude_latitude(cube: np.ndarray, width: int, height: int) -> np.ndarray
         d, np.argmax(np.abs(d), axis=-1)[..., None], -1)[..., 0] < 0)    # the side: 0..5
     out = sides.reshape(6, n * n, -1).mean(axis=1).round().astype(cube.dtype)[big]
     on = big == 0
-    u, v = d[on, 1] / d[on, 0], d[on, 2] / d[on, 0]
+    u, v = FRONT_SCALE * d[on, 1] / d[on, 0], FRONT_SCALE * d[on, 2] / d[on, 0]
     col = np.clip(((u + 1.0) / 2.0 * n).astype(int), 0, n - 1)
     row = np.clip(((1.0 - v) / 2.0 * n).astype(int), 0, n - 1)
     out[on] = front[row, col]

@@ -27,8 +27,9 @@ class BatchedProprioception:
 
     name = "proprioception"
 
-    def __init__(self, sense, delay: int, controls, nworld: int, torch, device):
+    def __init__(self, sense, delay: int, controls, nworld: int, torch, device, face=None):
         self._torch = torch
+        self._face = face     # () -> (nworld, 7) one-hot of the agent's expression
         self.controls = controls
         self.slices = dict(sense.slices)
         self.size = max(s.stop for s in self.slices.values())
@@ -67,6 +68,8 @@ class BatchedProprioception:
             elif c == "limits":
                 s = q * self.inv_margin
                 out[:, sl] = t.clamp(self.upper + s, min=0.0) - t.clamp(self.lower - s, min=0.0)
+            elif c == "face":
+                out[:, sl] = self._face()
             else:
                 out[:, sl] = self.controls.observation(data)
         return out

@@ -136,9 +136,10 @@ class BatchedTaskEnv:
         return obs
 
     # -- the loop --------------------------------------------------------------------------------
-    def step(self, actions, autoreset: bool = True):
+    def step(self, actions, autoreset: bool = True, expressions: dict | None = None):
         """One control step of every world. ``actions``: learner -> ``(nworld, n_controls)``
-        motor values (torch or numpy). Returns ``(obs, rewards, terminated, truncated,
+        motor values (torch or numpy); ``expressions``: learner -> ``(nworld,)`` expression ids
+        (:meth:`BatchedEnv.step`; None: unchanged). Returns ``(obs, rewards, terminated, truncated,
         infos)``: obs learner -> sense -> ``(nworld, size)``; rewards learner -> ``(nworld,)``;
         terminated and truncated ``(nworld,)`` bool (the tasks end every agent together; an
         unstable world is terminated, ``infos["instability"]``); infos the task's keys ->
@@ -159,7 +160,10 @@ class BatchedTaskEnv:
         for a, p in self.partners.items():
             full[a] = p.act()
         self.task.before_physics()
-        obs, unstable = self.batched.step(full, reset_unstable=False)
+        if expressions and set(expressions) - set(self.learners):
+            raise ValueError(f"expressions given for {sorted(set(expressions) - set(self.learners))}"
+                             f"; allowed: the learners {self.learners}")
+        obs, unstable = self.batched.step(full, reset_unstable=False, expressions=expressions)
         self.steps += 1
         rewards, terminated, task_infos = self.task.evaluate()
         terminated = terminated | unstable
