@@ -19,8 +19,9 @@ layout, where the CPU env has touch on (``touch=False`` leaves it out).
 Muscles: torques in torch before every physics step (:mod:`mimo_social.gpu.muscles`).
 Eyes: every agent's eye images rendered by MuJoCo Warp's batch renderer
 (:mod:`mimo_social.gpu.eyes`), where the CPU env has vision on (``eyes=False`` leaves them out).
-What stays on the CPU (docs/gpu.md): the other senses (audition, faces),
-expressions and voice (visual and auditory only: the batched actions are the motors). The
+Expressions: each world's faces (:mod:`mimo_social.gpu.faces`), given to :meth:`BatchedEnv.step`
+beside the motors. What stays on the CPU (docs/gpu.md): the other senses (audition, the
+``faces`` sense) and the voice. The
 task's logic is not here: :class:`~mimo_social.gpu.task_env.BatchedTaskEnv` adds it (reach,
 high five); a plain :class:`BatchedEnv` restarts every world from the one reset state.
 """

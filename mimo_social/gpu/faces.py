@@ -58,8 +58,9 @@ class BatchedFaces:
     def set(self, expressions: dict) -> None:
         """This step's expressions: agent -> ``(nworld,)`` ids (torch or numpy); a ValueError
         naming the agent, the field and the value for an agent without expressions or an id
-        out of range."""
+        out of range (then no agent's expression changes)."""
         t = self._torch
+        checked = []            # every agent's ids checked before any is drawn
         for a, given in expressions.items():
             if a not in self.names:
                 raise ValueError(f"expressions: unknown agent {a!r}; agents: {self.names}")
@@ -79,7 +80,9 @@ class BatchedFaces:
                 raise ValueError(f"{a}: expression {int(ids[bad][0])} not allowed; allowed: 0 to "
                                  f"{len(EXPRESSIONS) - 1} ("
                                  + ", ".join(f"{k}={e}" for k, e in enumerate(EXPRESSIONS)) + ")")
-            self.expression[:, i] = ids.to(self.expression.dtype)
+            checked.append((i, ids.to(self.expression.dtype)))
+        for i, ids in checked:
+            self.expression[:, i] = ids
         self._draw(None)
 
     def reset(self, worlds=None, shown=None) -> None:

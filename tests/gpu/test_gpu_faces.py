@@ -123,3 +123,12 @@ def test_the_task_env_passes_the_learners_expressions_on():
     assert tenv.batched.faces.expression[0, 0] == SURPRISED
     with pytest.raises(ValueError, match="expressions given for \\['infant_1'\\]"):
         tenv.step(zero, expressions={"infant_1": np.array([1])})
+
+
+def test_a_bad_expression_changes_no_agents_face(stepped):
+    b, _ = stepped
+    before = b.faces.expression.clone()
+    zero = {a: np.zeros((len(ALL), b.n_controls(a)), np.float32) for a in b.agents}
+    with pytest.raises(ValueError, match="infant_1: expression 7 not allowed"):
+        b.step(zero, expressions={"infant_0": ALL[::-1].copy(), "infant_1": ALL + 3})
+    assert (b.faces.expression == before).all()
