@@ -49,13 +49,17 @@ class GymVectorEnv(VectorEnv):
     a social task's ``scripted_env()``) on the Warp device ``device``; ``seed``: the first
     episodes' seeds (world ``w``: ``seed + w``, :class:`BatchedTaskEnv`); ``numpy``: hand out
     numpy arrays instead of torch tensors; ``nconmax`` / ``njmax`` / ``touch``:
-    :class:`BatchedEnv`'s; ``reset_bank``: :class:`BatchedTaskEnv`'s."""
+    :class:`BatchedEnv`'s; ``reset_bank``: :class:`BatchedTaskEnv`'s. ``expressions``: the
+    action a Dict of ``"motors"`` (the Box) and ``"expression"`` (``Discrete(7)``, drawn on the
+    learner's face in its world: :mod:`mimo_social.gpu.faces`), for a learner whose CPU actions
+    carry an expression; False (default): the motors' Box alone."""
 
     metadata = {"autoreset_mode": AutoresetMode.SAME_STEP, "render_modes": []}
 
     def __init__(self, env, num_envs: int, device: str | None = None, seed: int = 0,
                  numpy: bool = False, nconmax: int | None = None, njmax: int | None = None,
-                 touch: bool = True, reset_bank: int | None = None):
+                 touch: bool = True, reset_bank: int | None = None,
+                 expressions: bool = False):
         learners = list(env.possible_agents)
         if len(learners) != 1:
             raise ValueError(f"GymVectorEnv takes one learner; this env has {learners}: give "
@@ -70,6 +74,17 @@ class GymVectorEnv(VectorEnv):
         self.render_mode = None
         self.single_observation_space, self.single_action_space = \
             device_spaces(self.tenv, self.agent)
+        if not isinstance(expressions, bool):
+            raise ValueError(f"expressions={expressions!r} not allowed; allowed: True or False")
+        self.expressions = expressions
+        if expressions:
+            cpu = env.unwrapped.action_space(self.agent)
+            if not (isinstance(cpu, spaces.Dict) and "expression" in cpu.spaces):
+                raise ValueError(f"{self.agent}: expressions=True, but this agent's actions have "
+                                 f"no expression; allowed: its env made with expressions on "
+                                 f"(AgentConfig.expressions=True), or expressions=False")
+            self.single_action_space = spaces.Dict({"motors": self.single_action_space,
+                                                    "expression": cpu["expression"]})
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.device_name = self.tenv.device_name
@@ -83,7 +98,17 @@ class GymVectorEnv(VectorEnv):
         return self._out(obs[self.agent]), self._info(infos)
 
     def step(self, actions):
-        obs, rew, term, trunc, infos = self.tenv.step({self.agent: actions})
+        expressions = None
+        if self.expressions:
+            if not hasattr(actions, "keys") or set(actions) != {"motors", "expression"}:
+                raise ValueError(f"{self.agent}: actions must be a dict with 'motors' "
+                                 f"({self.num_envs}, n) and 'expression' ({self.num_envs},) "
+                                 f"(expressions=True); got "
+                                 f"{sorted(actions) if hasattr(actions, 'keys') else type(actions).__name__}")
+            expressions = {self.agent: actions["expression"]}
+            actions = actions["motors"]
+        obs, rew, term, trunc, infos = self.tenv.step({self.agent: actions},
+                                                      expressions=expressions)
         final = infos.pop("_final_obs")
         final_obs = infos.pop("final_obs")
         info = self._info(infos)

@@ -132,3 +132,25 @@ def test_a_bad_expression_changes_no_agents_face(stepped):
     with pytest.raises(ValueError, match="infant_1: expression 7 not allowed"):
         b.step(zero, expressions={"infant_0": ALL[::-1].copy(), "infant_1": ALL + 3})
     assert (b.faces.expression == before).all()
+
+
+def test_the_gym_vector_env_takes_the_expression_in_its_actions():
+    """``GymVectorEnv(..., expressions=True)``: a Dict action of the motors and the expression;
+    each world's learner face shows its own; the motors' Box alone without it; refused for a
+    learner without expressions and for an action without the expression."""
+    from mimo_social.gpu import GymVectorEnv
+    v = GymVectorEnv(high_five_v0.scripted_env(max_steps=5), 2, device="cpu", expressions=True)
+    assert set(v.single_action_space.spaces) == {"motors", "expression"}
+    v.reset(seed=0)
+    act = v.action_space.sample()
+    act["expression"] = np.array([SURPRISED, 1])
+    v.step(act)
+    assert v.tenv.batched.faces.expression[:, 0].tolist() == [SURPRISED, 1]
+    with pytest.raises(ValueError, match="infant_0: actions must be a dict with 'motors'"):
+        v.step(act["motors"])
+    plain = GymVectorEnv(high_five_v0.scripted_env(max_steps=5), 1, device="cpu")
+    assert plain.single_action_space.shape == (plain.tenv.n_controls("infant_0"),)
+    with pytest.raises(ValueError, match="infant_0: expressions=True, but this agent's actions "
+                                         "have no expression"):
+        GymVectorEnv(high_five_v0.scripted_env(expressions=False), 1, device="cpu",
+                     expressions=True)
