@@ -26,6 +26,7 @@ from tensordict import TensorDict
 from torchrl.data import Bounded, Categorical, Composite, Unbounded
 from torchrl.envs import EnvBase
 
+from ..expressions.faces import EXPRESSIONS
 from .task_env import BatchedTaskEnv
 from .vector import device_spaces
 
@@ -45,19 +46,30 @@ class TorchRLEnv(EnvBase):
     """``num_envs`` worlds of ``env`` (a CPU env of the catalogue: the ParallelEnv, every agent
     learning, or a one-learner form) on the Warp device ``device``; ``seed``: the first
     episodes' seeds and ``reset_bank`` (:class:`BatchedTaskEnv`); ``group``: the learners'
-    group name."""
+    group name; ``expressions``: the learners choose their expression too, ``(group,
+    "expression")`` a ``Categorical(7)`` beside ``(group, "action")`` (every learner's CPU
+    actions must carry one)."""
 
     def __init__(self, env, num_envs: int, device: str | None = None, seed: int = 0,
                  group: str = "agents", nconmax: int | None = None, njmax: int | None = None,
-                 touch: bool = True, reset_bank: int | None = None):
+                 touch: bool = True, reset_bank: int | None = None,
+                 expressions: bool = False):
         tenv = BatchedTaskEnv(env, num_envs, device=device, seed=seed, nconmax=nconmax,
                               njmax=njmax, touch=touch,
                               reset_bank=reset_bank)
         if not isinstance(group, str) or not group:
             raise ValueError(f"group={group!r} not allowed; allowed: a non-empty string")
+        if not isinstance(expressions, bool):
+            raise ValueError(f"expressions={expressions!r} not allowed; allowed: True or False")
+        for a in tenv.learners if expressions else ():
+            if not tenv.batched.faces.acting[tenv.agents.index(a)]:
+                raise ValueError(f"{a}: expressions=True, but this agent's actions have no "
+                                 f"expression; allowed: its env made with expressions on "
+                                 f"(AgentConfig.expressions=True), or expressions=False")
         dev = tenv.batched.qpos.device
         super().__init__(device=dev, batch_size=torch.Size([tenv.nworld]))
         self.tenv = tenv
+        self.expressions = expressions
         self.group = group
         self.learners = list(tenv.learners)
         self.group_map = {group: self.learners}
@@ -79,9 +91,13 @@ class TorchRLEnv(EnvBase):
         shape = (n, k) + act_space.shape
         as_t = lambda x: torch.as_tensor(np.broadcast_to(x, shape).copy(),  # noqa: E731
                                          dtype=torch.float32, device=dev)
-        self.action_spec = Composite({group: Composite({"action": Bounded(
-            low=as_t(act_space.low), high=as_t(act_space.high), shape=shape,
-            dtype=torch.float32, device=dev)}, shape=(n, k), device=dev)}, shape=(n,), device=dev)
+        acts = {"action": Bounded(low=as_t(act_space.low), high=as_t(act_space.high),
+                                  shape=shape, dtype=torch.float32, device=dev)}
+        if expressions:
+            acts["expression"] = Categorical(len(EXPRESSIONS), shape=(n, k), dtype=torch.int64,
+                                             device=dev)
+        self.action_spec = Composite({group: Composite(acts, shape=(n, k), device=dev)},
+                                     shape=(n,), device=dev)
         self.reward_spec = Composite({group: Composite({"reward": Unbounded(
             shape=(n, k, 1), dtype=torch.float32, device=dev)}, shape=(n, k), device=dev)},
             shape=(n,), device=dev)
@@ -122,7 +138,11 @@ class TorchRLEnv(EnvBase):
     def _step(self, tensordict):
         u = tensordict.get((self.group, "action"))
         actions = {a: u[:, j] for j, a in enumerate(self.learners)}
-        obs, rew, term, trunc, _ = self.tenv.step(actions, autoreset=False)
+        faces = None
+        if self.expressions:
+            e = tensordict.get((self.group, "expression"))
+            faces = {a: e[:, j] for j, a in enumerate(self.learners)}
+        obs, rew, term, trunc, _ = self.tenv.step(actions, autoreset=False, expressions=faces)
         td = self._obs_td(obs)
         self._last = td
         n = self.tenv.nworld

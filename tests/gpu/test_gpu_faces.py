@@ -154,3 +154,26 @@ def test_the_gym_vector_env_takes_the_expression_in_its_actions():
                                          "have no expression"):
         GymVectorEnv(high_five_v0.scripted_env(expressions=False), 1, device="cpu",
                      expressions=True)
+
+
+def test_the_torchrl_env_takes_the_learners_expressions():
+    """``TorchRLEnv(..., expressions=True)``: ``(group, "expression")`` a Categorical(7) beside
+    the motors; a rollout passes TorchRL's spec check and the faces show what was chosen."""
+    from tensordict import TensorDict
+    from torchrl.envs.utils import check_env_specs
+
+    from mimo_social.gpu import TorchRLEnv
+    env = TorchRLEnv(high_five_v0.parallel_env(max_steps=4), 2, device="cpu", expressions=True)
+    spec = env.action_spec["agents", "expression"]
+    assert spec.shape == (2, 2) and spec.space.n == len(EXPRESSIONS)
+    check_env_specs(env)
+    td = env.reset()
+    act = env.action_spec.rand()
+    act["agents", "expression"] = env.tenv.torch.tensor([[SURPRISED, 1], [2, 0]])
+    td.update(act)
+    env.step(td)
+    assert env.tenv.batched.faces.expression.tolist() == [[SURPRISED, 1], [2, 0]]
+    assert isinstance(td, TensorDict)
+    with pytest.raises(ValueError, match="expressions=True, but this agent's actions"):
+        TorchRLEnv(high_five_v0.parallel_env(expressions=False), 1, device="cpu",
+                   expressions=True)
