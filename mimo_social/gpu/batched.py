@@ -35,7 +35,7 @@ import numpy as np
 from ..core.world import World
 from .controls import AgentControls
 from .eyes import EYES, BatchedEyeSense, BatchedEyes
-from .faces import BatchedFaces
+from .faces import BatchedFaces, carries_expression
 from .device import describe, pick_device, require
 from .contacts import BatchedContacts
 from .proprioception import BatchedProprioception
@@ -100,8 +100,7 @@ class BatchedEnv:
         mjm, mjd = env.world.model, env.world.data
         self.nconmax, self.njmax = self._sizes(mjm, mjd, len(self.agents), nconmax, njmax)
         vision = env.systems.get("vision") if eyes else None
-        acting = any(hasattr(env.action_space(a), "spaces")
-                     and "expression" in env.action_space(a).spaces for a in self.agents)
+        acting = any(carries_expression(env, a) for a in self.agents)
         if vision is not None and acting and "mat_texid" not in batch_fields:
             batch_fields = tuple(batch_fields) + ("mat_texid",)   # each world's faces drawn
         with wp.ScopedDevice(self.device):

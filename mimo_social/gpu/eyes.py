@@ -174,4 +174,6 @@ class BatchedEyeSense:
 
     def observe(self, data):
         """This step's images (of ``delay`` steps before, when delayed)."""
-        return self._ring.push(self._flat().clone()).reshape((-1,) + self._shape)
+        reading = self._flat()     # a delay ring copies it; undelayed, the copy handed out
+        return self._ring.push(reading if self._ring.delay else reading.clone()).reshape(
+            (-1,) + self._shape)

@@ -15,10 +15,17 @@ import numpy as np
 from ..expressions.faces import EXPRESSIONS
 from ..expressions.switch import FaceTextures
 
-__all__ = ["BatchedFaces", "RGB_ROLE"]
+__all__ = ["BatchedFaces", "RGB_ROLE", "carries_expression"]
 
 #: the texture role of a material's colour texture (``mjtTextureRole.mjTEXROLE_RGB``)
 RGB_ROLE = 1
+
+
+def carries_expression(env, agent: str) -> bool:
+    """Whether ``agent``'s actions in the CPU ``env`` carry an expression
+    (``AgentConfig.expressions``)."""
+    space = env.action_space(agent)
+    return hasattr(space, "spaces") and "expression" in space.spaces
 
 
 class BatchedFaces:
@@ -31,8 +38,7 @@ class BatchedFaces:
         self._torch = torch
         self.names = list(env.possible_agents)
         #: whether each agent's actions carry an expression (AgentConfig.expressions)
-        self.acting = [hasattr(env.action_space(a), "spaces")
-                       and "expression" in env.action_space(a).spaces for a in self.names]
+        self.acting = [carries_expression(env, a) for a in self.names]
         self.materials = torch.as_tensor([a.head_material for a in w.agents], dtype=torch.int64,
                                          device=device)
         self.textures = torch.as_tensor([w.model.texture(n).id for n in FaceTextures.names],
@@ -46,6 +52,14 @@ class BatchedFaces:
     def shown(env) -> list[int]:
         """The expression each agent of the CPU ``env`` shows now."""
         return [env.world.expression_of(i) for i in range(len(env.possible_agents))]
+
+    def require_acting(self, agent: str, what: str, other: str = "") -> None:
+        """A ValueError naming ``agent`` and ``what`` asked for an expression unless its
+        actions carry one (``other``: a further way out the message names)."""
+        if not self.acting[self.names.index(agent)]:
+            raise ValueError(f"{agent}: {what}, but this agent's actions have no expression; "
+                             f"allowed: its env made with expressions on "
+                             f"(AgentConfig.expressions=True){other}")
 
     def _draw(self, worlds) -> None:
         if self._mat is None:
@@ -65,10 +79,7 @@ class BatchedFaces:
             if a not in self.names:
                 raise ValueError(f"expressions: unknown agent {a!r}; agents: {self.names}")
             i = self.names.index(a)
-            if not self.acting[i]:
-                raise ValueError(f"{a}: expression given, but this agent's actions have no "
-                                 f"expression; allowed: its env made with expressions on "
-                                 f"(AgentConfig.expressions=True)")
+            self.require_acting(a, "expression given")
             ids = t.as_tensor(np.asarray(given) if not hasattr(given, "to") else given,
                               device=self.expression.device)
             if ids.shape != (self.expression.shape[0],) or ids.dtype.is_floating_point:

@@ -20,16 +20,12 @@ class ResetBank:
         self._starts: list[tuple] = []
         self.first_seed: int | None = None
 
-    def fill(self, first_seed: int, progress: bool = False) -> None:
+    def fill(self, first_seed: int) -> None:
         """Make the ``size`` starts from seeds ``first_seed`` .. ``first_seed + size - 1``
         (nothing to do when they are already those)."""
         if first_seed == self.first_seed and len(self._starts) == self.size:
             return
-        seeds = range(first_seed, first_seed + self.size)
-        if progress:
-            from tqdm import tqdm
-            seeds = tqdm(seeds, desc="reset bank", unit="start")
-        self._starts = [self._capture(s) for s in seeds]
+        self._starts = [self._capture(s) for s in range(first_seed, first_seed + self.size)]
         self.first_seed = first_seed
 
     def start(self, n: int) -> tuple:

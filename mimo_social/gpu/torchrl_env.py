@@ -62,10 +62,7 @@ class TorchRLEnv(EnvBase):
         if not isinstance(expressions, bool):
             raise ValueError(f"expressions={expressions!r} not allowed; allowed: True or False")
         for a in tenv.learners if expressions else ():
-            if not tenv.batched.faces.acting[tenv.agents.index(a)]:
-                raise ValueError(f"{a}: expressions=True, but this agent's actions have no "
-                                 f"expression; allowed: its env made with expressions on "
-                                 f"(AgentConfig.expressions=True), or expressions=False")
+            tenv.batched.faces.require_acting(a, "expressions=True", ", or expressions=False")
         dev = tenv.batched.qpos.device
         super().__init__(device=dev, batch_size=torch.Size([tenv.nworld]))
         self.tenv = tenv

@@ -78,13 +78,11 @@ class GymVectorEnv(VectorEnv):
             raise ValueError(f"expressions={expressions!r} not allowed; allowed: True or False")
         self.expressions = expressions
         if expressions:
-            cpu = env.unwrapped.action_space(self.agent)
-            if not (isinstance(cpu, spaces.Dict) and "expression" in cpu.spaces):
-                raise ValueError(f"{self.agent}: expressions=True, but this agent's actions have "
-                                 f"no expression; allowed: its env made with expressions on "
-                                 f"(AgentConfig.expressions=True), or expressions=False")
-            self.single_action_space = spaces.Dict({"motors": self.single_action_space,
-                                                    "expression": cpu["expression"]})
+            self.tenv.batched.faces.require_acting(self.agent, "expressions=True",
+                                                   ", or expressions=False")
+            self.single_action_space = spaces.Dict({
+                "motors": self.single_action_space,
+                "expression": env.unwrapped.action_space(self.agent)["expression"]})
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.device_name = self.tenv.device_name
