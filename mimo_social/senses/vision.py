@@ -67,9 +67,16 @@ from .base import SenseEntry
 from .fovea import FoveaConfig, check_fovea, foveal_warp
 
 __all__ = ["VisionConfig", "VisionSystem", "VisionSense", "build_vision", "vision_system",
-           "eye_images", "render_now", "anaglyph", "save_anaglyph", "write_png", "EYES", "SENSE"]
+           "eye_images", "render_now", "anaglyph", "save_anaglyph", "write_png", "render_scale",
+           "EYES", "SENSE"]
 
 EYES = ("left", "right")
+
+
+def render_scale(config: "VisionConfig") -> int:
+    """How many times the eye images are rendered larger than observed, per side: the fovea's
+    render scale (the centre magnified from rendered detail), else 1."""
+    return config.fovea.render_scale if config.fovea else 1
 
 
 @dataclass(frozen=True)
@@ -112,19 +119,16 @@ class VisionSystem:
         self.configs = list(configs)
         self.agents = [i for i, c in enumerate(self.configs) if c]
         tiles, groups, self._tile_of = [], [], {}
-        self.cameras, self.cutoffs, self._blur, self.foveas = {}, {}, {}, {}
+        self.cameras, self.cutoffs, self.blurs, self.foveas = {}, {}, {}, {}
         for i in self.agents:
             cfg = self.configs[i]
             right, left = (int(c) for c in world.agents[i].eye_cameras)
             self.cameras[i] = {"left": left, "right": right}
             if cfg.field_of_view is not None:
                 world.model.cam_fovy[[left, right]] = cfg.field_of_view
-            self.cutoffs[i] = cutoff_for(cfg.acuity, world.agent_setups[i].config.age)
-            # with a fovea: rendered k times larger, blurred there (in degrees), then warped
-            k = cfg.fovea.render_scale if cfg.fovea else 1
             self.foveas[i] = foveal_warp(cfg.fovea, cfg.height, cfg.width) if cfg.fovea else None
-            self._blur[i] = acuity_blur(self.cutoffs[i], cfg.height * k, cfg.width * k,
-                                        float(world.model.cam_fovy[left]))
+            self._set_blur(i, world.model, world.agent_setups[i].config.age)
+            k = render_scale(cfg)
             group = []
             for eye in EYES:
                 self._tile_of[i, eye] = len(tiles)
@@ -147,9 +151,13 @@ class VisionSystem:
 
     def set_age(self, model, i: int, age_months: float | None) -> None:
         """Agent ``i``'s acuity blur for the body age ``age_months`` (an age change at reset)."""
-        cfg = self.configs[i]
+        self._set_blur(i, model, age_months)
+
+    def _set_blur(self, i: int, model, age_months: float | None) -> None:
+        # with a fovea the eye is rendered k times larger, blurred there (in degrees), warped
+        cfg, k = self.configs[i], render_scale(self.configs[i])
         self.cutoffs[i] = cutoff_for(cfg.acuity, age_months)
-        self._blur[i] = acuity_blur(self.cutoffs[i], cfg.height, cfg.width,
+        self.blurs[i] = acuity_blur(self.cutoffs[i], cfg.height * k, cfg.width * k,
                                     float(model.cam_fovy[self.cameras[i]["left"]]))
 
     # -- shared-system interface ---------------------------------------------------------------
@@ -170,7 +178,7 @@ class VisionSystem:
         jobs = [(self._tile_of[i, e], self.cameras[i][e]) for i in agents for e in EYES]
         result = self.renderer.render(model, data, jobs)
         for i in agents:
-            imgs, blur, fovea = {}, self._blur[i], self.foveas[i]
+            imgs, blur, fovea = {}, self.blurs[i], self.foveas[i]
             for e in EYES:
                 rgb, depth = result[self._tile_of[i, e]]
                 rgb = rgb if blur is None else blur(rgb)

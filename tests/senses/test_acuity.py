@@ -132,8 +132,8 @@ def test_the_young_eye_sees_less_fine_detail_and_18_months_at_128_px_is_untouche
         # the 18-month-old's cut-off is above 128 px's Nyquist: its images bit for bit
         assert np.array_equal(obs_on[old][eye], obs_off[old][eye])
     copy = pickle.loads(pickle.dumps(vision_system(on)))      # the blur travels with the env
-    assert copy.cutoffs == {0: 0.66, 1: 12.39} and copy._blur[1] is None
-    assert np.array_equal(copy._blur[0](obs_off[young]["eye_left"]), obs_on[young]["eye_left"])
+    assert copy.cutoffs == {0: 0.66, 1: 12.39} and copy.blurs[1] is None
+    assert np.array_equal(copy.blurs[0](obs_off[young]["eye_left"]), obs_on[young]["eye_left"])
     for agent in (young, old):  # depth stays sharp
         for eye in ("depth_left", "depth_right"):
             assert np.array_equal(obs_on[agent][eye], obs_off[agent][eye])

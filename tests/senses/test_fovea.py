@@ -234,3 +234,22 @@ def test_a_checked_setting_is_checked_again_where_it_is_reused():
         dataclasses.replace(cfg, height=1024)
     with pytest.raises(ConfigError, match="fovea strength=100"):
         VisionConfig(fovea=FoveaConfig(100.0, 2))
+
+
+def test_an_age_change_at_reset_keeps_the_blur_at_the_render_size_of_the_fovea():
+    """An age change (reset option) rebuilds the acuity blur for the eye rendered k times
+    larger, as a new env of that age builds it (it was once rebuilt for the observed size:
+    at 96 px a 1-month-old's cut-off is above Nyquist, so the blur was dropped)."""
+    vision = {"width": 96, "height": 96, "fovea": 3, "acuity": "age"}
+    grown = free_play_v0.parallel_env(n_agents=1, vision=vision, per_agent=[{"age_months": 0}])
+    grown.reset(seed=0)
+    obs, _ = grown.reset(seed=0, options={"age_months": 1})
+    born = free_play_v0.parallel_env(n_agents=1, vision=vision, per_agent=[{"age_months": 1}])
+    ref, _ = born.reset(seed=0)
+    blur, want = vision_system(grown).blurs[0], vision_system(born).blurs[0]
+    assert blur is not None and (blur.height, blur.width) == (288, 288)
+    assert blur.sigma_px == pytest.approx(want.sigma_px)
+    for eye in ("eye_left", "eye_right"):
+        assert np.array_equal(obs["infant_0"][eye], ref["infant_0"][eye])
+    grown.close()
+    born.close()
