@@ -1,8 +1,14 @@
 """The eyes on the device: every agent's eye images for every world, rendered by MuJoCo Warp's
 batch renderer (ray tracing on the device: ``create_render_context`` / ``render``), in the CPU
 vision sense's layout (:mod:`mimo_social.senses.vision`): ``eye_left`` and ``eye_right`` per
-agent with vision, ``(nworld, height, width, 3)`` uint8, row 0 at the top, delayed as the CPU
-env delays the ``vision`` channel.
+agent with vision, ``(nworld, height, width, 3)`` uint8, row 0 at the top, and with ``depth``
+on ``depth_left`` and ``depth_right``, ``(nworld, height, width)`` float32 metres along the
+viewing axis (nothing hit: the CPU's far plane); delayed as the CPU env delays the ``vision``
+channel. Every setting of the CPU sense is honoured: the ``acuity`` blur and the ``fovea``
+(the eye rendered ``render_scale`` times larger, blurred, warped: the CPU's own filters run on
+the device, :mod:`mimo_social.gpu.optics`), ``depth``, ``field_of_view`` and ``every`` (each
+world counts its steps since its reset, as the CPU env does; the renderer runs on steps where
+some world is due and the others keep their images).
 
 After each control step's physics the cameras' poses are brought up to the state
 (``camlight``), the renderer's bounding volumes refitted to the geoms' poses (``refit_bvh``) and
@@ -13,9 +19,7 @@ sphere's texture as a flat longitude-latitude image, while the heads carry cube 
 face on the +x side, :mod:`mimo_social.expressions.switch`), so the renderer is given a copy of
 the model whose cube textures are resampled to longitude-latitude images
 (:func:`ray_traced_textures`); each world's expressions are drawn by
-:class:`~mimo_social.gpu.faces.BatchedFaces` (the head materials' texture per world). What the
-device does not render is refused with a ValueError naming the agent and the setting: ``acuity`` blur, ``fovea``,
-``depth`` images, and ``every`` other than 1.
+:class:`~mimo_social.gpu.faces.BatchedFaces` (the head materials' texture per world).
 """
 
 from __future__ import annotations
@@ -25,7 +29,9 @@ import copy
 import mujoco
 import numpy as np
 
+from ..senses.vision import render_scale
 from .delay_ring import DelayRing
+from .optics import EyeOptics
 
 __all__ = ["BatchedEyes", "BatchedEyeSense", "EYES", "ray_traced_textures"]
 
@@ -84,86 +90,131 @@ def ray_traced_textures(mjm):
     return out
 
 
-def _check(name: str, cfg, cutoff) -> None:
-    """A ValueError for a vision setting the device does not render."""
-    for field, value, allowed in (
-            ("acuity", cfg.acuity if cutoff is not None else None, "None (no blur)"),
-            ("fovea", cfg.fovea, "None"), ("depth", cfg.depth, "False"),
-            ("every", cfg.every, "1 (every step rendered)")):
-        if value is not None and value is not False and not (field == "every" and value == 1):
-            raise ValueError(f"{name}: vision {field}={value!r} is not rendered on the device; "
-                             f"allowed there: {allowed} (or eyes=False: no eyes on the device)")
-
-
 class BatchedEyes:
     """The eyes of the agents ``names`` (index -> name) that have vision in the CPU env whose
     vision system is ``system`` (its compiled model ``mjm``), for the ``nworld`` worlds of the
     Warp ``model`` and ``data``; ``on_device``: the context that runs Warp's work on the
     device (:class:`~mimo_social.gpu.batched.BatchedEnv`'s); the images live on torch's
-    ``device``."""
+    ``device``. :attr:`images`: ``(agent, key)`` -> the current images of every world, the
+    keys those of the CPU sense (``eye_left``, ``eye_right``; with depth on ``depth_left``,
+    ``depth_right``)."""
 
     def __init__(self, system, mjm, model, data, nworld: int, names: dict, wp, mjw, torch,
                  device, on_device):
         self._torch, self._mjw = torch, mjw
         self._model, self._data, self._on_device = model, data, on_device
         self.agents = list(system.agents)
-        cams, res = [], []
+        cams, res, depth = [], [], []
+        #: per agent: the blur and the fovea's warp (:class:`~mimo_social.gpu.optics.EyeOptics`)
+        self.optics = {}
+        #: per agent: its eyes are rendered every ``every``-th step (the CPU's setting)
+        self.every = {}
         for i in self.agents:
             cfg = system.configs[i]
-            _check(names[i], cfg, system.cutoffs[i])
+            k = render_scale(cfg)
             for e in EYES:
                 cams.append(int(system.cameras[i][e]))
-                res.append((int(cfg.width), int(cfg.height)))
+                res.append((int(cfg.width) * k, int(cfg.height) * k))
+                depth.append(bool(cfg.depth))
+            self.optics[i] = EyeOptics(system.blurs[i], system.foveas[i], torch, device)
+            self.every[i] = int(cfg.every)
         with on_device():
             self.rc = mjw.create_render_context(ray_traced_textures(mjm), nworld, cam_res=res,
-                                                render_rgb=True, render_depth=False,
+                                                render_rgb=True, render_depth=depth,
                                                 render_seg=False, cam_active=cams)
-        adr = self.rc.rgb_adr.numpy()
+        # nothing hit: the CPU's depth is its far plane's distance, the renderer's 0
+        self._far = float(mjm.vis.map.zfar * mjm.stat.extent)
         self._packed = wp.to_torch(self.rc.rgb_data)                    # (nworld, pixels) uint32
-        #: per agent and eye: (first pixel, height, width) in the packed rows
+        self._depths = wp.to_torch(self.rc.depth_data) if any(depth) else None
+        rgb_adr, depth_adr = self.rc.rgb_adr.numpy(), self.rc.depth_adr.numpy()
+        #: per agent and key: (first pixel in the packed rows, render height, render width)
         self.slots = {}
         k = 0
         for i in self.agents:
             for e in EYES:
                 w, h = res[k]
-                self.slots[i, e] = (int(adr[k]), h, w)
+                self.slots[i, f"eye_{e}"] = (int(rgb_adr[k]), h, w)
+                if depth[k]:
+                    self.slots[i, f"depth_{e}"] = (int(depth_adr[k]), h, w)
                 k += 1
-        self.images = {key: torch.zeros((nworld, h, w, 3), dtype=torch.uint8, device=device)
-                       for key, (_, h, w) in self.slots.items()}
+        self.images = {}
+        for (i, key), (_, h, w) in sorted(self.slots.items(), key=lambda kv: _order(kv[0])):
+            cfg = system.configs[i]
+            shape = (nworld, cfg.height, cfg.width) + ((3,) if key.startswith("eye") else ())
+            dtype = torch.uint8 if key.startswith("eye") else torch.float32
+            self.images[i, key] = torch.zeros(shape, dtype=dtype, device=device)
+        #: the control steps since each world's reset (the step after a reset is its 0th)
+        self.count = torch.zeros(nworld, dtype=torch.int64, device=device)
+        self._all = torch.ones(nworld, dtype=torch.bool, device=device)
         self.renders = 0
 
+    def keys(self, agent: int) -> list[str]:
+        """Agent ``agent``'s image keys, in the CPU sense's order."""
+        return [key for (i, key) in self.images if i == agent]
+
     def render(self, worlds=None) -> None:
-        """Render every eye from the current state; keep the images of ``worlds`` (a bool mask;
-        None: all)."""
-        m, d, mjw = self._model, self._data, self._mjw
+        """After a reset or load of ``worlds`` (a bool mask; None: all): render every eye from
+        the current state and keep the images of those worlds; their steps count from 0."""
+        mask = self._all if worlds is None else worlds
+        self.count[mask] = 1
+        self._draw({i: (None if worlds is None else mask) for i in self.agents})
+
+    def step(self) -> None:
+        """After a control step: render the eyes due in some world (an agent's are due every
+        ``every``-th step since the world's reset) and keep their images in the worlds where
+        they are due; the others hold their last images."""
+        due = {}
+        for i in self.agents:
+            every = self.every[i]
+            due[i] = None if every == 1 else (self.count % every) == 0
+        self.count += 1
+        if all(d is not None and not bool(d.any()) for d in due.values()):
+            return
+        self._draw(due)
+
+    def _draw(self, keep: dict) -> None:
+        m, d, mjw, torch = self._model, self._data, self._mjw, self._torch
         with self._on_device():
             mjw.camlight(m, d)
             mjw.refit_bvh(m, d, self.rc)
             mjw.render(m, d, self.rc)
-        packed = self._packed.view(self._torch.int32)
-        for key, (start, h, w) in self.slots.items():
-            px = packed[:, start:start + h * w]
-            # the renderer packs a pixel as 0xAARRGGBB
-            rgb = self._torch.stack([(px >> 16) & 255, (px >> 8) & 255, px & 255], dim=-1)
-            img = rgb.to(self._torch.uint8).reshape(-1, h, w, 3)
-            if worlds is None:
-                self.images[key] = img
+        packed = self._packed.view(torch.int32)
+        for (i, key), (start, h, w) in self.slots.items():
+            if keep[i] is not None and not bool(keep[i].any()):
+                continue
+            if key.startswith("eye"):
+                px = packed[:, start:start + h * w]
+                # the renderer packs a pixel as 0xAARRGGBB
+                rgb = torch.stack([(px >> 16) & 255, (px >> 8) & 255, px & 255], dim=-1)
+                img = self.optics[i].rgb(rgb.to(torch.uint8).reshape(-1, h, w, 3))
             else:
-                self.images[key][worlds] = img[worlds]
+                raw = self._depths[:, start:start + h * w].reshape(-1, h, w)
+                img = self.optics[i].depth(torch.where(raw > 0, raw, self._far))
+            if keep[i] is None:
+                self.images[i, key] = img
+            else:
+                self.images[i, key][keep[i]] = img[keep[i]]
         self.renders += 1
 
 
-class BatchedEyeSense:
-    """Agent ``agent``'s eye ``eye`` (``"left"`` / ``"right"``) read from ``eyes``, delayed by
-    ``delay`` control steps (the CPU env's ``vision`` channel)."""
+def _order(key):
+    """The CPU sense's order of an agent's keys: its eyes, then its depth images."""
+    i, name = key
+    return (i, name.startswith("depth"), EYES.index(name.split("_")[1]))
 
-    def __init__(self, eyes: BatchedEyes, agent: int, eye: str, delay: int, nworld: int,
+
+class BatchedEyeSense:
+    """Agent ``agent``'s image ``key`` (``eye_left``, ..., ``depth_right``) read from ``eyes``,
+    delayed by ``delay`` control steps (the CPU env's ``vision`` channel)."""
+
+    def __init__(self, eyes: BatchedEyes, agent: int, key: str, delay: int, nworld: int,
                  torch, device):
-        self.name = f"eye_{eye}"
-        self._eyes, self._key = eyes, (agent, eye)
-        _, h, w = eyes.slots[agent, eye]
-        self._shape = (h, w, 3)
-        self._ring = DelayRing(delay, nworld, h * w * 3, torch, device, dtype=torch.uint8)
+        self.name = key
+        self._eyes, self._key = eyes, (agent, key)
+        image = eyes.images[agent, key]
+        self._shape = tuple(image.shape[1:])
+        self._ring = DelayRing(delay, nworld, int(np.prod(self._shape)), torch, device,
+                               dtype=image.dtype)
 
     def _flat(self):
         return self._eyes.images[self._key].reshape(self._eyes.images[self._key].shape[0], -1)

@@ -145,6 +145,14 @@ class AcuityBlur:
             self._rows = _blur_matrix(self.height, self.sigma_px)                 # (H, H)
             self._cols = _blur_matrix(self.width, self.sigma_px)                  # (W, W)
 
+    def matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """The filter as two dense float32 band matrices ``(rows (H, H), columns (W, W))``: the
+        blurred channel is ``rows @ channel @ columns.T`` (e.g. for a blur on another device);
+        identity matrices for the identity."""
+        if self.identity:
+            return (np.eye(self.height, dtype=np.float32), np.eye(self.width, dtype=np.float32))
+        return self._rows.toarray(), self._cols.toarray()
+
     def modulation(self, cpd: float) -> float:
         """The filter's modulation transfer at ``cpd`` cycles per degree on the line of sight
         (the continuous Gaussian's; 1.0 for the identity)."""

@@ -222,6 +222,12 @@ class FovealWarp:
         return foveal_warp, (self.config, self.height, self.width)
 
     @property
+    def matrix(self) -> sparse.csr_matrix:
+        """The warp's weights, float32 ``(height * width, render pixels)``: the warped channels
+        are ``matrix @ render.reshape(-1, channels)`` (read only)."""
+        return self._matrix
+
+    @property
     def taps(self) -> int:
         """Render pixels read for one colour channel (non-zero weights of the matrix)."""
         return int(self._matrix.nnz)
