@@ -34,7 +34,8 @@ import numpy as np
 
 from ..core.world import World
 from .controls import AgentControls
-from .eyes import EYES, BatchedEyeSense, BatchedEyes
+from .eyes import BatchedEyeSense, BatchedEyes
+from .stacking import stack_rows
 from .faces import BatchedFaces, carries_expression
 from .device import describe, pick_device, require
 from .contacts import BatchedContacts
@@ -73,7 +74,7 @@ class BatchedEnv:
     the agents' touch skins on the device (:mod:`mimo_social.gpu.skin`: the ``touch``
     observation of every agent that has touch in ``env``), or False to leave touch out.
     ``eyes``: the agents' eye images rendered on the device (:mod:`mimo_social.gpu.eyes`:
-    ``eye_left`` / ``eye_right`` of every agent that has vision in ``env``), or False.
+    ``eye_left`` / ``eye_right`` (and depth) of every agent that has vision in ``env``), or False.
     """
 
     def __init__(self, env, nworld: int, device: str | None = None, seed: int | None = 0,
@@ -149,8 +150,8 @@ class BatchedEnv:
                     senses.append(BatchedTouchSense(self.skin, s, delays["touch"], self.nworld,
                                                     torch, tdev))
                 elif s.name == "vision" and self.eyes is not None:
-                    senses.extend(BatchedEyeSense(self.eyes, i, e, delays["vision"], self.nworld,
-                                                  torch, tdev) for e in EYES)
+                    senses.extend(BatchedEyeSense(self.eyes, i, k, delays["vision"], self.nworld,
+                                                  torch, tdev) for k in self.eyes.keys(i))
             self.senses.append(senses)
         self._graph = None
         #: muscles update before every physics step (torch): no CUDA graph then
@@ -235,30 +236,35 @@ class BatchedEnv:
         sequence of world indices); the other worlds are not touched (no physics runs: the
         derived fields come from the snapshots). Returns the observations as :meth:`reset`
         (rows of the worlds not loaded: not meaningful)."""
-        torch = self._torch
-        idx = torch.as_tensor(np.asarray(worlds, dtype=np.int64), device=self.qpos.device)
+        idx = np.asarray(list(worlds) if not hasattr(worlds, "__len__") else worlds, np.int64)
         if len(snaps) != len(idx):
             raise ValueError(f"{len(snaps)} snapshots for {len(idx)} worlds")
         if not len(idx):
             return self._reset_obs(self._mask(np.zeros(self.nworld, bool)))
+        return self.load_rows(idx, stack_rows(list(snaps)))
+
+    def load_rows(self, worlds, rows) -> dict:
+        """:meth:`load` with the snapshots already stacked (:func:`~mimo_social.gpu.stacking.
+        stack_rows`: each leaf ``(len(worlds), ...)``, numpy or torch tensors on the device,
+        e.g. a reset bank's rows): one copy per field, nothing stacked on the host."""
+        torch = self._torch
+        dev = self.qpos.device
+        idx = torch.as_tensor(worlds, dtype=torch.int64, device=dev).reshape(-1)
         fields = [(f, t) for f, t in self._state.items()] + \
             [(f, self.tensors[f]) for f in DERIVED_FIELDS if f in self.tensors] + \
             [("model." + f, t) for f, t in self.model_tensors.items()]
         for f, t in fields:
-            rows = torch.as_tensor(np.stack([s[f] for s in snaps]), device=t.device)
-            t[idx] = rows.reshape((len(idx),) + tuple(t.shape[1:])).to(t.dtype)
-        mask = torch.zeros(self.nworld, dtype=torch.bool, device=self.qpos.device)
+            t[idx] = torch.as_tensor(rows[f], device=t.device).reshape(
+                (len(idx),) + tuple(t.shape[1:])).to(t.dtype)
+        mask = torch.zeros(self.nworld, dtype=torch.bool, device=dev)
         mask[idx] = True
         for i, c in enumerate(self.controls):
-            observed = [s["observed"][i] for s in snaps]
-            c.reset(mask, np.stack([s["controls"][i] for s in snaps]),
-                    None if observed[0] is None else np.stack(observed), idx)
+            c.reset(mask, rows["controls"][i], rows["observed"][i], idx)
             if c.muscle is not None:
-                c.muscle.reset(idx, np.stack([s["muscles"][i][0] for s in snaps]),
-                               np.stack([s["muscles"][i][1] for s in snaps]))
+                c.muscle.reset(idx, *rows["muscles"][i])
         if self.skin is not None:
-            self.skin.load(idx, np.stack([s["touch"] for s in snaps]))
-        self.faces.reset(mask, [s["expressions"] for s in snaps])
+            self.skin.load(idx, rows["touch"])
+        self.faces.reset(mask, rows["expressions"])
         if self.eyes is not None:
             self.eyes.render(mask)
         return self._reset_obs(mask)
@@ -289,7 +295,7 @@ class BatchedEnv:
         if self.skin is not None:
             self.skin.feel(contact_rows(self), self.tensors)
         if self.eyes is not None:
-            self.eyes.render()
+            self.eyes.step()
         obs = {a: {s.name: s.observe(self.tensors) for s in senses}
                for a, senses in zip(self.agents, self.senses)}
         if reset_unstable and bool(unstable.any()):

@@ -74,7 +74,7 @@ class AgentControls:
 
     def reset(self, worlds=None, controls=None, observed=None, rows=None) -> None:
         """The controls in force at reset, in every slot of the ring (``worlds``: a bool mask
-        of the worlds to reset; None: all). ``controls`` / ``observed``: ``(k, n)`` rows of
+        of the worlds to reset; None: all). ``controls`` / ``observed``: ``(k, n)`` rows (numpy or torch) of
         the worlds ``rows`` (indices; the same worlds as the mask) in place of the reset's given
         at construction (``observed`` None: ``controls``)."""
         if worlds is None:
@@ -86,9 +86,8 @@ class AgentControls:
             self.applied[worlds] = self._observed
         else:
             t, dev = self._torch, self.low.device
-            c = t.as_tensor(np.asarray(controls, np.float32), device=dev)
-            o = c if observed is None else t.as_tensor(np.asarray(observed, np.float32),
-                                                       device=dev)
+            c = t.as_tensor(controls, device=dev).to(t.float32)
+            o = c if observed is None else t.as_tensor(observed, device=dev).to(t.float32)
             self.ring[:, rows] = c
             self.applied[rows] = o
         if self.muscle is not None:

@@ -49,9 +49,11 @@ class BatchedFaces:
         self._draw(None)
 
     @staticmethod
-    def shown(env) -> list[int]:
-        """The expression each agent of the CPU ``env`` shows now."""
-        return [env.world.expression_of(i) for i in range(len(env.possible_agents))]
+    def shown(env) -> np.ndarray:
+        """The expression each agent of the CPU ``env`` shows now (one array: a leaf of the
+        snapshot's rows)."""
+        return np.array([env.world.expression_of(i) for i in range(len(env.possible_agents))],
+                        np.int64)
 
     def require_acting(self, agent: str, what: str, other: str = "") -> None:
         """A ValueError naming ``agent`` and ``what`` asked for an expression unless its
@@ -104,7 +106,7 @@ class BatchedFaces:
             self.expression[rows] = self.start
         else:
             self.expression[rows] = self._torch.as_tensor(
-                np.asarray(shown), dtype=self.expression.dtype, device=self.expression.device)
+                shown, device=self.expression.device).to(self.expression.dtype)
         self._draw(worlds)
 
     def one_hot(self, i: int):

@@ -87,10 +87,9 @@ class BatchedMuscle:
             self.force[sel] = 0.0
             return
         t = self._torch
-        self.activation[sel] = t.as_tensor(np.asarray(activation), dtype=t.float64,
-                                           device=self.activation.device)
-        self.force[sel] = t.as_tensor(np.asarray(force), dtype=t.float64,
-                                      device=self.force.device)
+        self.activation[sel] = t.as_tensor(activation, device=self.activation.device).to(
+            t.float64)
+        self.force[sel] = t.as_tensor(force, device=self.force.device).to(t.float64)
 
     def substep(self, data) -> None:
         """One physics step's update of every world (``data``: the batched data's tensors):

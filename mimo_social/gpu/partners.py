@@ -57,10 +57,11 @@ class BatchedHandOffer:
         return {"target": np.array(self.partner.target_angles, float), "kp": kp, "kd": kd}
 
     def load(self, idx, captured) -> None:
+        """The captured plans (stacked: ``(len(idx), n)`` per key) into the worlds ``idx``."""
         t = self.batched.torch
         for key in ("target", "kp", "kd"):
-            rows = np.stack([c[key] for c in captured])
-            getattr(self, key)[idx] = t.as_tensor(rows, dtype=t.float32, device=self.kp.device)
+            getattr(self, key)[idx] = t.as_tensor(captured[key], device=self.kp.device).to(
+                t.float32)
 
     def act(self):
         """Every world's motor commands ``(nworld, n)`` from the current data (read before the

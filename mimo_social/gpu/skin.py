@@ -89,8 +89,8 @@ class BatchedSkin:
 
     def load(self, idx, readings) -> None:
         """Worlds ``idx`` (an int64 tensor) given the readings ``(len(idx), N + 1, 4)``."""
-        self.acc[idx] = self._torch.as_tensor(np.asarray(readings), dtype=self.acc.dtype,
-                                              device=self.acc.device)
+        self.acc[idx] = self._torch.as_tensor(readings, device=self.acc.device).to(
+            self.acc.dtype)
 
     # -- the update ------------------------------------------------------------------------------
     def feel(self, rows: dict, data: dict, h: float | None = None) -> None:

@@ -20,7 +20,8 @@ once (at construction and at ``reset(seed=...)``) and kept: the episode that wou
 ``seed + n`` takes the kept start ``n mod K`` (:meth:`BatchedTaskEnv.seed_of` names it). No
 CPU env is reset while stepping; while fewer than ``K`` episodes have started the episodes are
 those of host resets, after that the starts repeat (``K`` distinct starts in all). The kept
-rows still go from the host to the device at each reset.
+starts live on the device, stacked (:mod:`mimo_social.gpu.stacking`): a reset copies its
+worlds' rows there; the host only names which worlds and which starts (small integers).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ import numpy as np
 
 from ..util.checks import check_int, check_seed
 from .reset_bank import ResetBank
+from .stacking import rows_to, stack_rows
 from .batched import BatchedEnv
 from .partners import batched_partner
 from .tasks import task_class
@@ -71,7 +73,8 @@ class BatchedTaskEnv:
         self._seed = seed
         self._episode = np.zeros(self.nworld, np.int64)
         self._was_reset = False
-        self.bank = None if reset_bank is None else ResetBank(reset_bank, self._capture)
+        self.bank = None if reset_bank is None else ResetBank(
+            reset_bank, self._capture, lambda rows: rows_to(rows, self.torch, dev))
         if self.bank is not None:
             self.bank.fill(seed)
 
@@ -121,18 +124,21 @@ class BatchedTaskEnv:
 
     def _load(self, idx: np.ndarray) -> dict:
         """Each world's start (its seed's CPU reset, or the kept one) copied into the world."""
-        starts = [self.bank.start(self.seed_of(w) - self._seed) if self.bank is not None
-                  else self._capture(self.seed_of(w)) for w in idx.tolist()]
-        snaps = [s[0] for s in starts]
-        task_caps = [s[1] for s in starts]
-        partner_caps = {a: [s[2][a] for s in starts] for a in self.partners}
-        obs = self.batched.load(idx, snaps)
+        if not len(idx):
+            return self.batched.load(idx, [])
+        if self.bank is None:
+            rows = stack_rows([self._capture(self.seed_of(w)) for w in idx.tolist()])
+        else:
+            kept = [self.seed_of(w) - self._seed for w in idx.tolist()]
+            rows = self.bank.rows(self.torch.as_tensor(kept, dtype=self.torch.int64,
+                                                       device=self.steps.device))
+        snaps, task_caps, partner_caps = rows
+        obs = self.batched.load_rows(idx, snaps)
         tidx = self.torch.as_tensor(idx, dtype=self.torch.int64, device=self.steps.device)
-        if len(idx):
-            self.task.load(tidx, task_caps)
-            for a, p in self.partners.items():
-                p.load(tidx, partner_caps[a])
-            self.steps[tidx] = 0
+        self.task.load(tidx, task_caps)
+        for a, p in self.partners.items():
+            p.load(tidx, partner_caps[a])
+        self.steps[tidx] = 0
         return obs
 
     # -- the loop --------------------------------------------------------------------------------

@@ -11,7 +11,9 @@ are read from it) and the :class:`~mimo_social.gpu.batched.BatchedEnv` made of i
 * ``batch_fields``: the model fields its reset changes per world (reach: the ball's
   ``body_pos``), batched per world on the device;
 * ``capture(env)``: what the task's reset drew on the CPU env just reset (host work at resets);
-* ``load(idx, captured)``: that put into the worlds ``idx``, the per-world state reset;
+* ``load(idx, captured)``: that put into the worlds ``idx``, the per-world state reset
+  (``captured``: the captures of those worlds stacked, each key's values ``(len(idx), ...)``,
+  numpy or torch: :func:`~mimo_social.gpu.stacking.stack_rows`);
 * ``before_physics()``: the task's per-step hook (reach: head and eyes on the ball);
 * ``evaluate()``: ``(rewards (nworld, n_agents), terminated (nworld,), infos)``, infos a dict
   of the CPU task's info keys to ``(nworld,)`` tensors (``(nworld, n_agents)`` for per-agent
@@ -114,8 +116,7 @@ class BatchedReach(BatchedTask):
 
     def load(self, idx, captured) -> None:
         t = self.batched.torch
-        self.gaze[idx] = t.as_tensor(np.stack([c["gaze"] for c in captured]),
-                                     dtype=t.float32, device=self.gaze.device)
+        self.gaze[idx] = t.as_tensor(captured["gaze"], device=self.gaze.device).to(t.float32)
 
     def before_physics(self) -> None:
         data = self.batched.tensors
@@ -290,8 +291,8 @@ class BatchedSelfBody(BatchedTask):
 
     def load(self, idx, captured) -> None:
         t = self.batched.torch
-        self.target[idx] = t.as_tensor([c["target"] for c in captured], dtype=t.int64,
-                                       device=self.target.device)
+        self.target[idx] = t.as_tensor(captured["target"], device=self.target.device).to(
+            t.int64)
 
     def observe(self) -> list[dict]:
         t = self.batched.torch
