@@ -57,6 +57,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     parser.add_argument("--no-touch", dest="touch", action="store_false",
                         help="leave the touch skin out of the learner's observation (default: "
                              "observed where the task's env has touch: self-body, high five)")
+    parser.add_argument("--eyes", type=positive_int, default=None, metavar="SIDE",
+                        help="the learner also sees through its two eyes: square images of "
+                             "SIDE pixels (16 to 256), rendered on the device, encoded by a "
+                             "small CNN (default: no eyes)")
     parser.add_argument("--device", choices=("auto", "cpu", "cuda"), default="auto",
                         help="auto (default): a GPU when Warp sees one, else the CPU")
     parser.set_defaults(func=run)
@@ -69,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
     config = GpuPPOConfig(task=args.task, worlds=args.worlds, steps=args.steps, seed=args.seed,
                           learning_rate=args.lr, epochs=args.epochs, minibatch=args.minibatch,
                           rollout=args.rollout, max_steps=args.max_steps,
-                          entropy_coeff=args.entropy_coeff, touch=args.touch,
+                          entropy_coeff=args.entropy_coeff, touch=args.touch, eyes=args.eyes,
                           device=None if args.device == "auto" else args.device)
 
     def show(row):

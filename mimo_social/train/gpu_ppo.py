@@ -5,12 +5,15 @@ The worlds are a :class:`~mimo_social.gpu.GymVectorEnv` (torch tensors on Warp's
 when there is one, else the CPU) of reach, of self-body (its target observed as a one-hot) or
 of the high five's one-learner form (``infant_0`` learns, the scripted partner ``HandOffer``
 acts on the device). The learner is built from
-TorchRL's PPO pieces: a :class:`~torchrl.modules.ProbabilisticActor` with a tanh-normal
-distribution over the motors' Box (an MLP for the mean, a learnt state-independent log std), a
+TorchRL's PPO pieces (:mod:`mimo_social.train.gpu_networks`): a
+:class:`~torchrl.modules.ProbabilisticActor` with a tanh-normal distribution over the motors'
+Box (an MLP for the mean, a learnt state-independent log std), a
 :class:`~torchrl.modules.ValueOperator` critic MLP, :class:`~torchrl.objectives.value.GAE` and
 :class:`~torchrl.objectives.ClipPPOLoss`. Both networks start with the same running
 normalisation of the observations (:class:`RunningObsNorm`: the senses the device computes,
-concatenated; its statistics are buffers of the policy, saved with it).
+concatenated; its statistics are buffers of the policy, saved with it). With ``eyes`` the
+learner also sees through its two eyes (rendered on the device): each network encodes the
+images with its own small CNN and reads the encoding beside the normalised senses.
 
 Each iteration: ``rollout`` control steps of every world on the device (the policy samples,
 the env steps and resets finished worlds in the same step; a finished world's bootstrap value
@@ -41,24 +44,24 @@ from pathlib import Path
 import numpy as np
 import torch
 from tensordict import TensorDict
-from tensordict.nn import TensorDictModule
 from torch import nn
-from torchrl.envs.utils import ExplorationType, set_exploration_type
-from torchrl.modules import MLP, ProbabilisticActor, TanhNormal, ValueOperator
 from torchrl.objectives import ClipPPOLoss
 from torchrl.objectives.value import GAE
 
 from ..envs import high_five_v0, reach_v0, selfbody_v0
 from ..gpu import GymVectorEnv
+from .gpu_networks import RunningObsNorm, act, build_networks
 
-__all__ = ["TASKS", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObsNorm", "make_env",
-           "build_networks", "act", "train_gpu_ppo", "evaluate_gpu_ppo", "read_progress",
-           "plot_progress"]
+__all__ = ["TASKS", "EYE_SIDES", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObsNorm",
+           "make_env", "build_networks", "act", "train_gpu_ppo", "evaluate_gpu_ppo",
+           "read_progress", "plot_progress"]
 
 #: the tasks the on-device PPO trains: name -> the CPU env with one learner
 TASKS = {"reach": reach_v0.parallel_env, "high_five": high_five_v0.scripted_env,
          "selfbody": selfbody_v0.parallel_env}
 DEVICES = (None, "cpu", "cuda")
+#: the eye image sides (pixels) the learner's CNN takes
+EYE_SIDES = (16, 256)
 
 #: the columns of ``progress.csv``, one row per iteration; the episode columns are over the
 #: episodes that finished in the iteration (empty when none did)
@@ -76,7 +79,10 @@ class GpuPPOConfig:
     the CPU); ``reward_scale``: the rewards' factor for the critic and the advantages (the
     progress reports unscaled returns); ``max_steps``: the episodes' length (None: the
     task's); ``hidden``: the width of both MLPs' two hidden layers; ``touch``: the touch skin
-    in the learner's observation where the task's env has touch (self-body, high five)."""
+    in the learner's observation where the task's env has touch (self-body, high five);
+    ``eyes``: the learner's two eyes observed, square images of this side in pixels
+    (:data:`EYE_SIDES`; rendered on the device, encoded by a small CNN:
+    :class:`~mimo_social.train.gpu_networks.EyeEncoder`), or None (no eyes)."""
 
     task: str = "reach"
     worlds: int = 64
@@ -98,6 +104,7 @@ class GpuPPOConfig:
     hidden: int = 64
     max_steps: int | None = None
     touch: bool = True
+    eyes: int | None = None
 
     def __post_init__(self):
         if self.task not in TASKS:
@@ -110,6 +117,10 @@ class GpuPPOConfig:
             _bad("seed", self.seed, "an integer >= 0")
         if not isinstance(self.touch, bool):
             _bad("touch", self.touch, "True or False")
+        lo, hi = EYE_SIDES
+        if self.eyes is not None and (isinstance(self.eyes, bool) or not isinstance(
+                self.eyes, int) or not lo <= self.eyes <= hi):
+            _bad("eyes", self.eyes, f"None (no eyes) or an image side from {lo} to {hi} pixels")
         if self.max_steps is not None and (isinstance(self.max_steps, bool) or not isinstance(
                 self.max_steps, int) or self.max_steps < 1):
             _bad("max_steps", self.max_steps, "None or a positive integer")
@@ -151,115 +162,42 @@ def _bad(name, value, allowed):
     raise ValueError(f"{name}={value!r} not allowed; allowed: {allowed}")
 
 
-class RunningObsNorm(nn.Module):
-    """Observations shifted and scaled by running estimates of their mean and variance
-    (clipped to +-``clip``); the estimates are buffers (``mean``, ``var``, ``count``), changed
-    only by :meth:`update`, never by the forward pass."""
-
-    def __init__(self, size: int, clip: float = 10.0, eps: float = 1e-8):
-        super().__init__()
-        self.clip, self.eps = float(clip), float(eps)
-        self.register_buffer("mean", torch.zeros(size))
-        self.register_buffer("var", torch.ones(size))
-        self.register_buffer("count", torch.zeros(()))
-
-    @torch.no_grad()
-    def update(self, x: torch.Tensor) -> None:
-        """Merge a batch ``(..., size)`` into the estimates (Chan et al.'s parallel rule)."""
-        x = x.reshape(-1, self.mean.shape[0]).to(self.mean.dtype)
-        n = float(x.shape[0])
-        if n == 0:
-            return
-        mean, var = x.mean(0), x.var(0, unbiased=False)
-        total = self.count + n
-        delta = mean - self.mean
-        m2 = self.var * self.count + var * n + delta.square() * self.count * n / total
-        self.mean += delta * n / total
-        self.var.copy_(m2 / total)
-        self.count.copy_(total)
-
-    def forward(self, x: torch.Tensor) -> torch.Tensor:
-        z = (x - self.mean) / torch.sqrt(self.var + self.eps)
-        return z.clamp(-self.clip, self.clip)
-
-
-class _Gaussian(nn.Module):
-    """Normalised observation -> (loc, scale): an MLP for the mean, a learnt log std."""
-
-    def __init__(self, norm: RunningObsNorm, n_obs: int, n_act: int, hidden: int,
-                 init_log_std: float):
-        super().__init__()
-        self.norm = norm
-        self.mlp = MLP(in_features=n_obs, out_features=n_act, num_cells=[hidden, hidden],
-                       activation_class=nn.Tanh)
-        self.log_std = nn.Parameter(torch.full((n_act,), float(init_log_std)))
-
-    def forward(self, obs):
-        loc = self.mlp(self.norm(obs))
-        return loc, self.log_std.exp().expand_as(loc)
-
-
-class _Value(nn.Module):
-    def __init__(self, norm: RunningObsNorm, n_obs: int, hidden: int):
-        super().__init__()
-        self.norm = norm
-        self.mlp = MLP(in_features=n_obs, out_features=1, num_cells=[hidden, hidden],
-                       activation_class=nn.Tanh)
-
-    def forward(self, obs):
-        return self.mlp(self.norm(obs))
-
-
 def make_env(config: GpuPPOConfig) -> GymVectorEnv:
     """The batched worlds of ``config.task`` as a Gymnasium vector env of torch tensors."""
     kw = {} if config.max_steps is None else {"max_steps": config.max_steps}
+    if config.eyes is not None:
+        kw["vision"] = {"width": config.eyes, "height": config.eyes}
     return GymVectorEnv(TASKS[config.task](**kw), config.worlds, device=config.device,
                         seed=config.seed, touch=config.touch)
 
 
-def build_networks(n_obs: int, low: torch.Tensor, high: torch.Tensor, config: GpuPPOConfig):
-    """The actor (a :class:`ProbabilisticActor`: ``"observation"`` -> ``"action"`` in
-    ``[low, high]`` and its log-probability) and the critic (``"observation"`` ->
-    ``"state_value"``), sharing one :class:`RunningObsNorm`; returns ``(actor, critic,
-    norm)``."""
-    norm = RunningObsNorm(n_obs).to(low.device)
-    n_act = int(low.shape[-1])
-    gauss = _Gaussian(norm, n_obs, n_act, config.hidden, config.init_log_std).to(low.device)
-    actor = ProbabilisticActor(
-        TensorDictModule(gauss, in_keys=["observation"], out_keys=["loc", "scale"]),
-        in_keys=["loc", "scale"], distribution_class=TanhNormal,
-        distribution_kwargs={"low": low, "high": high}, return_log_prob=True)
-    critic = ValueOperator(_Value(norm, n_obs, config.hidden).to(low.device),
-                           in_keys=["observation"])
-    return actor, critic, norm
-
-
-@torch.no_grad()
-def act(actor, obs: torch.Tensor, explore: bool = True) -> TensorDict:
-    """The actor on ``obs`` ``(n, size)``: the actions sampled from its distribution
-    (``explore``; TorchRL's modules take the distribution's mode unless told to sample) or its
-    deterministic action, with their log-probabilities, as a TensorDict ``(n,)``."""
-    kind = ExplorationType.RANDOM if explore else ExplorationType.DETERMINISTIC
-    with set_exploration_type(kind):
-        return actor(TensorDict({"observation": obs}, batch_size=[obs.shape[0]],
-                                device=obs.device))
-
-
 def _start(config: GpuPPOConfig):
-    """The vector env reset with the config's seed, its first observations (flat) and fresh
-    networks sized for them: ``(venv, obs, (actor, critic, norm))``."""
+    """The vector env reset with the config's seed, its first inputs (:func:`_inputs`) and
+    fresh networks sized for them: ``(venv, inputs, (actor, critic, norm))``."""
     venv = make_env(config)
     obs_dict, _ = venv.reset(seed=config.seed)
-    obs = _flat(obs_dict)
+    inputs = _inputs(obs_dict)
     space = venv.single_action_space
-    low = torch.as_tensor(space.low, dtype=torch.float32, device=obs.device)
-    high = torch.as_tensor(space.high, dtype=torch.float32, device=obs.device)
-    return venv, obs, build_networks(int(obs.shape[-1]), low, high, config)
+    dev = inputs["observation"].device
+    low = torch.as_tensor(space.low, dtype=torch.float32, device=dev)
+    high = torch.as_tensor(space.high, dtype=torch.float32, device=dev)
+    pixels = inputs.get("pixels")
+    eyes = None if pixels is None else tuple(pixels.shape[1:])
+    return venv, inputs, build_networks(int(inputs["observation"].shape[-1]), low, high,
+                                        config, eyes)
 
 
-def _flat(obs: dict) -> torch.Tensor:
-    """The senses of one observation Dict, concatenated in their order, ``(n, size)``."""
-    return torch.cat([obs[k].to(torch.float32) for k in obs], dim=-1)
+def _inputs(obs: dict) -> dict:
+    """The networks' inputs from one observation Dict: ``"observation"``, the senses other than
+    the eyes concatenated in their order (float32 ``(n, size)``), and where the eyes are
+    observed ``"pixels"``, ``eye_left`` and ``eye_right`` stacked along the colour axis (uint8
+    ``(n, H, W, 6)``)."""
+    eyes = [k for k in ("eye_left", "eye_right") if k in obs]
+    out = {"observation": torch.cat([obs[k].to(torch.float32).flatten(1) for k in obs
+                                     if k not in eyes], dim=-1)}
+    if eyes:
+        out["pixels"] = torch.cat([obs[k] for k in eyes], dim=-1)
+    return out
 
 
 def train_gpu_ppo(config: GpuPPOConfig, out, progress=None) -> dict:
@@ -275,8 +213,8 @@ def train_gpu_ppo(config: GpuPPOConfig, out, progress=None) -> dict:
         torch.set_num_threads(1)   # the same sums every run (and Warp's CPU device beside it)
     t0 = time.perf_counter()
     venv, obs, (actor, critic, norm) = _start(config)
-    dev = obs.device
-    norm.update(obs)
+    dev = obs["observation"].device
+    norm.update(obs["observation"])
     loss_fn = ClipPPOLoss(actor, critic, clip_epsilon=config.clip_epsilon,
                           entropy_bonus=config.entropy_coeff > 0,
                           entropy_coeff=config.entropy_coeff or None,
@@ -288,7 +226,8 @@ def train_gpu_ppo(config: GpuPPOConfig, out, progress=None) -> dict:
     gen = torch.Generator(device="cpu").manual_seed(config.seed)
     build_s = time.perf_counter() - t0
     meta = {"config": asdict(config), "device": str(dev), "device_name": venv.device_name,
-            "observation_size": int(obs.shape[-1]),
+            "observation_size": int(obs["observation"].shape[-1]),
+            "pixels": list(obs["pixels"].shape[1:]) if "pixels" in obs else None,
             "action_size": int(venv.single_action_space.shape[-1]),
             "build_s": build_s}
     (out / "config.json").write_text(json.dumps(meta, indent=1))
@@ -322,14 +261,14 @@ def train_gpu_ppo(config: GpuPPOConfig, out, progress=None) -> dict:
 def _collect(venv, actor, obs, ep_return, ep_length, config):
     """``config.rollout`` steps of every world; the batch ``(worlds, rollout)``, the next
     observation and the iteration's episode sums (one read from the device)."""
-    dev = obs.device
+    dev = obs["observation"].device
     steps, sums = [], torch.zeros(4, device=dev)   # episodes, returns, lengths, successes
     for _ in range(config.rollout):
         td = act(actor, obs)
         nxt, rew, term, trunc, infos = venv.step(td["action"])
         rew = rew.to(torch.float32)
         done = term | trunc
-        final = _flat(infos["final_obs"])
+        final = _inputs(infos["final_obs"])
         ep_return += rew
         ep_length += 1
         d = done.to(torch.float32)
@@ -339,11 +278,11 @@ def _collect(venv, actor, obs, ep_return, ep_length, config):
         ep_return *= 1.0 - d
         ep_length *= 1.0 - d
         td.set("next", TensorDict({
-            "observation": final, "reward": (rew * config.reward_scale)[:, None],
+            **final, "reward": (rew * config.reward_scale)[:, None],
             "done": done[:, None], "terminated": term[:, None]},
             batch_size=[config.worlds], device=dev))
         steps.append(td)
-        obs = _flat(nxt)
+        obs = _inputs(nxt)
     batch = torch.stack(steps, dim=1)   # (worlds, rollout): time last, as GAE reads it
     return batch, obs, sums.tolist()
 
@@ -399,7 +338,7 @@ def evaluate_gpu_ppo(run, worlds: int = 64, seed: int = 1_000_000, explore: bool
     config = GpuPPOConfig(**settings)
     torch.manual_seed(config.seed)
     venv, obs, (actor, _, _) = _start(config)
-    dev = obs.device
+    dev = obs["observation"].device
     actor.load_state_dict(torch.load(run / "policy.pt", map_location=dev))
     n = config.worlds
     ret, length = torch.zeros(n, device=dev), torch.zeros(n, device=dev)
@@ -415,7 +354,7 @@ def evaluate_gpu_ppo(run, worlds: int = 64, seed: int = 1_000_000, explore: bool
         finished |= term | trunc
         ret *= ~(term | trunc)
         length *= ~(term | trunc)
-        obs = _flat(nxt)
+        obs = _inputs(nxt)
         if bool(finished.all()):
             break
     venv.close()

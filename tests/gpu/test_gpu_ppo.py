@@ -154,6 +154,8 @@ def test_gpu_ppo_running_normalisation_is_the_mean_and_variance_of_all_rows():
     ("max_steps", 0, "None or a positive integer"),
     ("entropy_coeff", -0.1, "a number >= 0"),
     ("minibatch", 129, "at most worlds * rollout = 4 * 32 = 128"),
+    ("eyes", 8, "None (no eyes) or an image side from 16 to 256 pixels"),
+    ("eyes", True, "None (no eyes) or an image side from 16 to 256 pixels"),
 ])
 def test_gpu_ppo_refuses_bad_settings_naming_them(setting, value, allowed):
     kw = {"worlds": 4, setting: value}
