@@ -36,7 +36,7 @@ from ..tasks.common import right_hand_parts
 from ..tasks.high_five.task import PALM_COS
 
 __all__ = ["TASKS", "BatchedTask", "BatchedFreePlay", "BatchedReach", "BatchedHighFive",
-           "BatchedSelfBody", "batched_task", "task_class"]
+           "BatchedSelfBody", "BatchedStandup", "batched_task", "task_class"]
 
 
 class BatchedTask:
@@ -333,9 +333,60 @@ class BatchedSelfBody(BatchedTask):
         return reward[:, None], success, infos
 
 
+class BatchedStandup(BatchedTask):
+    """Stand-up (:class:`mimo_social.tasks.standup.Standup`): the reward is the head's height
+    above the reference minus ``cost_weight`` times the squared applied controls (after the
+    motor delay, as the CPU env's ``controls``); success: the head ``success_gain`` above its
+    settled start height for ``success_hold`` s in a row (a per-world step count); the episode
+    ends at the time limit only. Each world's start height and reference (the head's height
+    after the CPU reset's settling, where the option asks for it) come from the CPU env reset
+    with the world's seed."""
+
+    name = "standup"
+    info_keys = ("head_height", "head_gain", "is_success", "control_cost")
+
+    def __init__(self, env, batched):
+        super().__init__(env, batched)
+        torch = batched.torch
+        opts = env.task.options
+        dev = batched.qpos.device
+        self.head = int(env.world.agents[0].head_site)
+        self.cost_weight = float(opts.cost_weight)
+        self.success_gain = float(opts.success_gain)
+        self.hold_steps = max(1, round(float(opts.success_hold) / float(env.dt)))
+        self.controls = batched.controls[0]
+        n = batched.nworld
+        self.start = torch.zeros(n, dtype=torch.float32, device=dev)
+        self.ref = torch.zeros(n, dtype=torch.float32, device=dev)
+        self.above = torch.zeros(n, dtype=torch.int64, device=dev)
+
+    def capture(self, env) -> dict:
+        return {"start": float(env.task.start_height), "ref": float(env.task.reference)}
+
+    def load(self, idx, captured) -> None:
+        t = self.batched.torch
+        for key in ("start", "ref"):
+            getattr(self, key)[idx] = t.as_tensor(captured[key], device=self.ref.device).to(
+                t.float32)
+        self.above[idx] = 0
+
+    def evaluate(self):
+        t = self.batched.torch
+        height = self.batched.tensors["site_xpos"][:, self.head, 2].to(t.float32)
+        u = self.controls.applied
+        cost = self.cost_weight * (u * u).sum(1)
+        gain = height - self.start
+        self.above = t.where(gain >= self.success_gain, self.above + 1,
+                             t.zeros_like(self.above))
+        success = self.above >= self.hold_steps
+        infos = {"head_height": height, "head_gain": gain, "is_success": success,
+                 "control_cost": cost}
+        return (height - self.ref - cost)[:, None], t.zeros_like(success), infos
+
+
 #: the batched task logic by task name
 TASKS = {"free_play": BatchedFreePlay, "reach": BatchedReach, "high_five": BatchedHighFive,
-         "selfbody": BatchedSelfBody}
+         "selfbody": BatchedSelfBody, "standup": BatchedStandup}
 
 
 def task_class(name: str):

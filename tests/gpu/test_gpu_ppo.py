@@ -141,7 +141,7 @@ def test_gpu_ppo_running_normalisation_is_the_mean_and_variance_of_all_rows():
 
 
 @pytest.mark.parametrize("setting, value, allowed", [
-    ("task", "catch", "one of reach, high_five, selfbody"),
+    ("task", "catch", "one of reach, high_five, selfbody, standup"),
     ("worlds", 0, "a positive integer"),
     ("steps", -5, "a positive integer"),
     ("epochs", 1.5, "a positive integer"),

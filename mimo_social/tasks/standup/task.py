@@ -193,6 +193,16 @@ class Standup(Task):
         self._above = 0   # steps in a row with the head success_gain above its start
         self._hold_steps = max(1, round(self.options.success_hold / env.dt))
 
+    @property
+    def start_height(self) -> float:
+        """The head's height (m) after this episode's settling."""
+        return self._start_height
+
+    @property
+    def reference(self) -> float:
+        """The height (m) the reward subtracts from the head's: the option, or the start's."""
+        return self._ref
+
     def _model_settings(self, env):
         """The model values the task sets at reset (a pickled env carries them: its MjData
         travels with its model)."""
