@@ -259,7 +259,6 @@ class Imitation(Task):
         self._dt = float(env.dt)
 
     def reset(self, env, rng):
-        w = env.world
         self._allowed = np.zeros(len(ACTIONS), bool)
         self._allowed[self.action_ids] = True
         self._weights = np.array([1.0, 0.0 if self.options.scripted_partner else 1.0])

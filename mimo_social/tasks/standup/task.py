@@ -175,7 +175,6 @@ class Standup(Task):
     def reset(self, env, rng):
         w = env.world
         m, d = w.model, w.data
-        a = w.agents[0]
         self._model_settings(env)
         d.qpos[:] = self._start
         d.qvel[:] = 0.0
