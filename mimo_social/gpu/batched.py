@@ -370,6 +370,12 @@ class BatchedEnv:
         """The number of motor values of ``agent``'s actions."""
         return self.controls[self.agents.index(agent)].n
 
+    def kinematics(self) -> None:
+        """Every world's body, site and camera poses from its current ``qpos`` (MuJoCo Warp's
+        ``kinematics``), e.g. after a task set joint angles by hand."""
+        with self._on_device():
+            self._mjw.kinematics(self.model, self.data)
+
 
 def _positional_reset_u(act, mjm, mjd):
     """The controls a positional agent reports at reset (the targets of the pose it holds:

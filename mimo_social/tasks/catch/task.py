@@ -162,6 +162,16 @@ class Catch(Task):
         m.body_inertia[b] = 0.4 * mass * radius * radius
         self._radius, self._mass = float(radius), float(mass)
 
+    @property
+    def ball_radius(self) -> float:
+        """This episode's ball radius (m)."""
+        return self._radius
+
+    @property
+    def ball_mass(self) -> float:
+        """This episode's ball mass (kg)."""
+        return self._mass
+
     def hold_hand(self, env) -> None:
         """Set the agent's controls (and, for muscles, their activations) to those that hold
         the wrist and fingers where they are against gravity and the joints' springs (static:
