@@ -128,8 +128,8 @@ class BatchedEnv:
         self.faces = BatchedFaces(env, self.nworld, torch, tdev, self.model_tensors.get("mat_texid"))
         #: the agents' eyes on the device (None: no agent has vision, or ``eyes=False``)
         self.eyes = None if vision is None else BatchedEyes(
-            vision, mjm, self.model, self.data, self.nworld, dict(enumerate(self.agents)), wp,
-            mjw, torch, tdev, self._on_device)
+            vision, mjm, self.model, self.data, self.nworld, wp, mjw, torch, tdev,
+            self._on_device)
         self.controls, self.senses = [], []
         for i, name in enumerate(self.agents):
             act = env.actuation[i]

@@ -91,16 +91,15 @@ def ray_traced_textures(mjm):
 
 
 class BatchedEyes:
-    """The eyes of the agents ``names`` (index -> name) that have vision in the CPU env whose
-    vision system is ``system`` (its compiled model ``mjm``), for the ``nworld`` worlds of the
-    Warp ``model`` and ``data``; ``on_device``: the context that runs Warp's work on the
-    device (:class:`~mimo_social.gpu.batched.BatchedEnv`'s); the images live on torch's
-    ``device``. :attr:`images`: ``(agent, key)`` -> the current images of every world, the
-    keys those of the CPU sense (``eye_left``, ``eye_right``; with depth on ``depth_left``,
-    ``depth_right``)."""
+    """The eyes of the agents that have vision in the CPU env whose vision system is
+    ``system`` (its compiled model ``mjm``), for the ``nworld`` worlds of the Warp ``model``
+    and ``data``; ``on_device``: the context that runs Warp's work on the device
+    (:class:`~mimo_social.gpu.batched.BatchedEnv`'s); the images live on torch's ``device``.
+    :attr:`images`: ``(agent, key)`` -> the current images of every world, the keys those of
+    the CPU sense (``eye_left``, ``eye_right``; with depth on ``depth_left``, ``depth_right``)."""
 
-    def __init__(self, system, mjm, model, data, nworld: int, names: dict, wp, mjw, torch,
-                 device, on_device):
+    def __init__(self, system, mjm, model, data, nworld: int, wp, mjw, torch, device,
+                 on_device):
         self._torch, self._mjw = torch, mjw
         self._model, self._data, self._on_device = model, data, on_device
         self.agents = list(system.agents)
@@ -143,7 +142,8 @@ class BatchedEyes:
             shape = (nworld, cfg.height, cfg.width) + ((3,) if key.startswith("eye") else ())
             dtype = torch.uint8 if key.startswith("eye") else torch.float32
             self.images[i, key] = torch.zeros(shape, dtype=dtype, device=device)
-        #: the control steps since each world's reset (the step after a reset is its 0th)
+        #: per world, the steps since its reset: the reset's render is its 0th, the k-th control
+        #: step after it the k-th (an agent's eyes render where this is a multiple of ``every``)
         self.count = torch.zeros(nworld, dtype=torch.int64, device=device)
         self._all = torch.ones(nworld, dtype=torch.bool, device=device)
         self.renders = 0
@@ -154,7 +154,8 @@ class BatchedEyes:
 
     def render(self, worlds=None) -> None:
         """After a reset or load of ``worlds`` (a bool mask; None: all): render every eye from
-        the current state and keep the images of those worlds; their steps count from 0."""
+        the current state and keep the images of those worlds (their step 0; the next control
+        step is their step 1)."""
         mask = self._all if worlds is None else worlds
         self.count[mask] = 1
         self._draw({i: (None if worlds is None else mask) for i in self.agents})

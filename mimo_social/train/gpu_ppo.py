@@ -3,8 +3,8 @@ pulling every step back to the host (issue 34; ``mimo-social train-gpu``; docs/g
 
 The worlds are a :class:`~mimo_social.gpu.GymVectorEnv` (torch tensors on Warp's device: a GPU
 when there is one, else the CPU) of reach, of stand-up, of catch, of self-body (its target
-observed as a one-hot) or of the high five's one-learner form (``infant_0`` learns, the scripted partner ``HandOffer``
-acts on the device). The learner is built from
+observed as a one-hot) or of the high five's one-learner form (``infant_0`` learns, the
+scripted partner ``HandOffer`` acts on the device). The learner is built from
 TorchRL's PPO pieces (:mod:`mimo_social.train.gpu_networks`): a
 :class:`~torchrl.modules.ProbabilisticActor` with a tanh-normal distribution over the motors'
 Box (an MLP for the mean, a learnt state-independent log std), a
