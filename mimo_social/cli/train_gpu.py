@@ -21,17 +21,17 @@ __all__ = ["NAME", "add_parser", "run"]
 NAME = "train-gpu"
 #: the names of :data:`mimo_social.train.gpu_ppo.TASKS`, spelt out so that building the parser
 #: imports no torch (tests/gpu/test_gpu_ppo.py checks that the two agree)
-TASKS = ("reach", "high_five", "selfbody", "standup", "catch")
+TASKS = ("reach", "high_five", "selfbody", "standup", "catch", "rollover")
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     parser = subparsers.add_parser(
         NAME, help="PPO on MuJoCo Warp's batched worlds, on the device (reach, high five, "
-             "self-body, stand-up, catch)",
+             "self-body, stand-up, catch, roll-over)",
         description="PPO (TorchRL's ClipPPOLoss and GAE) on N batched MuJoCo Warp worlds of "
-                    "reach, of self-body, of stand-up, of catch or of the high five with its "
-                    "scripted partner, collected and learnt on the device: a GPU when Warp sees "
-                    "one, else Warp's CPU device.")
+                    "reach, of self-body, of stand-up, of catch, of roll-over or of the high "
+                    "five with its scripted partner, collected and learnt on the device: a GPU "
+                    "when Warp sees one, else Warp's CPU device.")
     parser.add_argument("--task", choices=TASKS, required=True, help="the task to learn")
     parser.add_argument("--worlds", type=positive_int, default=64,
                         help="worlds stepped together (default 64)")

@@ -2,9 +2,9 @@
 pulling every step back to the host (issue 34; ``mimo-social train-gpu``; docs/gpu.md).
 
 The worlds are a :class:`~mimo_social.gpu.GymVectorEnv` (torch tensors on Warp's device: a GPU
-when there is one, else the CPU) of reach, of stand-up, of catch, of self-body (its target
-observed as a one-hot) or of the high five's one-learner form (``infant_0`` learns, the
-scripted partner ``HandOffer`` acts on the device). The learner is built from
+when there is one, else the CPU) of reach, of stand-up, of roll-over, of catch, of self-body
+(its target observed as a one-hot) or of the high five's one-learner form (``infant_0``
+learns, the scripted partner ``HandOffer`` acts on the device). The learner is built from
 TorchRL's PPO pieces (:mod:`mimo_social.train.gpu_networks`): a
 :class:`~torchrl.modules.ProbabilisticActor` with a tanh-normal distribution over the motors'
 Box (an MLP for the mean, a learnt state-independent log std), a
@@ -48,7 +48,7 @@ from torch import nn
 from torchrl.objectives import ClipPPOLoss
 from torchrl.objectives.value import GAE
 
-from ..envs import catch_v0, high_five_v0, reach_v0, selfbody_v0, standup_v0
+from ..envs import catch_v0, high_five_v0, reach_v0, rollover_v0, selfbody_v0, standup_v0
 from ..gpu import GymVectorEnv
 from .gpu_networks import RunningObsNorm, act, build_networks
 
@@ -59,7 +59,7 @@ __all__ = ["TASKS", "EYE_SIDES", "PROGRESS_COLUMNS", "GpuPPOConfig", "RunningObs
 #: the tasks the on-device PPO trains: name -> the CPU env with one learner
 TASKS = {"reach": reach_v0.parallel_env, "high_five": high_five_v0.scripted_env,
          "selfbody": selfbody_v0.parallel_env, "standup": standup_v0.parallel_env,
-         "catch": catch_v0.parallel_env}
+         "catch": catch_v0.parallel_env, "rollover": rollover_v0.parallel_env}
 DEVICES = (None, "cpu", "cuda")
 #: the eye image sides (pixels) the learner's CNN takes
 EYE_SIDES = (16, 256)

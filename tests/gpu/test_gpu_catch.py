@@ -1,4 +1,4 @@
-"""Catch's task logic on the device (:class:`~mimo_social.gpu.tasks.BatchedCatch`), on Warp's
+"""Catch's task logic on the device (:class:`~mimo_social.gpu.motor_tasks.BatchedCatch`), on Warp's
 CPU device, against the CPU env on the catalogue's scripted catches: the gaze following the
 ball (:class:`~mimo_social.gpu.gaze.BatchedGaze`), each world's ball (radius and mass per
 world), the touch and hold counts, success, the rewards with the muscles' effort."""

@@ -141,7 +141,7 @@ def test_gpu_ppo_running_normalisation_is_the_mean_and_variance_of_all_rows():
 
 
 @pytest.mark.parametrize("setting, value, allowed", [
-    ("task", "rollover", "one of reach, high_five, selfbody, standup, catch"),
+    ("task", "mirror", "one of reach, high_five, selfbody, standup, catch, rollover"),
     ("worlds", 0, "a positive integer"),
     ("steps", -5, "a positive integer"),
     ("epochs", 1.5, "a positive integer"),
@@ -182,7 +182,7 @@ def test_gpu_ppo_command_trains_a_tiny_run(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv, option", [
-    (["--task", "rollover"], "--task"), (["--worlds", "0"], "--worlds"),
+    (["--task", "mirror"], "--task"), (["--worlds", "0"], "--worlds"),
     (["--steps", "x"], "--steps"), (["--seed", "-1"], "--seed"), (["--lr", "0"], "--lr"),
     (["--entropy-coeff", "-1"], "--entropy-coeff"), (["--device", "tpu"], "--device")])
 def test_gpu_ppo_command_refuses_bad_flags_before_running(argv, option, tmp_path, capsys,

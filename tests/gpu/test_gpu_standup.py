@@ -1,4 +1,4 @@
-"""Stand-up's task logic on the device (:class:`~mimo_social.gpu.tasks.BatchedStandup`), on
+"""Stand-up's task logic on the device (:class:`~mimo_social.gpu.motor_tasks.BatchedStandup`), on
 Warp's CPU device, against the CPU env on the catalogue's scripted episodes: the reward (the
 head's height above the reference minus the control cost), the start height of each world's
 seed, success after the hold, no termination."""
