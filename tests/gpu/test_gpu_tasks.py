@@ -334,7 +334,8 @@ def test_gpu_free_play_has_no_reward_and_ends_at_its_time_limit():
 
 def test_gpu_task_env_refuses_what_the_device_does_not_run():
     with pytest.raises(ValueError, match=r"task 'mirror' has no batched task logic .*"
-                                         r"allowed: free_play, high_five, reach, selfbody"):
+                                         r"allowed: catch, free_play, high_five, reach, rollover, "
+                                         r"selfbody, standup"):
         BatchedTaskEnv(mirror_v0.parallel_env(), 1, device="cpu")
     with pytest.raises(ValueError, match=r"high_five: task option assisted_gaze=True does not "
                                          r"run .* allowed: assisted_gaze=False"):
