@@ -414,8 +414,9 @@ def plot_progress(run, path=None, window: int = 5) -> Path:
             top.set_xlabel("wall time, s")
     axes[0].set_ylim(-0.02, 1.02)
     axes[0].legend(loc="upper left", fontsize=8)
-    fig.suptitle(f"PPO on the device: {cfg['task']}, {cfg['worlds']} worlds, seed {cfg['seed']}"
-                 f" ({meta['device_name']})", fontsize=10)
+    eyes = f", eyes {cfg['eyes']}x{cfg['eyes']}" if cfg.get("eyes") else ""
+    fig.suptitle(f"PPO on the device: {cfg['task']}{eyes}, {cfg['worlds']} worlds, seed "
+                 f"{cfg['seed']} ({meta['device_name']})", fontsize=10)
     fig.tight_layout()
     path = Path(path) if path is not None else run / "learning_curve.png"
     fig.savefig(path, dpi=110)
