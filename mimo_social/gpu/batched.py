@@ -236,7 +236,7 @@ class BatchedEnv:
         sequence of world indices); the other worlds are not touched (no physics runs: the
         derived fields come from the snapshots). Returns the observations as :meth:`reset`
         (rows of the worlds not loaded: not meaningful)."""
-        idx = np.asarray(list(worlds) if not hasattr(worlds, "__len__") else worlds, np.int64)
+        idx = np.asarray(worlds, dtype=np.int64)
         if len(snaps) != len(idx):
             raise ValueError(f"{len(snaps)} snapshots for {len(idx)} worlds")
         if not len(idx):

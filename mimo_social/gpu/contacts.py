@@ -72,6 +72,16 @@ class BatchedContacts:
         out.index_add_(0, w, rows.to(t.int32))
         return out > 0
 
+    def distinct_per_world(self, rows, keys, size: int):
+        """``(nworld,)``: how many distinct values of ``keys`` (per row, each in ``0 .. size -
+        1``, e.g. the other geom's id or its body's) the rows of ``rows`` (a mask) carry in each
+        world."""
+        t = self._torch
+        w = self.worldid.long().clamp(0, self.nworld - 1)
+        count = t.zeros(self.nworld * size, dtype=t.int32, device=rows.device)
+        count.index_add_(0, w * size + keys, rows.to(t.int32))
+        return (count.reshape(self.nworld, size) > 0).sum(1)
+
     def normal_forces(self):
         """Each row's normal force (N; MuJoCo's ``mj_contactForce``, Warp's ``contact_force``;
         0 for rows not in use or left out of the constraints), ``(naconmax,)``."""

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..core.kinematics import LookAt, hand_geoms
 from .gaze import BatchedGaze
-from .task_base import BatchedTask
+from .task_base import BatchedTask, hold_steps, streak
 
 __all__ = ["BatchedStandup", "BatchedRollOver", "BatchedCatch"]
 
@@ -34,7 +34,7 @@ class BatchedStandup(BatchedTask):
         self.head = int(env.world.agents[0].head_site)
         self.cost_weight = float(opts.cost_weight)
         self.success_gain = float(opts.success_gain)
-        self.hold_steps = max(1, round(float(opts.success_hold) / float(env.dt)))
+        self.hold_steps = hold_steps(opts.success_hold, env.dt)
         self.controls = batched.controls[0]
         n = batched.nworld
         self.start = torch.zeros(n, dtype=torch.float32, device=dev)
@@ -57,8 +57,7 @@ class BatchedStandup(BatchedTask):
         u = self.controls.applied
         cost = self.cost_weight * (u * u).sum(1)
         gain = height - self.start
-        self.above = t.where(gain >= self.success_gain, self.above + 1,
-                             t.zeros_like(self.above))
+        self.above = streak(self.above, gain >= self.success_gain)
         success = self.above >= self.hold_steps
         infos = {"head_height": height, "head_gain": gain, "is_success": success,
                  "control_cost": cost}
@@ -85,7 +84,7 @@ class BatchedRollOver(BatchedTask):
         self.sign = -1.0 if o.start == "prone" else 1.0
         self.success_angle = float(o.success_angle)
         self.over_bonus, self.cost_weight = float(o.over_bonus), float(o.cost_weight)
-        self.hold_steps = max(1, round(float(o.success_hold) / float(env.dt)))
+        self.hold_steps = hold_steps(o.success_hold, env.dt)
         self.controls = batched.controls[0]
         self.turned = torch.zeros(batched.nworld, dtype=torch.int64, device=batched.qpos.device)
 
@@ -99,7 +98,7 @@ class BatchedRollOver(BatchedTask):
         u = self.controls.applied
         cost = self.cost_weight * (u * u).sum(1)
         over = angle >= self.success_angle
-        self.turned = t.where(over, self.turned + 1, t.zeros_like(self.turned))
+        self.turned = streak(self.turned, over)
         success = self.turned >= self.hold_steps
         reward = angle / 180.0 + self.over_bonus * over.to(t.float32) - cost
         infos = {"turn_angle": angle, "is_success": success, "control_cost": cost}
@@ -157,7 +156,7 @@ class BatchedCatch(BatchedTask):
         self.nbody = int(m.nbody)
         self.gaze = BatchedGaze(LookAt(w, 0, a.gaze_idx), batched)
         self.opts = o
-        self.hold_steps = max(1, round(float(o.hold_time) / float(env.dt)))
+        self.hold_steps = hold_steps(o.hold_time, env.dt)
         self.max_steps = int(env.max_steps)
         n = batched.nworld
         self.held = torch.zeros(n, dtype=torch.int64, device=dev)
@@ -195,15 +194,12 @@ class BatchedCatch(BatchedTask):
         """Per world: the infant's body parts touching the ball, and whether the hand does."""
         t = self.batched.torch
         c = self.contacts
-        n = self.batched.nworld
         g0, g1 = c.sides()
         on = c.valid() & (c.dist <= 0.0) & ((g0 == self.ball_geom) | (g1 == self.ball_geom))
         other = t.where(g0 == self.ball_geom, g1, g0)
         mine = on & self.mine[other]
-        world = c.worldid.long().clamp(0, n - 1)
-        parts = t.zeros(n * self.nbody, dtype=t.int32, device=other.device)
-        parts.index_add_(0, world * self.nbody + self.body_of[other], mine.to(t.int32))
-        return (parts.reshape(n, self.nbody) > 0).sum(1), c.per_world(mine & self.hand[other])
+        return (c.distinct_per_world(mine, self.body_of[other], self.nbody),
+                c.per_world(mine & self.hand[other]))
 
     def evaluate(self):
         t = self.batched.torch
@@ -211,7 +207,7 @@ class BatchedCatch(BatchedTask):
         d = self.batched.tensors
         self.steps += 1
         n_touch, in_hand = self._touching()
-        self.held = t.where(in_hand, self.held + 1, t.zeros_like(self.held))
+        self.held = streak(self.held, in_hand)
         ball = d["xpos"][:, self.ball_body].to(t.float32)
         palm = d["site_xpos"][:, self.palm].to(t.float32)
         dropped = (ball[:, 2] < palm[:, 2] - o.drop_margin) | (

@@ -26,7 +26,18 @@ task observation).
 
 from __future__ import annotations
 
-__all__ = ["BatchedTask"]
+__all__ = ["BatchedTask", "hold_steps", "streak"]
+
+
+def hold_steps(seconds: float, dt: float) -> int:
+    """The control steps in a row a task's success must hold (at least 1), as the CPU tasks
+    count them."""
+    return max(1, round(float(seconds) / float(dt)))
+
+
+def streak(count, on):
+    """Per world, the steps in a row ``on`` has held: ``count + 1`` where it holds, else 0."""
+    return (count + 1) * on
 
 
 class BatchedTask:

@@ -17,7 +17,7 @@ from ..core.kinematics import hand_geoms
 from ..tasks.common import right_hand_parts
 from ..tasks.high_five.task import PALM_COS
 from .motor_tasks import BatchedCatch, BatchedRollOver, BatchedStandup
-from .task_base import BatchedTask
+from .task_base import BatchedTask, hold_steps, streak
 
 __all__ = ["TASKS", "BatchedTask", "BatchedFreePlay", "BatchedReach", "BatchedHighFive",
            "BatchedSelfBody", "BatchedStandup", "BatchedCatch", "BatchedRollOver", "batched_task",
@@ -125,7 +125,7 @@ class BatchedHighFive(BatchedTask):
         self.shaping = bool(opts.shaping)
         self.touch_rule = opts.success == "touch"
         self.dt = float(env.dt)
-        self.hold_steps = max(1, int(round(opts.hold_time / env.dt)))
+        self.hold_steps = hold_steps(opts.hold_time, env.dt)
         dev = batched.qpos.device
         hands = [hand_geoms(w, i) for i in range(2)]
         self.hands = [c.mask(h) for h in hands]
@@ -185,7 +185,7 @@ class BatchedHighFive(BatchedTask):
         meet = felt[:, 0] & felt[:, 1] & self.contacts.per_world(
             self.contacts.between(self.hands[0], self.hands[1]))
         palm_contact = meet & self._palms_meet()
-        self.held = t.where(palm_contact, self.held + 1, t.zeros_like(self.held))
+        self.held = streak(self.held, palm_contact)
         touching = meet if self.touch_rule else self.held >= self.hold_steps
         r = (-dist if self.shaping else t.zeros_like(dist)) + self.touch_bonus * touching
         terminated = touching & self.end_on_touch
@@ -279,9 +279,7 @@ class BatchedSelfBody(BatchedTask):
         nearest = t.full((n,), inf, dtype=dist.dtype, device=dist.device).scatter_reduce(
             0, world, dist.masked_fill(~pressed, inf), reduce="amin")
         any_pressed = t.isfinite(nearest)
-        count = t.zeros(n * c.ngeom, dtype=t.int32, device=dist.device)
-        count.index_add_(0, world * c.ngeom + other, pressed.to(t.int32))
-        touched = (count.reshape(n, c.ngeom) > 0).sum(1)
+        touched = c.distinct_per_world(pressed, other, c.ngeom)
         reward = t.where(success, t.full_like(nearest, self.success_reward),
                          t.where(any_pressed, -(self.other_touch_cost + nearest),
                                  t.full_like(nearest, self.miss_reward)))
